@@ -1,0 +1,30 @@
+#pragma once
+// The view frustum of a perspective camera as a convex polyhedron, and an exact test of
+// whether an axis-aligned box meets it.
+#include <homcull/aabb.hpp>
+#include <homcull/camera.hpp>
+
+#include <array>
+
+namespace homcull {
+
+struct Frustum {
+    // Corners: near plane (0..3) then far plane (4..7), each as
+    // bottom-left, bottom-right, top-right, top-left seen from the eye.
+    std::array<glm::dvec3, 8> corners;
+    // Inward-facing planes (normal, offset) with dot(normal, p) + offset >= 0 inside:
+    // left, right, bottom, top, near, far.
+    std::array<glm::dvec4, 6> planes;
+    // Directions of the frustum's edges: the four side edges, then right and up (the
+    // directions of the near and far rectangles' edges).
+    std::array<glm::dvec3, 6> edge_directions;
+};
+
+Frustum make_frustum(const Camera& camera, double aspect);
+
+// True when the box and the frustum share at least one point. Exact (separating axis theorem
+// over the 6 frustum planes, the 3 box axes and the 18 edge-edge cross products), not the
+// usual conservative plane-only test that keeps boxes near frustum corners.
+bool intersects(const Frustum& frustum, const Aabb& box);
+
+}  // namespace homcull

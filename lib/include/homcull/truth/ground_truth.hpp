@@ -1,0 +1,44 @@
+#pragma once
+// Exact per-object visibility by ray casting (DESIGN.md, "The occlusion representation").
+// Rays go from the eye through S x S sample positions per pixel, a regular grid at
+// ((i + (a + 0.5)/S), (j + (b + 0.5)/S)) for a, b in [0, S): S = 1 is the pixel centre.
+// A sample sees the closest surface with view depth in [near, far]; back faces count.
+#include <homcull/camera.hpp>
+#include <homcull/truth/ray_scene.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace homcull {
+
+struct TruthOptions {
+    Resolution resolution{1280, 720};
+    int samples = 1;  // S, sub-samples per pixel along each axis, 1..16
+    // A sample is "robust" when no other object lies within this relative view depth of its
+    // hit: coincident surfaces (the castle's stacked market stalls, the house's rafters 1e-6
+    // under the roof) make the closest hit arbitrary, and robust counts leave them out.
+    double tie_relative_depth = 1e-4;
+    bool keep_sample_ids = false;  // fill TruthResult::sample_ids
+};
+
+struct ObjectVisibility {
+    bool in_frustum = false;  // the world AABB meets the view frustum (exact test)
+    std::uint64_t visible_samples = 0;
+    std::uint64_t robust_samples = 0;
+};
+
+struct TruthResult {
+    std::vector<ObjectVisibility> objects;  // indexed by object id
+    int sample_width = 0, sample_height = 0;  // resolution * samples
+    // Object id per sample (kNoObject where nothing is hit), rows top to bottom; only when
+    // TruthOptions::keep_sample_ids.
+    std::vector<std::uint32_t> sample_ids;
+    std::uint64_t rays = 0;     // primary plus tie-check rays
+    double trace_ms = 0.0;
+};
+
+// Throws homcull::Error on an invalid camera or options. Uses all cores (TBB).
+TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const Camera& camera,
+                                 const TruthOptions& options);
+
+}  // namespace homcull

@@ -1,0 +1,95 @@
+// "name:key=value,key=value" specs for the generated scenes, as the command line takes them.
+#include <homcull/error.hpp>
+#include <homcull/generate.hpp>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <string>
+
+namespace homcull {
+namespace {
+
+std::map<std::string, std::string> parse_options(std::string_view text, std::string_view spec) {
+    std::map<std::string, std::string> options;
+    while (!text.empty()) {
+        const std::size_t comma = text.find(',');
+        const std::string_view item = text.substr(0, comma);
+        const std::size_t eq = item.find('=');
+        if (eq == std::string_view::npos || eq == 0 || eq + 1 == item.size())
+            throw Error("generated scene '" + std::string(spec) + "': expected key=value, got '" +
+                        std::string(item) + "'");
+        options[std::string(item.substr(0, eq))] = std::string(item.substr(eq + 1));
+        text = comma == std::string_view::npos ? std::string_view{} : text.substr(comma + 1);
+    }
+    return options;
+}
+
+double to_number(const std::string& key, const std::string& value, std::string_view spec) {
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(value.c_str(), &end);
+    if (end == value.c_str() || *end != '\0' || errno != 0 || !std::isfinite(v))
+        throw Error("generated scene '" + std::string(spec) + "': " + key + " must be a number, got '" + value + "'");
+    return v;
+}
+
+std::uint64_t to_seed(const std::string& value, std::string_view spec) {
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(value.c_str(), &end, 0);
+    if (end == value.c_str() || *end != '\0' || errno != 0 || value[0] == '-')
+        throw Error("generated scene '" + std::string(spec) + "': seed must be a non-negative integer, got '" + value + "'");
+    return v;
+}
+
+int to_int(const std::string& key, const std::string& value, std::string_view spec) {
+    const double v = to_number(key, value, spec);
+    if (v != std::floor(v) || std::abs(v) > 1e9)
+        throw Error("generated scene '" + std::string(spec) + "': " + key + " must be an integer, got '" + value + "'");
+    return int(v);
+}
+
+}  // namespace
+
+Scene generate_scene(std::string_view spec) {
+    const std::size_t colon = spec.find(':');
+    const std::string name(spec.substr(0, colon));
+    auto options = parse_options(colon == std::string_view::npos ? std::string_view{} : spec.substr(colon + 1), spec);
+    auto take = [&](const char* key) -> const std::string* {
+        auto it = options.find(key);
+        return it == options.end() ? nullptr : &it->second;
+    };
+    Scene scene;
+    if (name == "city") {
+        CityOptions o;
+        if (auto v = take("seed")) o.seed = to_seed(*v, spec);
+        if (auto v = take("blocks")) o.blocks = to_int("blocks", *v, spec);
+        if (auto v = take("block")) o.block_size = to_number("block", *v, spec);
+        if (auto v = take("street")) o.street_width = to_number("street", *v, spec);
+        if (auto v = take("cars")) o.cars_per_block = to_int("cars", *v, spec);
+        for (const char* k : {"seed", "blocks", "block", "street", "cars"}) options.erase(k);
+        if (!options.empty())
+            throw Error("generated scene '" + std::string(spec) + "': unknown option '" + options.begin()->first +
+                        "' (city takes seed, blocks, block, street, cars)");
+        scene = generate_city(o);
+    } else if (name == "forest") {
+        ForestOptions o;
+        if (auto v = take("seed")) o.seed = to_seed(*v, spec);
+        if (auto v = take("radius")) o.radius = to_number("radius", *v, spec);
+        if (auto v = take("spacing")) o.tree_spacing = to_number("spacing", *v, spec);
+        if (auto v = take("rocks")) o.rocks = to_int("rocks", *v, spec);
+        for (const char* k : {"seed", "radius", "spacing", "rocks"}) options.erase(k);
+        if (!options.empty())
+            throw Error("generated scene '" + std::string(spec) + "': unknown option '" + options.begin()->first +
+                        "' (forest takes seed, radius, spacing, rocks)");
+        scene = generate_forest(o);
+    } else {
+        throw Error("unknown generated scene '" + name + "' (known: city, forest)");
+    }
+    scene.source = "gen:" + std::string(spec);
+    return scene;
+}
+
+}  // namespace homcull

@@ -1,0 +1,150 @@
+// Ground-truth visibility: Embree ray packets through every sample of the display, in
+// parallel over image tiles (TBB).
+#include "truth/embree_scene.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/frustum.hpp>
+#include <homcull/truth/ground_truth.hpp>
+
+#include <tbb/blocked_range.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+namespace homcull {
+namespace {
+
+constexpr int kPacket = 8;  // rtcIntersect8: 8 consecutive samples of one row
+constexpr std::uint32_t kNone = RTC_INVALID_GEOMETRY_ID;
+
+// Tie check: a hit of the ray's own object (stored in the ray id) does not count.
+void reject_same_object(const RTCFilterFunctionNArguments* args) {
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        if (RTCHitN_geomID(args->hit, args->N, i) == RTCRayN_id(args->ray, args->N, i)) args->valid[i] = 0;
+    }
+}
+
+}  // namespace
+
+TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const Camera& camera,
+                                 const TruthOptions& options) {
+    validate_camera(camera);
+    validate_resolution(options.resolution);
+    if (options.samples < 1 || options.samples > 16) throw Error("samples per pixel axis must be in [1, 16]");
+    if (!(options.tie_relative_depth >= 0.0 && options.tie_relative_depth < 1.0))
+        throw Error("tie relative depth must be in [0, 1)");
+    if (rays.object_count() != scene.objects.size()) throw Error("the ray scene was built from another scene");
+
+    const auto start = std::chrono::steady_clock::now();
+    const RTCScene rtc = rays.impl().scene;
+    const int S = options.samples;
+    const Resolution display = options.resolution;
+    const int width = display.width * S, height = display.height * S;
+    const double aspect = display.aspect();
+    const CameraBasis basis = camera_basis(camera);
+    const float t_near = float(camera.near_plane), t_far = float(camera.far_plane);
+    const float origin[3] = {float(camera.eye.x), float(camera.eye.y), float(camera.eye.z)};
+    const float tie_lo = float(1.0 - options.tie_relative_depth), tie_hi = float(1.0 + options.tie_relative_depth);
+
+    // Per sample: the object seen, and whether another object lies within the tie window.
+    std::vector<std::uint32_t> ids(std::size_t(width) * std::size_t(height), kNone);
+    std::vector<std::uint8_t> tied(ids.size(), 0);
+    std::atomic<std::uint64_t> tie_rays{0};
+
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 8, 0, width, 64), [&](const tbb::blocked_range2d<int>& tile) {
+        RTCIntersectContext primary;
+        rtcInitIntersectContext(&primary);
+        RTCIntersectContext tie_check;
+        rtcInitIntersectContext(&tie_check);
+        tie_check.filter = reject_same_object;
+        std::uint64_t local_tie_rays = 0;
+
+        for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
+            const double pixel_y = (y + 0.5) / S;
+            for (int x0 = tile.cols().begin(); x0 < tile.cols().end(); x0 += kPacket) {
+                alignas(32) int valid[kPacket];
+                RTCRayHit8 rh;
+                for (int k = 0; k < kPacket; ++k) {
+                    const int x = x0 + k;
+                    valid[k] = x < tile.cols().end() ? -1 : 0;
+                    const glm::dvec2 ndc = pixel_to_ndc(display, (x + 0.5) / S, pixel_y);
+                    const glm::vec3 d(ray_direction(camera, basis, aspect, ndc));
+                    rh.ray.org_x[k] = origin[0];
+                    rh.ray.org_y[k] = origin[1];
+                    rh.ray.org_z[k] = origin[2];
+                    rh.ray.dir_x[k] = d.x;
+                    rh.ray.dir_y[k] = d.y;
+                    rh.ray.dir_z[k] = d.z;
+                    rh.ray.tnear[k] = t_near;
+                    rh.ray.tfar[k] = t_far;
+                    rh.ray.time[k] = 0.0f;
+                    rh.ray.mask[k] = 0xFFFFFFFFu;
+                    rh.ray.id[k] = 0;
+                    rh.ray.flags[k] = 0;
+                    rh.hit.geomID[k] = kNone;
+                    rh.hit.instID[0][k] = kNone;
+                }
+                rtcIntersect8(valid, rtc, &primary, &rh);
+
+                // Tie check: from just before to just after the hit, ignoring the hit object.
+                alignas(32) int tie_valid[kPacket];
+                RTCRay8 tie;
+                bool any = false;
+                for (int k = 0; k < kPacket; ++k) {
+                    const bool hit = valid[k] != 0 && rh.hit.geomID[k] != kNone;
+                    tie_valid[k] = hit ? -1 : 0;
+                    any = any || hit;
+                    tie.org_x[k] = rh.ray.org_x[k];
+                    tie.org_y[k] = rh.ray.org_y[k];
+                    tie.org_z[k] = rh.ray.org_z[k];
+                    tie.dir_x[k] = rh.ray.dir_x[k];
+                    tie.dir_y[k] = rh.ray.dir_y[k];
+                    tie.dir_z[k] = rh.ray.dir_z[k];
+                    tie.tnear[k] = rh.ray.tfar[k] * tie_lo;
+                    tie.tfar[k] = rh.ray.tfar[k] * tie_hi;
+                    tie.time[k] = 0.0f;
+                    tie.mask[k] = 0xFFFFFFFFu;
+                    tie.id[k] = hit ? rh.hit.geomID[k] : kNone;
+                    tie.flags[k] = 0;
+                }
+                if (any) {
+                    rtcOccluded8(tie_valid, rtc, &tie_check, &tie);
+                    for (int k = 0; k < kPacket; ++k) local_tie_rays += tie_valid[k] != 0;
+                }
+                const std::size_t row = std::size_t(y) * std::size_t(width);
+                for (int k = 0; k < kPacket && x0 + k < tile.cols().end(); ++k) {
+                    ids[row + std::size_t(x0 + k)] = rh.hit.geomID[k];
+                    // rtcOccluded8 sets tfar to -inf for rays that hit something.
+                    tied[row + std::size_t(x0 + k)] = tie_valid[k] != 0 && tie.tfar[k] == -INFINITY;
+                }
+            }
+        }
+        tie_rays += local_tie_rays;
+    });
+
+    TruthResult result;
+    result.sample_width = width;
+    result.sample_height = height;
+    result.objects.resize(scene.objects.size());
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+        if (ids[i] == kNone) continue;
+        ObjectVisibility& v = result.objects[ids[i]];
+        ++v.visible_samples;
+        v.robust_samples += tied[i] == 0;
+    }
+    const Frustum frustum = make_frustum(camera, aspect);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.objects.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i)
+            result.objects[i].in_frustum = intersects(frustum, scene.objects[i].world_bounds);
+    });
+    result.rays = ids.size() + tie_rays.load();
+    if (options.keep_sample_ids) result.sample_ids = std::move(ids);  // kNone == kNoObject
+    result.trace_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace homcull

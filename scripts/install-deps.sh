@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package homcull needs to build, test and benchmark.
+# Idempotent: packages already present are left alone. Needs root (or sudo).
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libglm-dev                      # math vocabulary (the only dependency of the core library)
+  libembree-dev libtbb-dev        # ground truth ray casts; TBB drives the tools' parallel-for
+  libopenimageio-dev openimageio-tools  # image dumps (id images, later pyramids)
+  libassimp-dev                   # scene import (glTF/GLB, OBJ, PLY, IFC, ...)
+  libhwy-dev                      # SIMD with runtime dispatch (rasterizer)
+  libmeshoptimizer-dev            # occluder simplification
+  libcli11-dev nlohmann-json3-dev libfmt-dev
+  libtinygltf-dev                 # glTF/GLB import and export (keeps node order and extras)
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed" >&2
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -q
+"${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -1,0 +1,12 @@
+#pragma once
+// Each subcommand of the homcull program registers itself on the top-level app.
+#include <CLI/CLI.hpp>
+
+namespace homcull::cli {
+
+void register_info(CLI::App& app);
+void register_truth(CLI::App& app);
+void register_export(CLI::App& app);
+void register_path(CLI::App& app);
+
+}  // namespace homcull::cli

@@ -1,0 +1,88 @@
+#include "options.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/io/camera_path.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+
+namespace homcull::cli {
+
+void add_scene_option(CLI::App& app, std::string& scene) {
+    app.add_option("--scene", scene,
+                   "Scene file (glTF/GLB, OBJ, PLY, IFC, ... anything assimp reads) or a generated "
+                   "scene: gen:city, gen:forest, with options such as gen:city:seed=3,blocks=10")
+        ->required();
+}
+
+void add_camera_options(CLI::App& app, CameraOptions& o) {
+    auto* eye = app.add_option("--eye", o.eye, "Camera position x,y,z");
+    auto* target = app.add_option("--target", o.target, "Point the camera looks at x,y,z");
+    auto* up = app.add_option("--up", o.up, "Up direction x,y,z")->capture_default_str();
+    auto* fov = app.add_option("--fov-y", o.fov_y, "Vertical field of view, degrees")->capture_default_str();
+    auto* near_opt = app.add_option("--near", o.near_plane, "Near plane distance (view depth)")->capture_default_str();
+    auto* far_opt = app.add_option("--far", o.far_plane, "Far plane distance (view depth)")->capture_default_str();
+    auto* path = app.add_option("--path", o.path, "Camera path file (JSON, see README); use with --frame");
+    auto* frame = app.add_option("--frame", o.frame, "Frame of --path to use (from 0)")->capture_default_str();
+    frame->needs(path);
+    for (auto* single : {eye, target, up, fov, near_opt, far_opt}) single->excludes(path);
+}
+
+Camera resolve_camera(const CameraOptions& o) {
+    if (!o.path.empty()) {
+        const CameraPath path = read_camera_path(o.path);
+        if (o.frame < 0 || std::size_t(o.frame) >= path.frames.size())
+            throw Error(o.path + ": frame " + std::to_string(o.frame) + " out of range (the path has " +
+                        std::to_string(path.frames.size()) + " frames)");
+        return path.frames[std::size_t(o.frame)];
+    }
+    if (o.eye.empty() || o.target.empty())
+        throw Error("no camera: give --eye and --target (and optionally --up, --fov-y, --near, --far), or --path");
+    Camera c;
+    c.eye = parse_vec3(o.eye, "--eye");
+    c.target = parse_vec3(o.target, "--target");
+    c.up = parse_vec3(o.up, "--up");
+    c.fov_y_degrees = o.fov_y;
+    c.near_plane = o.near_plane;
+    c.far_plane = o.far_plane;
+    validate_camera(c);
+    return c;
+}
+
+glm::dvec3 parse_vec3(const std::string& text, const char* what) {
+    glm::dvec3 v;
+    const char* p = text.c_str();
+    for (int k = 0; k < 3; ++k) {
+        char* end = nullptr;
+        v[k] = std::strtod(p, &end);
+        const char expected = k < 2 ? ',' : '\0';
+        if (end == p || *end != expected || !std::isfinite(v[k]))
+            throw Error(std::string(what) + ": expected three numbers x,y,z, got '" + text + "'");
+        p = end + 1;
+    }
+    return v;
+}
+
+Resolution parse_resolution(const std::string& text) {
+    Resolution r;
+    char* end = nullptr;
+    const long w = std::strtol(text.c_str(), &end, 10);
+    if (end == text.c_str() || (*end != 'x' && *end != 'X' && *end != ','))
+        throw Error("resolution: expected WxH such as 1920x1080, got '" + text + "'");
+    const char* rest = end + 1;
+    const long h = std::strtol(rest, &end, 10);
+    if (end == rest || *end != '\0') throw Error("resolution: expected WxH such as 1920x1080, got '" + text + "'");
+    r.width = int(std::max(-1L, std::min(w, 1L << 30)));
+    r.height = int(std::max(-1L, std::min(h, 1L << 30)));
+    validate_resolution(r);
+    return r;
+}
+
+long long now_ns() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double elapsed_ms(long long start_ns) { return double(now_ns() - start_ns) * 1e-6; }
+
+}  // namespace homcull::cli

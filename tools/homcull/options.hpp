@@ -1,0 +1,33 @@
+#pragma once
+// Options several subcommands share: the scene, the camera, the display resolution.
+#include <homcull/camera.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace homcull::cli {
+
+struct CameraOptions {
+    std::string eye, target, up = "0,1,0";
+    double fov_y = 60.0, near_plane = 0.1, far_plane = 10000.0;
+    std::string path;
+    int frame = 0;
+};
+
+// --scene F: a file (glTF/GLB, OBJ, PLY, IFC, ...) or gen:city / gen:forest[:options].
+void add_scene_option(CLI::App& app, std::string& scene);
+// --eye x,y,z --target x,y,z [--up x,y,z --fov-y D --near N --far F], or --path P [--frame K].
+void add_camera_options(CLI::App& app, CameraOptions& options);
+// Throws homcull::Error when the options do not make a valid camera.
+Camera resolve_camera(const CameraOptions& options);
+
+glm::dvec3 parse_vec3(const std::string& text, const char* what);
+// "WxH" (also "W,H").
+Resolution parse_resolution(const std::string& text);
+
+// Milliseconds since `start` (std::chrono::steady_clock).
+double elapsed_ms(long long start_ns);
+long long now_ns();
+
+}  // namespace homcull::cli
