@@ -7,7 +7,7 @@ function(homcull_set_warnings target)
     endif()
   else()
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow
-                           -Wnon-virtual-dtor -Wcast-align -Wunused -Wnull-dereference
+                           -Wnon-virtual-dtor -Wcast-align -Wunused
                            -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
     if(HOMCULL_WARNINGS_AS_ERRORS)
       target_compile_options(${target} PRIVATE -Werror)

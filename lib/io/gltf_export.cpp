@@ -5,6 +5,7 @@
 
 #include "io/tinygltf_config.hpp"
 
+#include <cmath>
 #include <cstring>
 
 namespace homcull {
@@ -43,7 +44,9 @@ void save_glb(const Scene& scene, const std::string& path) {
         positions.type = TINYGLTF_TYPE_VEC3;
         positions.count = mesh.positions.size();
         Aabb box;
-        for (const auto& p : mesh.positions) box.extend(p);
+        for (const auto& p : mesh.positions)  // glTF min/max must be numbers: skip NaN/Inf
+            if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) box.extend(p);
+        if (box.empty()) box.extend(glm::vec3(0.0f));
         positions.minValues = {box.min.x, box.min.y, box.min.z};
         positions.maxValues = {box.max.x, box.max.y, box.max.z};
         model.accessors.push_back(positions);

@@ -32,7 +32,7 @@ Scene generate_city(const CityOptions& o) {
         object.name = std::move(name);
         object.mesh = mesh;
         object.world = world;
-        object.extras = {{"set", set}, {"role", role}};
+        object.extras = {{"role", role}, {"set", set}};  // sorted, as glTF export writes them
         scene.objects.push_back(std::move(object));
     };
 

@@ -36,7 +36,7 @@ Scene generate_forest(const ForestOptions& o) {
         object.name = std::move(name);
         object.mesh = mesh;
         object.world = world;
-        object.extras = {{"set", set}, {"role", role}};
+        object.extras = {{"role", role}, {"set", set}};  // sorted, as glTF export writes them
         scene.objects.push_back(std::move(object));
     };
     add("ground", ground_mesh, detail::place({0, 0, 0}, {2 * o.radius + 20, 1, 2 * o.radius + 20}),

@@ -8,19 +8,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <map>
+#include <utility>
 
 namespace homcull {
 namespace {
 
-constexpr float kNoLimit = 1e30f;
 const glm::dvec3 kDown(0.0, -1.0, 0.0);
 
 glm::dvec3 heading_vector(double angle) { return {std::cos(angle), 0.0, std::sin(angle)}; }
 
 class Walker {
 public:
-    Walker(const RayScene& rays, double eye_height)
-        : rays_(rays), eye_height_(eye_height), clearance_(0.25 * eye_height),
+    Walker(const RayScene& rays, double eye_height, double step)
+        : rays_(rays), eye_height_(eye_height), step_(step), clearance_(0.25 * eye_height),
           max_step_up_(0.2 * eye_height), max_drop_(0.5 * eye_height) {}
 
     // Free distance along a direction from a point, up to `limit`.
@@ -45,27 +47,70 @@ public:
         return std::min(free_distance(eye, direction, limit), free_distance(knee, direction, limit));
     }
 
-    // Is the eye position in open space: room around it and overhead, not inside a solid?
-    // Returns the mean free distance over 8 directions (a measure of openness), or -1.
-    double openness(const glm::dvec3& eye, double look) const {
-        if (free_distance(eye, {0, 1, 0}, 0.3 * eye_height_) < 0.3 * eye_height_) return -1;
-        double total = 0.0;
+    // One move of `distance` along a horizontal direction: no wall within the move plus the
+    // clearance (at eye and knee height), a floor under the new position that is at most a
+    // stair step higher and not a ledge lower, and room to rise onto it. The one rule both
+    // the walk and the search for a start point use.
+    bool try_move(const glm::dvec3& eye, const glm::dvec3& direction, double distance, glm::dvec3& next) const {
+        const double needed = distance + 2.0 * clearance_;
+        if (free_ahead(eye, direction, needed) < needed) return false;
+        const glm::dvec3 moved = eye + distance * direction;
+        double floor_y;
+        if (!floor_below(moved, eye_height_ + max_drop_, floor_y)) return false;
+        if (floor_y > moved.y - eye_height_ + max_step_up_) return false;
+        const glm::dvec3 raised(moved.x, floor_y + eye_height_, moved.z);
+        if (raised.y > moved.y && free_distance(moved, raised - moved, 1.0) < 1.0) return false;
+        next = raised;
+        return true;
+    }
+
+    // Rejects eye positions that are not in open space (too little room around or overhead,
+    // or inside a solid); otherwise counts the 8 horizontal directions that meet geometry
+    // within `reach`: streets and halls are enclosed, roofs and open fields are not.
+    bool enclosure(const glm::dvec3& eye, double reach, int& enclosed) const {
+        if (free_distance(eye, {0, 1, 0}, 0.3 * eye_height_) < 0.3 * eye_height_) return false;
+        enclosed = 0;
         int back_faces = 0;
         for (int k = 0; k < 8; ++k) {
             const glm::dvec3 d = heading_vector(k * glm::quarter_pi<double>());
-            const RayHit hit = rays_.intersect(glm::vec3(eye), glm::vec3(d), 0.0f, float(look));
-            const double free = hit.hit() ? double(hit.t) : look;
-            if (free < 2 * clearance_) return -1;
+            const RayHit hit = rays_.intersect(glm::vec3(eye), glm::vec3(d), 0.0f, float(reach));
+            if (hit.hit() && double(hit.t) < 2.0 * clearance_) return false;
             // Seeing the inside of surfaces in most directions means we are inside a solid.
             if (hit.hit() && glm::dot(glm::dvec3(hit.normal), d) > 0.0) ++back_faces;
-            total += free;
+            enclosed += hit.hit();
         }
-        if (back_faces >= 5) return -1;
-        return total / 8.0;
+        return back_faces < 5;
+    }
+
+    // How much floor can be walked to from `eye`: a breadth-first flood fill over a grid of
+    // cells 4 steps wide, moving by try_move, counting cells up to `cap`. A roof or a
+    // balcony is small; a street network or a hall is large.
+    int reachable_cells(const glm::dvec3& eye, int cap) const {
+        const double cell = 4.0 * step_;
+        std::map<std::pair<int, int>, bool> seen;
+        std::deque<std::pair<std::pair<int, int>, glm::dvec3>> queue;
+        seen[{0, 0}] = true;
+        queue.push_back({{0, 0}, eye});
+        const int dx[4] = {1, -1, 0, 0}, dz[4] = {0, 0, 1, -1};
+        int count = 1;
+        while (!queue.empty() && count < cap) {
+            const auto [key, position] = queue.front();
+            queue.pop_front();
+            for (int k = 0; k < 4 && count < cap; ++k) {
+                const std::pair<int, int> next_key(key.first + dx[k], key.second + dz[k]);
+                if (seen.count(next_key)) continue;
+                glm::dvec3 next;
+                if (!try_move(position, glm::dvec3(dx[k], 0, dz[k]), cell, next)) continue;
+                seen[next_key] = true;
+                queue.push_back({next_key, next});
+                ++count;
+            }
+        }
+        return count;
     }
 
     const RayScene& rays_;
-    double eye_height_, clearance_, max_step_up_, max_drop_;
+    double eye_height_, step_, clearance_, max_step_up_, max_drop_;
 };
 
 }  // namespace
@@ -84,27 +129,32 @@ CameraPath walk_path(const RayScene& rays, const Scene& scene, const WalkOptions
     const double step = options.step > 0 ? options.step : eye_height / 5.0;
     const glm::dvec3 lo(bounds.min), hi(bounds.max);
     const double diagonal = glm::length(hi - lo);
-    const Walker walker(rays, eye_height);
+    const Walker walker(rays, eye_height, step);
     const double look = 20.0 * step;
     detail::SplitMix64 rng(options.seed);
 
-    // Start at the most open of up to 48 valid random floor points.
+    // Start at the best of up to 32 valid random floor points: enclosed (6 or more of 8
+    // directions meet geometry), then the most floor to walk on.
     glm::dvec3 eye(0.0);
-    double best = -1.0;
+    std::pair<bool, int> best(false, -1);
     int found = 0;
-    for (int attempt = 0; attempt < 20000 && found < 48; ++attempt) {
+    for (int attempt = 0; attempt < 20000 && found < 32; ++attempt) {
         const glm::dvec3 probe(rng.uniform(lo.x, hi.x), rng.uniform(lo.y, hi.y), rng.uniform(lo.z, hi.z));
         double floor_y;
         if (!walker.floor_below(probe, hi.y - lo.y + 1.0, floor_y)) continue;
         const glm::dvec3 candidate(probe.x, floor_y + eye_height, probe.z);
-        const double open = walker.openness(candidate, look);
-        if (open < 4.0 * step) continue;
+        int enclosed;
+        if (!walker.enclosure(candidate, diagonal, enclosed)) continue;
         ++found;
-        if (open > best) { best = open; eye = candidate; }
+        const std::pair<bool, int> score(enclosed >= 6, walker.reachable_cells(candidate, 600));
+        if (score > best) {
+            best = score;
+            eye = candidate;
+        }
     }
-    if (found == 0)
-        throw Error("walk: found no walkable floor with room to walk in " + scene.source +
-                    " (eye height " + std::to_string(eye_height) + "; try --eye-height)");
+    if (found == 0 || best.second < 4)
+        throw Error("walk: found no walkable floor with room to walk in " + scene.source + " (eye height " +
+                    std::to_string(eye_height) + "; try --eye-height)");
 
     Camera camera;
     camera.fov_y_degrees = options.fov_y_degrees;
@@ -130,36 +180,26 @@ CameraPath walk_path(const RayScene& rays, const Scene& scene, const WalkOptions
         }
         turn_rate = 0.9 * turn_rate + 0.02 * rng.uniform(-1.0, 1.0);
         heading += turn_rate;
-        const glm::dvec3 dir = heading_vector(heading);
-
-        bool moved = false;
-        if (walker.free_ahead(eye, dir, step + 2 * walker.clearance_) >= step + 2 * walker.clearance_) {
-            const glm::dvec3 next = eye + step * dir;
-            double floor_y;
-            // The floor under the next position: not more than a step up, not a ledge down.
-            if (walker.floor_below(next, eye_height + walker.max_drop_, floor_y) &&
-                floor_y <= next.y - eye_height + walker.max_step_up_) {
-                const glm::dvec3 raised(next.x, floor_y + eye_height, next.z);
-                if (raised.y <= next.y || walker.free_distance(next, raised - next, 1.0) >= 1.0) {
-                    eye = raised;
-                    moved = true;
-                }
+        glm::dvec3 next;
+        if (walker.try_move(eye, heading_vector(heading), step, next)) {
+            eye = next;
+            continue;
+        }
+        // Blocked by a wall or a ledge: turn towards the most open direction in which a
+        // step is possible (the smallest turn on ties); turn around if there is none.
+        double best_free = -1.0, best_turn = glm::pi<double>();
+        for (int k = 1; k < 16; ++k) {
+            const double turn = (k <= 8 ? k : k - 16) * glm::pi<double>() / 8.0;
+            const glm::dvec3 dir = heading_vector(heading + turn);
+            if (!walker.try_move(eye, dir, step, next)) continue;
+            const double free = walker.free_ahead(eye, dir, look);
+            if (free > best_free + 1e-6 || (std::abs(free - best_free) <= 1e-6 && std::abs(turn) < std::abs(best_turn))) {
+                best_free = free;
+                best_turn = turn;
             }
         }
-        if (!moved) {
-            // Blocked: turn towards the most open of 16 directions (the smallest turn on ties).
-            double best_free = -1.0, best_turn = glm::pi<double>();
-            for (int k = 1; k < 16; ++k) {
-                const double turn = (k <= 8 ? k : k - 16) * glm::pi<double>() / 8.0;
-                const double free = walker.free_ahead(eye, heading_vector(heading + turn), look);
-                if (free > best_free + 1e-6 || (std::abs(free - best_free) <= 1e-6 && std::abs(turn) < std::abs(best_turn))) {
-                    best_free = free;
-                    best_turn = turn;
-                }
-            }
-            pending_turn = best_turn;
-            turn_rate = 0.0;
-        }
+        pending_turn = best_turn;
+        turn_rate = 0.0;
     }
     return path;
 }

@@ -26,7 +26,7 @@ struct Object {
     glm::dmat4 world{1.0};  // model to world
     Aabb world_bounds;      // of the transformed vertices the mesh's triangles use
     // Application data from the file (glTF node extras such as the castle's set and role);
-    // string values as they are, other JSON values as their JSON text.
+    // keys sorted, string values as they are, other JSON values as their JSON text.
     std::vector<std::pair<std::string, std::string>> extras;
 
     // The value of an extra, or nullptr.

@@ -18,7 +18,8 @@ struct WalkOptions {
 };
 
 // A smooth walk at eye height above walkable floors (surfaces within 45 degrees of level):
-// it starts at the most open of many random floor points, turns gently, steps up at most a
+// it starts at a random floor point in the most enclosed open space (a street or a hall,
+// not a roof), turns gently, steps up at most a
 // fifth of the eye height, never steps off a ledge higher than half the eye height, and
 // never moves closer than a quarter of the eye height to a wall. Every move is checked by
 // ray casts at eye and knee height, so the path does not pass through geometry.

@@ -1,0 +1,65 @@
+#include "support.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+namespace homcull::test {
+
+std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+    Mesh mesh;
+    mesh.name = name;
+    mesh.positions = {a, b, c, d};
+    mesh.indices = {0, 1, 2, 0, 2, 3};
+    scene.meshes.push_back(mesh);
+    Object object;
+    object.name = name;
+    object.mesh = std::uint32_t(scene.meshes.size() - 1);
+    scene.objects.push_back(object);
+    scene.finalize();
+    return std::uint32_t(scene.objects.size() - 1);
+}
+
+std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::vec3 hi) {
+    Mesh mesh;
+    mesh.name = name;
+    for (int k = 0; k < 8; ++k)
+        mesh.positions.emplace_back((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    mesh.indices = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                    2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+    scene.meshes.push_back(mesh);
+    Object object;
+    object.name = name;
+    object.mesh = std::uint32_t(scene.meshes.size() - 1);
+    scene.objects.push_back(object);
+    scene.finalize();
+    return std::uint32_t(scene.objects.size() - 1);
+}
+
+Camera camera_down_minus_z(double fov_y_degrees, double near_plane, double far_plane) {
+    Camera c;
+    c.eye = {0, 0, 0};
+    c.target = {0, 0, -1};
+    c.up = {0, 1, 0};
+    c.fov_y_degrees = fov_y_degrees;
+    c.near_plane = near_plane;
+    c.far_plane = far_plane;
+    return c;
+}
+
+std::string temp_dir(const std::string& test_name) {
+    const std::filesystem::path dir = std::filesystem::path(HOMCULL_TEST_TMP_DIR) / test_name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir.string();
+}
+
+std::string shared_scene(const std::string& file) {
+    const std::filesystem::path path = std::filesystem::path(HOMCULL_SHARED_SCENES_DIR) / file;
+    return std::filesystem::is_regular_file(path) ? path.string() : std::string();
+}
+
+void write_text(const std::string& path, const std::string& text) {
+    std::ofstream(path, std::ios::binary) << text;
+}
+
+}  // namespace homcull::test

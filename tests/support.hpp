@@ -1,0 +1,23 @@
+#pragma once
+// Small scenes built in code, with answers known by construction, and paths for test files.
+#include <homcull/camera.hpp>
+#include <homcull/scene.hpp>
+
+#include <string>
+
+namespace homcull::test {
+
+// Appends an object holding a quad (two CCW triangles a, b, c, d) with its own mesh.
+std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d);
+// Appends an axis-aligned box object (12 triangles, CCW outward).
+std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::vec3 hi);
+// A camera at the origin looking down -z with the given vertical field of view.
+Camera camera_down_minus_z(double fov_y_degrees = 90.0, double near_plane = 0.1, double far_plane = 1000.0);
+
+// A fresh, empty folder for one test's files.
+std::string temp_dir(const std::string& test_name);
+// ../shared/scenes/<file>, or "" when the shared folder is missing.
+std::string shared_scene(const std::string& file);
+void write_text(const std::string& path, const std::string& text);
+
+}  // namespace homcull::test

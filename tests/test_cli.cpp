@@ -1,0 +1,109 @@
+// The homcull program end to end: exit codes, messages, JSON.
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <sys/wait.h>
+
+namespace homcull {
+namespace {
+
+struct CliRun {
+    int exit_code;
+    std::string out, err;
+};
+
+CliRun run_cli(const std::string& arguments) {
+    const std::string dir = test::temp_dir("cli_run");
+    const std::string command = std::string(HOMCULL_CLI_PATH) + " " + arguments + " >" + dir + "/out 2>" + dir + "/err";
+    const int status = std::system(command.c_str());
+    auto slurp = [](const std::string& path) {
+        std::FILE* f = std::fopen(path.c_str(), "rb");
+        std::string text;
+        if (!f) return text;
+        std::array<char, 65536> buffer;
+        for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), f)) > 0;) text.append(buffer.data(), n);
+        std::fclose(f);
+        return text;
+    };
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir + "/out"), slurp(dir + "/err")};
+}
+
+#define EXPECT_MENTIONS(text, fragment) EXPECT_NE((text).find(fragment), std::string::npos) << (text)
+
+const std::string kCityCamera = "--scene gen:city:seed=2,blocks=3 --eye -1,1.7,-30 --target 20,3,10 --resolution 96x54";
+
+TEST(Cli, TruthJsonHasEveryObjectInTheDesignFormat) {
+    const CliRun r = run_cli("truth " + kCityCamera + " --samples 2 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(j["objects"].is_array());
+    std::uint64_t samples = 0;
+    for (std::size_t i = 0; i < j["objects"].size(); ++i) {
+        const auto& o = j["objects"][i];
+        EXPECT_EQ(o["id"], i);
+        for (const char* key : {"name", "triangles", "in_frustum", "visible_samples", "robust_samples", "result"})
+            EXPECT_TRUE(o.contains(key)) << key;
+        samples += o["visible_samples"].get<std::uint64_t>();
+    }
+    EXPECT_EQ(samples + j["summary"]["background_samples"].get<std::uint64_t>(), 96u * 54u * 4u);
+    EXPECT_EQ(j["resolution"], nlohmann::json({96, 54}));
+}
+
+TEST(Cli, PathFileFramesDriveTheCamera) {
+    const std::string dir = test::temp_dir("cli_path");
+    CliRun r = run_cli("path --scene gen:city:blocks=3 --kind walk --frames 20 --out " + dir + "/walk.json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_cli("truth --scene gen:city:blocks=3 --path " + dir + "/walk.json --frame 19 --resolution 64x36 --id-image " + dir +
+            "/ids.png");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_MENTIONS(r.out, "ids.png");
+    r = run_cli("truth --scene gen:city:blocks=3 --path " + dir + "/walk.json --frame 20 --resolution 64x36");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "frame 20 out of range (the path has 20 frames)");
+    r = run_cli("path --scene gen:city:blocks=3 --kind orbit --frames 8");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["frames"].size(), 8u);
+}
+
+TEST(Cli, ExportThenInfoGivesTheSameScene) {
+    const std::string dir = test::temp_dir("cli_export");
+    CliRun r = run_cli("export --scene gen:forest:radius=15 --out " + dir + "/forest.glb");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto generated = nlohmann::json::parse(run_cli("info --scene gen:forest:radius=15 --json").out);
+    r = run_cli("info --scene " + dir + "/forest.glb --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto loaded = nlohmann::json::parse(r.out);
+    EXPECT_EQ(loaded["objects"], generated["objects"]);
+}
+
+TEST(Cli, BadInputExitsWithOneAndSaysWhatIsWrong) {
+    CliRun r = run_cli("info --scene /nonexistent/scene.glb");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "/nonexistent/scene.glb: no such file");
+    r = run_cli("truth --scene gen:city --resolution 64x36");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "no camera");
+    r = run_cli("truth " + kCityCamera + " --resolution 0x10");
+    EXPECT_NE(r.exit_code, 0);
+    r = run_cli("truth --scene gen:city --eye 0,1,0 --target 0,1,0 --resolution 64x36");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "same point");
+    r = run_cli("truth --scene gen:city --eye 0,1 --target 0,1,0");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--eye: expected three numbers");
+    r = run_cli("truth --scene gen:city --eye 0,1,0 --target 5,1,0 --resolution wide");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "expected WxH");
+    r = run_cli("truth --scene gen:village --eye 0,1,0 --target 5,1,0");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "unknown generated scene 'village'");
+    r = run_cli("frobnicate");
+    EXPECT_NE(r.exit_code, 0);
+}
+
+}  // namespace
+}  // namespace homcull

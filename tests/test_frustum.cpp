@@ -1,0 +1,95 @@
+#include <homcull/frustum.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+namespace homcull {
+namespace {
+
+Camera looking_down_minus_z() {
+    Camera c;
+    c.fov_y_degrees = 90.0;
+    c.near_plane = 1.0;
+    c.far_plane = 100.0;
+    return c;
+}
+
+Aabb box(glm::vec3 lo, glm::vec3 hi) { return Aabb{lo, hi}; }
+
+TEST(Frustum, ObviousCases) {
+    const Frustum f = make_frustum(looking_down_minus_z(), 1.0);
+    EXPECT_TRUE(intersects(f, box({-1, -1, -10}, {1, 1, -8})));       // straight ahead
+    EXPECT_FALSE(intersects(f, box({-1, -1, 5}, {1, 1, 8})));         // behind the eye
+    EXPECT_FALSE(intersects(f, box({-1, -1, -300}, {1, 1, -200})));   // beyond far
+    EXPECT_FALSE(intersects(f, box({-0.1f, -0.1f, -0.5f}, {0.1f, 0.1f, -0.2f})));  // before near
+    EXPECT_TRUE(intersects(f, box({-0.1f, -0.1f, -2}, {0.1f, 0.1f, 0.5f})));       // through near
+    EXPECT_FALSE(intersects(f, box({11, -1, -10}, {12, 1, -9})));     // right of the right plane
+    EXPECT_TRUE(intersects(f, box({9, -1, -10}, {12, 1, -9})));       // across it
+    EXPECT_TRUE(intersects(f, box({-1000, -1000, -1000}, {1000, 1000, 1000})));  // contains it
+    EXPECT_FALSE(intersects(f, Aabb{}));                                // empty box
+}
+
+// An independent oracle: clip each face of the box by the six frustum planes
+// (Sutherland-Hodgman); the bodies meet iff a face keeps some area, or the frustum lies
+// inside the box.
+bool meets_by_clipping(const Frustum& f, const Aabb& b) {
+    const glm::dvec3 lo(b.min), hi(b.max);
+    auto corner = [&](int k) { return glm::dvec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z); };
+    const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    for (const auto& face : faces) {
+        std::vector<glm::dvec3> poly = {corner(face[0]), corner(face[1]), corner(face[2]), corner(face[3])};
+        for (const auto& plane : f.planes) {
+            std::vector<glm::dvec3> out;
+            for (std::size_t i = 0; i < poly.size(); ++i) {
+                const glm::dvec3 a = poly[i], c = poly[(i + 1) % poly.size()];
+                const double da = glm::dot(glm::dvec3(plane), a) + plane.w, dc = glm::dot(glm::dvec3(plane), c) + plane.w;
+                if (da >= 0) out.push_back(a);
+                if ((da >= 0) != (dc >= 0)) out.push_back(a + (c - a) * (da / (da - dc)));
+            }
+            poly = out;
+            if (poly.empty()) break;
+        }
+        if (!poly.empty()) return true;
+    }
+    const glm::dvec3 p = f.corners[0];
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+}
+
+bool plane_test(const Frustum& f, const Aabb& b) {  // the usual conservative test
+    for (const auto& plane : f.planes) {
+        const glm::dvec3 n(plane);
+        const glm::dvec3 far_corner(n.x >= 0 ? b.max.x : b.min.x, n.y >= 0 ? b.max.y : b.min.y, n.z >= 0 ? b.max.z : b.min.z);
+        if (glm::dot(n, far_corner) + plane.w < 0) return false;
+    }
+    return true;
+}
+
+TEST(Frustum, ExactAgainstClippingOracleOnRandomBoxes) {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> pos(-60.0, 60.0), size(0.1, 15.0);
+    int disagreements = 0, plane_test_keeps_outside = 0;
+    for (int camera_trial = 0; camera_trial < 20; ++camera_trial) {
+        Camera c;
+        c.eye = {pos(rng) * 0.2, pos(rng) * 0.2, pos(rng) * 0.2};
+        c.target = {pos(rng), pos(rng), pos(rng)};
+        c.fov_y_degrees = 30.0 + double(rng() % 90);
+        c.near_plane = 0.5;
+        c.far_plane = 80.0;
+        const Frustum f = make_frustum(c, 1.6);
+        for (int k = 0; k < 2000; ++k) {
+            const glm::vec3 lo(glm::dvec3(pos(rng), pos(rng), pos(rng)));
+            const Aabb b{lo, lo + glm::vec3(glm::dvec3(size(rng), size(rng), size(rng)))};
+            const bool exact = intersects(f, b);
+            disagreements += exact != meets_by_clipping(f, b);
+            plane_test_keeps_outside += plane_test(f, b) && !exact;
+            if (exact) { EXPECT_TRUE(plane_test(f, b)) << "the exact test must never be looser"; }
+        }
+    }
+    EXPECT_EQ(disagreements, 0);
+    EXPECT_GT(plane_test_keeps_outside, 0) << "expected boxes near frustum edges that only the exact test rejects";
+}
+
+}  // namespace
+}  // namespace homcull

@@ -1,0 +1,162 @@
+// Bad input gets a clear error that names the file and the problem, never a crash.
+#include "support.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/generate.hpp>
+#include <homcull/io/camera_path.hpp>
+#include <homcull/io/scene_io.hpp>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+namespace homcull {
+namespace {
+
+// The message of the homcull::Error that loading `path` throws.
+std::string load_error(const std::string& path) {
+    try {
+        load_scene(path);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(loaded without error)";
+}
+
+#define EXPECT_MENTIONS(message, fragment) \
+    EXPECT_NE((message).find(fragment), std::string::npos) << "message: " << (message)
+
+TEST(MalformedInput, MissingFilesAndFolders) {
+    const std::string dir = test::temp_dir("Missing");
+    for (const char* name : {"/none.glb", "/none.gltf", "/none.obj", "/none.ply"}) {
+        const std::string message = load_error(dir + name);
+        EXPECT_MENTIONS(message, dir + name);
+        EXPECT_MENTIONS(message, "no such file");
+    }
+    EXPECT_MENTIONS(load_error(dir), "no such file");  // a folder is not a scene
+}
+
+TEST(MalformedInput, UnsupportedExtension) {
+    const std::string path = test::temp_dir("Unsupported") + "/scene.xyz";
+    test::write_text(path, "hello");
+    EXPECT_MENTIONS(load_error(path), "unsupported scene format '.xyz'");
+}
+
+TEST(MalformedInput, BrokenGlbFiles) {
+    const std::string dir = test::temp_dir("BrokenGlb");
+    test::write_text(dir + "/empty.glb", "");
+    test::write_text(dir + "/text.glb", "this is not a glb");
+    test::write_text(dir + "/json.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [");
+    for (const char* name : {"/empty.glb", "/text.glb", "/json.gltf"}) {
+        const std::string message = load_error(dir + name);
+        EXPECT_MENTIONS(message, dir + name);
+        EXPECT_MENTIONS(message, "not a readable glTF file");
+    }
+    // A real GLB cut short at every few hundred bytes.
+    save_glb(generate_scene("city:blocks=1"), dir + "/whole.glb");
+    std::ifstream in(dir + "/whole.glb", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (std::size_t cut : {std::size_t(12), std::size_t(20), std::size_t(200), bytes.size() / 2, bytes.size() - 1}) {
+        test::write_text(dir + "/cut.glb", bytes.substr(0, cut));
+        EXPECT_MENTIONS(load_error(dir + "/cut.glb"), dir + "/cut.glb");
+    }
+}
+
+// A one-triangle glTF whose pieces the tests below break one at a time.
+// Positions (0,0,0) (1,0,0) (0,1,0) as little-endian floats; indices as base64 of uint16s.
+std::string triangle_gltf(const std::string& indices_data, int index_count, int position_count = 3,
+                          const std::string& position_type = "VEC3") {
+    return R"({"asset":{"version":"2.0"},"nodes":[{"name":"t","mesh":0}],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],
+      "accessors":[{"bufferView":0,"componentType":5126,"count":)" + std::to_string(position_count) +
+           R"(,"type":")" + position_type + R"(","min":[0,0,0],"max":[1,1,0]},
+                   {"bufferView":1,"componentType":5123,"count":)" + std::to_string(index_count) + R"(,"type":"SCALAR"}],
+      "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36},{"buffer":1,"byteOffset":0,"byteLength":6}],
+      "buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"},
+                 {"byteLength":6,"uri":"data:application/octet-stream;base64,)" + indices_data + R"("}]})";
+}
+
+TEST(MalformedInput, GltfIndexAndAccessorErrors) {
+    const std::string dir = test::temp_dir("GltfErrors");
+    test::write_text(dir + "/ok.gltf", triangle_gltf("AAABAAIA", 3));  // indices 0 1 2
+    EXPECT_EQ(load_scene(dir + "/ok.gltf").instanced_triangle_count(), 1u);
+
+    test::write_text(dir + "/index.gltf", triangle_gltf("AAABAAkA", 3));  // 0 1 9
+    const std::string index_message = load_error(dir + "/index.gltf");
+    EXPECT_MENTIONS(index_message, dir + "/index.gltf");
+    EXPECT_MENTIONS(index_message, "index 9 out of range");
+
+    test::write_text(dir + "/short.gltf", triangle_gltf("AAABAAIA", 3, 30));  // 30 positions in 36 bytes
+    EXPECT_MENTIONS(load_error(dir + "/short.gltf"), "past the end");
+
+    test::write_text(dir + "/count.gltf", triangle_gltf("AAABAAIA", 2));  // 2 indices: not triangles
+    EXPECT_MENTIONS(load_error(dir + "/count.gltf"), dir + "/count.gltf");
+
+    test::write_text(dir + "/type.gltf", triangle_gltf("AAABAAIA", 3, 3, "VEC2"));
+    EXPECT_MENTIONS(load_error(dir + "/type.gltf"), dir + "/type.gltf");
+}
+
+TEST(MalformedInput, NonFiniteVerticesDropTheirTrianglesOnly) {
+    Scene scene = generate_scene("city:blocks=1,cars=0");
+    scene.meshes[1].positions[0].x = std::numeric_limits<float>::quiet_NaN();  // a box corner
+    scene.meshes[1].positions[7].y = std::numeric_limits<float>::infinity();
+    const std::string path = test::temp_dir("NonFinite") + "/nan.glb";
+    save_glb(scene, path);
+    const Scene loaded = load_scene(path);
+    // Corner 0 is used by 6 of the box's triangles and corner 7 by the other 6: none is
+    // left, and the boxes become empty objects (ids unchanged). One bad corner keeps 6.
+    EXPECT_EQ(loaded.meshes[1].triangle_count(), 0u);
+    Scene one_bad = generate_scene("city:blocks=1,cars=0");
+    one_bad.meshes[1].positions[0].x = std::numeric_limits<float>::quiet_NaN();
+    save_glb(one_bad, path);
+    EXPECT_EQ(load_scene(path).meshes[1].triangle_count(), 6u);
+    for (const Object& o : loaded.objects)
+        EXPECT_TRUE(o.world_bounds.empty() || (std::isfinite(o.world_bounds.min.x) && std::isfinite(o.world_bounds.max.y)))
+            << o.name;
+}
+
+TEST(MalformedInput, BrokenObjFiles) {
+    const std::string dir = test::temp_dir("BrokenObj");
+    test::write_text(dir + "/garbage.obj", "\x01\x02\x03 not an obj\n");
+    EXPECT_MENTIONS(load_error(dir + "/garbage.obj"), dir + "/garbage.obj");
+    test::write_text(dir + "/index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    EXPECT_MENTIONS(load_error(dir + "/index.obj"), dir + "/index.obj");
+}
+
+TEST(MalformedInput, CameraPathFiles) {
+    auto error_of = [](const std::string& text) {
+        try {
+            parse_camera_path(text, "path.json");
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("(no error)");
+    };
+    EXPECT_MENTIONS(error_of("{"), "path.json: not valid JSON");
+    EXPECT_MENTIONS(error_of("{\"frames\": 3}"), "expected {\"frames\"");
+    EXPECT_MENTIONS(error_of("{\"frames\": []}"), "no frames");
+    EXPECT_MENTIONS(error_of("{\"frames\": [{\"eye\":[0,0,0]}]}"), "frame 0: missing \"target\"");
+    EXPECT_MENTIONS(error_of("{\"frames\": [{\"eye\":[0,0,0],\"target\":[0,0,-1]},{\"eye\":[1,1,1],\"target\":[1,1,1]}]}"),
+                    "frame 1: camera: eye and target are the same point");
+    EXPECT_MENTIONS(error_of("{\"frames\": [{\"eye\":[0,0],\"target\":[0,0,-1]}]}"), "three numbers");
+    EXPECT_MENTIONS(error_of("{\"frames\": [{\"eye\":[0,0,0],\"target\":[0,0,-1],\"near\":\"x\"}]}"), "\"near\" must be a number");
+    const CameraPath ok = parse_camera_path("{\"frames\": [{\"eye\":[0,0,0],\"target\":[0,0,-1]}]}", "p");
+    EXPECT_EQ(ok.frames[0].fov_y_degrees, 60.0);
+    EXPECT_EQ(ok.frames[0].far_plane, 10000.0);
+    try {
+        read_camera_path("/nonexistent/path.json");
+        ADD_FAILURE();
+    } catch (const Error& e) {
+        EXPECT_MENTIONS(std::string(e.what()), "/nonexistent/path.json");
+    }
+    // A round trip through the file format keeps every number.
+    CameraPath path;
+    path.frames.push_back(ok.frames[0]);
+    path.frames[0].eye = {0.1, 1.0 / 3.0, -7e5};
+    EXPECT_EQ(parse_camera_path(camera_path_to_json(path), "p").frames[0].eye, path.frames[0].eye);
+}
+
+}  // namespace
+}  // namespace homcull
