@@ -161,7 +161,17 @@ CameraPath walk_path(const RayScene& rays, const Scene& scene, const WalkOptions
     camera.near_plane = eye_height / 17.0;  // 0.1 m for a 1.7 m eye
     camera.far_plane = std::max(2.0 * diagonal, 10.0 * eye_height);
 
-    double heading = rng.uniform(0.0, 2.0 * glm::pi<double>());
+    // Set off towards the most open of 16 directions.
+    double heading = 0.0, heading_free = -1.0;
+    const double offset = rng.uniform(0.0, glm::pi<double>() / 8.0);
+    for (int k = 0; k < 16; ++k) {
+        const double angle = offset + k * glm::pi<double>() / 8.0;
+        const double free = walker.free_ahead(eye, heading_vector(angle), 4.0 * look);
+        if (free > heading_free) {
+            heading_free = free;
+            heading = angle;
+        }
+    }
     double turn_rate = 0.0;        // radians per frame, smoothed
     double pending_turn = 0.0;     // a turn away from an obstacle, done gradually
     const double max_turn = 0.12;  // radians per frame
