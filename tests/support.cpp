@@ -4,19 +4,26 @@
 #include <fstream>
 
 namespace homcull::test {
+namespace {
+
+std::uint32_t add_object_with_own_mesh(Scene& scene, Mesh mesh) {
+    Object object;
+    object.name = mesh.name;
+    object.mesh = std::uint32_t(scene.meshes.size());
+    scene.meshes.push_back(std::move(mesh));
+    scene.objects.push_back(object);
+    scene.finalize();
+    return std::uint32_t(scene.objects.size() - 1);
+}
+
+}  // namespace
 
 std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
     Mesh mesh;
     mesh.name = name;
     mesh.positions = {a, b, c, d};
     mesh.indices = {0, 1, 2, 0, 2, 3};
-    scene.meshes.push_back(mesh);
-    Object object;
-    object.name = name;
-    object.mesh = std::uint32_t(scene.meshes.size() - 1);
-    scene.objects.push_back(object);
-    scene.finalize();
-    return std::uint32_t(scene.objects.size() - 1);
+    return add_object_with_own_mesh(scene, std::move(mesh));
 }
 
 std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::vec3 hi) {
@@ -26,13 +33,7 @@ std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::
         mesh.positions.emplace_back((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
     mesh.indices = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
                     2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
-    scene.meshes.push_back(mesh);
-    Object object;
-    object.name = name;
-    object.mesh = std::uint32_t(scene.meshes.size() - 1);
-    scene.objects.push_back(object);
-    scene.finalize();
-    return std::uint32_t(scene.objects.size() - 1);
+    return add_object_with_own_mesh(scene, std::move(mesh));
 }
 
 Camera camera_down_minus_z(double fov_y_degrees, double near_plane, double far_plane) {

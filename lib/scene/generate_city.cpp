@@ -26,19 +26,9 @@ Scene generate_city(const CityOptions& o) {
     scene.meshes.push_back(detail::make_box_mesh());     // mesh 1, shared by every box
     const std::uint32_t ground_mesh = 0, box_mesh = 1;
 
-    auto add = [&](std::string name, std::uint32_t mesh, const glm::dmat4& world,
-                   const char* set, const char* role) {
-        Object object;
-        object.name = std::move(name);
-        object.mesh = mesh;
-        object.world = world;
-        object.extras = {{"role", role}, {"set", set}};  // sorted, as glTF export writes them
-        scene.objects.push_back(std::move(object));
-    };
-
     const double pitch = o.block_size + o.street_width;
     const double half = o.blocks * pitch * 0.5;
-    add("ground", ground_mesh, detail::place({0, 0, 0}, {2 * half + 40, 1, 2 * half + 40}),
+    detail::add_object(scene, "ground", ground_mesh, detail::place({0, 0, 0}, {2 * half + 40, 1, 2 * half + 40}),
         "ground", "occluder");
 
     struct Roof { glm::dvec3 centre; glm::dvec2 size; };
@@ -56,7 +46,7 @@ Scene generate_city(const CityOptions& o) {
                 const double height = 6.0 + 54.0 * u * u;
                 const glm::dvec3 size(lot - west - east, height, lot - north - south);
                 const glm::dvec3 base(x0 + west + 0.5 * size.x, 0.0, z0 + north + 0.5 * size.z);
-                add("building_" + std::to_string(bx) + "_" + std::to_string(bz) + "_" +
+                detail::add_object(scene, "building_" + std::to_string(bx) + "_" + std::to_string(bz) + "_" +
                         std::to_string(l),
                     box_mesh, detail::place(base, size), "buildings", "occluder");
                 roofs.push_back({base + glm::dvec3(0, height, 0), {size.x, size.z}});
@@ -72,7 +62,7 @@ Scene generate_city(const CityOptions& o) {
         const glm::dvec3 size = along_x ? glm::dvec3(4.5, 1.5, 1.9) : glm::dvec3(1.9, 1.5, 4.5);
         const glm::dvec3 base = along_x ? glm::dvec3(along, 0, street + lane)
                                         : glm::dvec3(street + lane, 0, along);
-        add("car_" + std::to_string(k), box_mesh, detail::place(base, size), "cars", "occludee");
+        detail::add_object(scene, "car_" + std::to_string(k), box_mesh, detail::place(base, size), "cars", "occludee");
     }
 
     // Units on about a third of the roofs, seen only from above or from far away.
@@ -82,7 +72,7 @@ Scene generate_city(const CityOptions& o) {
         const glm::dvec3 size(rng.uniform(1.5, 4.0), rng.uniform(1.0, 3.0), rng.uniform(1.5, 4.0));
         const glm::dvec3 offset(rng.uniform(-0.3, 0.3) * (roof.size.x - size.x), 0,
                                 rng.uniform(-0.3, 0.3) * (roof.size.y - size.z));
-        add("roof_unit_" + std::to_string(unit++), box_mesh,
+        detail::add_object(scene, "roof_unit_" + std::to_string(unit++), box_mesh,
             detail::place(roof.centre + offset, size), "roof_units", "occludee");
     }
     scene.finalize();

@@ -30,16 +30,7 @@ Scene generate_forest(const ForestOptions& o) {
     scene.meshes.push_back(detail::make_box_mesh());
     const std::uint32_t ground_mesh = 0, tree_mesh = 1, box_mesh = 2;
 
-    auto add = [&](std::string name, std::uint32_t mesh, const glm::dmat4& world,
-                   const char* set, const char* role) {
-        Object object;
-        object.name = std::move(name);
-        object.mesh = mesh;
-        object.world = world;
-        object.extras = {{"role", role}, {"set", set}};  // sorted, as glTF export writes them
-        scene.objects.push_back(std::move(object));
-    };
-    add("ground", ground_mesh, detail::place({0, 0, 0}, {2 * o.radius + 20, 1, 2 * o.radius + 20}),
+    detail::add_object(scene, "ground", ground_mesh, detail::place({0, 0, 0}, {2 * o.radius + 20, 1, 2 * o.radius + 20}),
         "ground", "occluder");
 
     // One tree per grid cell, jittered inside its cell so that crowns never touch; about one
@@ -53,7 +44,7 @@ Scene generate_forest(const ForestOptions& o) {
             const double jx = rng.uniform(-slack, slack), jz = rng.uniform(-slack, slack);
             if (rng.uniform() < 0.1) continue;
             const glm::dvec3 base(start + cx * o.tree_spacing + jx, 0.0, start + cz * o.tree_spacing + jz);
-            add("tree_" + std::to_string(tree++), tree_mesh,
+            detail::add_object(scene, "tree_" + std::to_string(tree++), tree_mesh,
                 detail::place(base, glm::dvec3(scale, scale * rng.uniform(0.9, 1.3), scale)),
                 "trees", "occluder");
         }
@@ -61,7 +52,7 @@ Scene generate_forest(const ForestOptions& o) {
     for (int k = 0; k < o.rocks; ++k) {
         const glm::dvec3 size(rng.uniform(0.4, 1.5), rng.uniform(0.3, 1.0), rng.uniform(0.4, 1.5));
         const glm::dvec3 base(rng.uniform(-o.radius, o.radius), 0.0, rng.uniform(-o.radius, o.radius));
-        add("rock_" + std::to_string(k), box_mesh, detail::place(base, size), "rocks", "occludee");
+        detail::add_object(scene, "rock_" + std::to_string(k), box_mesh, detail::place(base, size), "rocks", "occludee");
     }
     scene.finalize();
     return scene;

@@ -73,4 +73,14 @@ glm::dmat4 place(const glm::dvec3& position, const glm::dvec3& scale) {
     return m;
 }
 
+void add_object(Scene& scene, std::string name, std::uint32_t mesh, const glm::dmat4& world, const char* set,
+                const char* role) {
+    Object object;
+    object.name = std::move(name);
+    object.mesh = mesh;
+    object.world = world;
+    object.extras = {{"role", role}, {"set", set}};  // sorted, as glTF export writes them
+    scene.objects.push_back(std::move(object));
+}
+
 }  // namespace homcull::detail

@@ -2,6 +2,8 @@
 // Small meshes the scene generators place many times.
 #include <homcull/scene.hpp>
 
+#include <string>
+
 namespace homcull::detail {
 
 // Box with its base on y = 0: x and z in [-0.5, 0.5], y in [0, 1]; faces wound CCW outward.
@@ -15,5 +17,9 @@ inline constexpr double kTreeCrownRadius = 1.8;
 
 // Model-to-world for a mesh scaled by `scale` and then moved to `position`.
 glm::dmat4 place(const glm::dvec3& position, const glm::dvec3& scale);
+
+// Appends an object with the generators' extras: role ("occluder"/"occludee") and set.
+void add_object(Scene& scene, std::string name, std::uint32_t mesh, const glm::dmat4& world, const char* set,
+                const char* role);
 
 }  // namespace homcull::detail
