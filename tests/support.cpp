@@ -1,5 +1,6 @@
 #include "support.hpp"
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -54,8 +55,13 @@ std::string temp_dir(const std::string& test_name) {
     return dir.string();
 }
 
+std::string shared_scenes_dir() {
+    const char* override_dir = std::getenv("HOMCULL_SHARED_SCENES_DIR");
+    return override_dir && *override_dir ? override_dir : HOMCULL_SHARED_SCENES_DIR;
+}
+
 std::string shared_scene(const std::string& file) {
-    const std::filesystem::path path = std::filesystem::path(HOMCULL_SHARED_SCENES_DIR) / file;
+    const std::filesystem::path path = std::filesystem::path(shared_scenes_dir()) / file;
     return std::filesystem::is_regular_file(path) ? path.string() : std::string();
 }
 

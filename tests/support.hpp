@@ -16,7 +16,9 @@ Camera camera_down_minus_z(double fov_y_degrees = 90.0, double near_plane = 0.1,
 
 // A fresh, empty folder for one test's files.
 std::string temp_dir(const std::string& test_name);
-// ../shared/scenes/<file>, or "" when the shared folder is missing.
+// The shared scenes folder: $HOMCULL_SHARED_SCENES_DIR, else the one CMake was given.
+std::string shared_scenes_dir();
+// <shared scenes folder>/<file>, or "" when it is missing.
 std::string shared_scene(const std::string& file);
 void write_text(const std::string& path, const std::string& text);
 

@@ -17,7 +17,10 @@ struct CliRun {
 };
 
 CliRun run_cli(const std::string& arguments) {
-    const std::string dir = test::temp_dir("cli_run");
+    // One folder per test and call: ctest runs tests in parallel processes.
+    static int call = 0;
+    const std::string dir = test::temp_dir(std::string("cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+                                           "_" + std::to_string(call++));
     const std::string command = std::string(HOMCULL_CLI_PATH) + " " + arguments + " >" + dir + "/out 2>" + dir + "/err";
     const int status = std::system(command.c_str());
     auto slurp = [](const std::string& path) {

@@ -14,8 +14,8 @@ namespace {
 
 #define REQUIRE_SHARED_SCENE(var, file)                                                              \
     const std::string var = test::shared_scene(file);                                                \
-    if (var.empty()) GTEST_SKIP() << "../shared/scenes/" file " is missing (HOMCULL_SHARED_SCENES_DIR=" \
-                                  << HOMCULL_SHARED_SCENES_DIR << "); this test needs the shared test scenes"
+    if (var.empty()) GTEST_SKIP() << file " is missing from " << test::shared_scenes_dir()             \
+                                  << " (set HOMCULL_SHARED_SCENES_DIR to the folder of the shared test scenes)"
 
 struct Expected {
     const char* file;
@@ -36,7 +36,7 @@ TEST(SharedScenes, ObjectAndTriangleCountsMatchTheirReadme) {
         EXPECT_EQ(scene.objects.size(), e.objects) << e.file;
         EXPECT_EQ(scene.instanced_triangle_count(), e.triangles) << e.file;
     }
-    if (found == 0) GTEST_SKIP() << "../shared/scenes is missing; no scene to check";
+    if (found == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir() << "; nothing to check";
 }
 
 TEST(SharedScenes, CastleSharesMeshesAndKeepsRoles) {
@@ -117,7 +117,7 @@ TEST(SharedScenes, CastleViewC0) {
 TEST(SharedScenes, WalksThroughSponzaAndAQuakeMap) {
     for (const char* file : {"crytek_sponza.glb", "openarena_pul1duel-oa.glb"}) {
         const std::string path = test::shared_scene(file);
-        if (path.empty()) GTEST_SKIP() << "../shared/scenes/" << file << " is missing";
+        if (path.empty()) GTEST_SKIP() << file << " is missing from " << test::shared_scenes_dir();
         const Scene scene = load_scene(path);
         const RayScene rays(scene);
         WalkOptions options;

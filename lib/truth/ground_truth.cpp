@@ -37,6 +37,9 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
     if (options.samples < 1 || options.samples > 16) throw Error("samples per pixel axis must be in [1, 16]");
     if (!(options.tie_relative_depth >= 0.0 && options.tie_relative_depth < 1.0))
         throw Error("tie relative depth must be in [0, 1)");
+    // Per-sample buffers are indexed with int coordinates and cost 5 bytes a sample.
+    if (double(options.resolution.width) * options.samples * double(options.resolution.height) * options.samples > double(1 << 30))
+        throw Error("ground truth: resolution x samples^2 exceeds 2^30 samples; lower the resolution or the samples");
     if (rays.object_count() != scene.objects.size()) throw Error("the ray scene was built from another scene");
 
     const auto start = std::chrono::steady_clock::now();
