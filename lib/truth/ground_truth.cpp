@@ -19,6 +19,7 @@ namespace {
 
 constexpr int kPacket = 8;  // rtcIntersect8: 8 consecutive samples of one row
 constexpr std::uint32_t kNone = RTC_INVALID_GEOMETRY_ID;
+static_assert(kNone == kNoObject, "sample ids hand Embree's 'no geometry' on as kNoObject");
 
 // Tie check: a hit of the ray's own object (stored in the ray id) does not count.
 void reject_same_object(const RTCFilterFunctionNArguments* args) {
@@ -145,7 +146,7 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
             result.objects[i].in_frustum = intersects(frustum, scene.objects[i].world_bounds);
     });
     result.rays = ids.size() + tie_rays.load();
-    if (options.keep_sample_ids) result.sample_ids = std::move(ids);  // kNone == kNoObject
+    if (options.keep_sample_ids) result.sample_ids = std::move(ids);
     result.trace_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
 }

@@ -12,6 +12,9 @@
 
 namespace homcull {
 
+// "No object": the id of a sample that sees nothing.
+inline constexpr std::uint32_t kNoObject = 0xFFFFFFFFu;
+
 struct Mesh {
     std::string name;
     std::vector<glm::vec3> positions;

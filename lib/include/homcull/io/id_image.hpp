@@ -1,12 +1,12 @@
 #pragma once
 // Writes a per-sample object id buffer as an image with OpenImageIO.
+#include <homcull/scene.hpp>
+
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace homcull {
-
-inline constexpr std::uint32_t kNoObject = 0xFFFFFFFFu;
 
 // 8-bit formats (.png, .jpg, .bmp, ...) get a colour per object (a hash of the id, black
 // where nothing is hit), for looking at. Other formats (.exr, .tif) get one uint32 channel

@@ -13,10 +13,10 @@
 namespace homcull {
 
 struct RayHit {
-    std::uint32_t object = 0xFFFFFFFFu;  // kNoObject when nothing was hit
+    std::uint32_t object = kNoObject;  // when nothing was hit
     float t = 0.0f;                      // ray parameter of the hit
     glm::vec3 normal{0.0f};              // geometric normal, unnormalized, CCW front side
-    bool hit() const { return object != 0xFFFFFFFFu; }
+    bool hit() const { return object != kNoObject; }
 };
 
 class RayScene {
