@@ -8,7 +8,7 @@ packages=(
   libglm-dev                      # math vocabulary (the only dependency of the core library)
   libembree-dev libtbb-dev        # ground truth ray casts; TBB drives the tools' parallel-for
   libopenimageio-dev openimageio-tools  # image dumps (id images, later pyramids)
-  libassimp-dev                   # scene import (glTF/GLB, OBJ, PLY, IFC, ...)
+  libassimp-dev zlib1g-dev        # scene import; assimp's CMake target links libz.so but does not depend on it
   libhwy-dev                      # SIMD with runtime dispatch (rasterizer)
   libmeshoptimizer-dev            # occluder simplification
   libcli11-dev nlohmann-json3-dev libfmt-dev
