@@ -13,6 +13,7 @@ packages=(
   libmeshoptimizer-dev            # occluder simplification
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libtinygltf-dev                 # glTF/GLB import and export (keeps node order and extras)
+  assimp-testmodels               # test data: the IFC source of fzk_haus.glb, for the IFC import test
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 namespace homcull {
 namespace {
 
@@ -52,6 +54,26 @@ TEST(SharedScenes, CastleSharesMeshesAndKeepsRoles) {
         }
     EXPECT_EQ(occluders, 115u);  // 114 large occluders + the ground
     EXPECT_EQ(occluder_triangles, 41660u + 7040u);
+}
+
+// fzk_haus.glb was converted from the IFC file Debian ships in assimp-testmodels; reading that
+// IFC through assimp must give the same objects in the same order.
+TEST(SharedScenes, FzkHausIfcSourceImportsToTheSameObjects) {
+    REQUIRE_SHARED_SCENE(glb_path, "fzk_haus.glb");
+    const std::string ifc_path = "/usr/share/assimp/models/IFC/AC14-FZK-Haus.ifc";
+    if (!std::filesystem::is_regular_file(ifc_path))
+        GTEST_SKIP() << ifc_path << " is missing (Debian package assimp-testmodels, installed by scripts/install-deps.sh)";
+    const Scene ifc = load_scene(ifc_path), glb = load_scene(glb_path);
+    ASSERT_EQ(ifc.objects.size(), glb.objects.size());
+    EXPECT_LT(ifc.meshes.size(), ifc.objects.size()) << "IFC mapped items share meshes";
+    for (std::size_t i = 0; i < ifc.objects.size(); ++i) {
+        EXPECT_EQ(ifc.objects[i].name, glb.objects[i].name) << i;
+        EXPECT_EQ(ifc.triangle_count(ifc.objects[i]), glb.triangle_count(glb.objects[i])) << i;
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_NEAR(ifc.objects[i].world_bounds.min[k], glb.objects[i].world_bounds.min[k], 1e-4f) << i;
+            EXPECT_NEAR(ifc.objects[i].world_bounds.max[k], glb.objects[i].world_bounds.max[k], 1e-4f) << i;
+        }
+    }
 }
 
 TEST(SharedScenes, FzkHausGroundTruthMatchesSingleRaysAndHidesTheInterior) {
