@@ -1,0 +1,137 @@
+#pragma once
+// The occlusion buffer: occluder triangles rasterized into per-sample coverage masks and a
+// conservative farthest depth, and occludee tests against it.
+//
+// Layout. The buffer has W x H pixels of S x S samples each (S = 1, 2 or 4). Samples are
+// grouped in subtiles of 8 x 4 samples (one 32-bit mask each); the sample (i, j) has its
+// centre at (i + 0.5, j + 0.5) in sample units, which is the centre of display pixel (i, j)
+// when W*S x H*S is the display resolution (the same grid as ground truth's sub-samples).
+//
+// Depth. Depth is stored reversed as d = 1/w (clip w = view depth for a perspective
+// projection): larger is nearer, 0 is "nothing". Each subtile keeps the two layers of
+// masked occlusion culling (Hasselgren, Andersson, Akenine-Moller, "Masked Software
+// Occlusion Culling", HPG 2016): a reference depth d0 that every sample of the subtile is
+// known to be at or nearer than, and a working layer (d1, mask) for the samples in mask.
+//
+// Conservative. A sample is marked covered only when it lies inside the triangle by a margin
+// (edge_margin samples) on every silhouette edge, which absorbs the rounding between this
+// rasterizer and an exact ray cast (edges shared by two drawn triangles need none); a triangle's depth enters the buffer as a lower bound of 1/w over the samples it
+// covers, lowered by a relative 2^-20. So the buffer never claims an occluder where there is
+// none, nor nearer than it is, and occludee tests never hide what is visible at the samples.
+#include <homcull/camera.hpp>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace homcull {
+
+enum class Backface : std::uint8_t {
+    none,  // rasterize both sides
+    cw,    // cull triangles that are clockwise in NDC (y up): counter-clockwise front faces
+    ccw,   // cull counter-clockwise triangles
+};
+
+enum class Visibility : std::uint8_t { visible, occluded, view_culled };
+
+struct BufferConfig {
+    int width = 0, height = 0;  // pixels, >= 1
+    int samples = 1;            // S: S x S samples per pixel, 1, 2 or 4
+    // Triangles are clipped at clip w >= near_w (the camera's near distance for a standard
+    // perspective projection). Occludees reaching w < near_w are visible.
+    float near_w = 0.1f;
+    // Inner margin of coverage, in samples: see "Conservative" above.
+    double edge_margin = 1.0 / 1024.0;
+};
+
+struct RasterStats {
+    std::uint64_t triangles_in = 0;       // submitted
+    std::uint64_t invalid = 0;            // non-finite vertex or index out of range
+    std::uint64_t outside = 0;            // entirely outside the frustum
+    std::uint64_t near_clipped = 0;       // crossed the near plane (or the guard band)
+    // Reaching more than 2^28 times its nearest w in x or y: clipping it in double would lose
+    // the precision conservative coverage needs, so it is skipped (as an occluder, safely).
+    std::uint64_t too_large = 0;
+    std::uint64_t backface_culled = 0;
+    std::uint64_t degenerate = 0;         // zero area after projection
+    std::uint64_t rasterized = 0;         // triangles (after clipping) that reached the buffer
+    std::uint64_t subtiles_touched = 0;   // subtile updates
+};
+
+// Vertex input as engines have it: positions (x, y, z, or x, y, z, w as floats) every
+// `stride` bytes, and triangles as 16- or 32-bit index triples (or none: consecutive
+// vertices). Positions are multiplied by model_to_clip as (x, y, z, 1) or (x, y, z, w).
+struct TriangleInput {
+    const void* positions = nullptr;
+    int position_components = 3;       // 3 or 4
+    std::size_t position_stride = 12;  // bytes between consecutive positions
+    std::size_t vertex_count = 0;
+    const void* indices = nullptr;     // nullptr: triangles are vertices 3k, 3k+1, 3k+2
+    bool indices_16bit = false;
+    std::size_t triangle_count = 0;
+    std::array<float, 16> model_to_clip{};  // column-major, as glm and OpenGL
+    Backface backface = Backface::cw;
+    // Optional, one byte per triangle: bit k set when the edge from its vertex k to vertex
+    // k + 1 is shared with another triangle drawn into the same buffer (compute_shared_edges
+    // finds them once per mesh). Samples on a shared edge are covered by one of the two
+    // triangles, so the coverage margin, which keeps silhouettes conservative, is not applied
+    // there and meshes leave no cracks. Without flags every edge is treated as a silhouette.
+    const std::uint8_t* shared_edges = nullptr;
+};
+
+// Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
+// in opposite order as consistently wound neighbours have them) and writes the
+// TriangleInput::shared_edges bits. `indices` may be null (vertices 3k, 3k+1, 3k+2). Meant
+// for load time: it allocates and sorts.
+void compute_shared_edges(const float* positions, std::size_t position_stride, std::size_t vertex_count,
+                          const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
+
+class OcclusionBuffer {
+public:
+    struct Subtile {
+        float d0 = 0.0f;           // reference layer: all samples at or nearer than this
+        float d1 = 0.0f;           // working layer depth, for the samples in `mask`
+        std::uint32_t mask = 0;    // working layer samples
+        std::uint32_t covered = 0; // union of all occluder coverage (for opacity)
+    };
+    static constexpr int kSubtileWidth = 8, kSubtileHeight = 4;
+
+    // Throws homcull::Error on an invalid configuration. All memory is allocated here.
+    explicit OcclusionBuffer(const BufferConfig& config);
+
+    void clear();
+    // Rasterizes occluders. Statistics accumulate until clear().
+    void render(const TriangleInput& input);
+
+    // Occludee tests. Thread-safe with each other (no render in flight).
+    // Screen rectangle in NDC (y up) with the nearest clip w of the occludee.
+    Visibility test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
+    // World (or model) AABB under a model-to-clip matrix (column-major).
+    Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
+
+    const BufferConfig& config() const { return config_; }
+    int sample_width() const { return sample_width_; }
+    int sample_height() const { return sample_height_; }
+    const RasterStats& stats() const { return stats_; }
+    const std::vector<Subtile>& subtiles() const { return subtiles_; }
+    int subtiles_x() const { return subtiles_x_; }
+    int subtiles_y() const { return subtiles_y_; }
+
+    // Read-back per sample (row-major, top row first): whether an occluder covers it, and
+    // the conservative occluder depth as clip w (infinity where nothing is known).
+    void read_coverage(std::vector<std::uint8_t>& covered) const;
+    void read_depth(std::vector<float>& w) const;
+
+private:
+    BufferConfig config_;
+    int sample_width_ = 0, sample_height_ = 0;
+    int subtiles_x_ = 0, subtiles_y_ = 0;
+    std::vector<Subtile> subtiles_;
+    RasterStats stats_;
+};
+
+// A camera's view-projection matrix as a column-major float array for TriangleInput and
+// test_aabb (projection_matrix * view_matrix).
+std::array<float, 16> clip_from_world(const Camera& camera, double aspect);
+
+}  // namespace homcull
