@@ -1,0 +1,28 @@
+#pragma once
+// A scene's occluders as one world-space triangle list, ready for OcclusionBuffer::render:
+// positions transformed exactly as ground truth transforms them (transform_point), and the
+// shared-edge flags of the whole set (edges shared between objects count too).
+#include <homcull/occlusion_buffer.hpp>
+#include <homcull/scene.hpp>
+
+#include <string_view>
+#include <vector>
+
+namespace homcull {
+
+struct WorldTriangles {
+    std::vector<float> positions;  // x, y, z per vertex
+    std::vector<std::uint32_t> indices;
+    std::vector<std::uint8_t> shared_edges;
+
+    std::size_t triangle_count() const { return indices.size() / 3; }
+    TriangleInput input(const std::array<float, 16>& clip_from_world, Backface backface = Backface::cw) const;
+};
+
+// The triangles of the given objects. Allocates: meant for load time or tools.
+WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects);
+
+// Ids of the objects whose extra "role" equals `role`, or of every object when role is empty.
+std::vector<std::uint32_t> objects_with_role(const Scene& scene, std::string_view role);
+
+}  // namespace homcull

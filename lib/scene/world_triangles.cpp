@@ -1,0 +1,44 @@
+#include <homcull/world_triangles.hpp>
+
+namespace homcull {
+
+TriangleInput WorldTriangles::input(const std::array<float, 16>& clip_from_world, Backface backface) const {
+    TriangleInput in;
+    in.positions = positions.data();
+    in.vertex_count = positions.size() / 3;
+    in.indices = indices.data();
+    in.triangle_count = triangle_count();
+    in.model_to_clip = clip_from_world;
+    in.backface = backface;
+    in.shared_edges = shared_edges.data();
+    return in;
+}
+
+WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects) {
+    WorldTriangles out;
+    for (std::uint32_t id : objects) {
+        const Object& object = scene.objects.at(id);
+        const Mesh& mesh = scene.meshes[object.mesh];
+        const auto base = std::uint32_t(out.positions.size() / 3);
+        for (const glm::vec3& p : mesh.positions) {
+            const glm::vec3 w = transform_point(object.world, p);
+            out.positions.insert(out.positions.end(), {w.x, w.y, w.z});
+        }
+        for (std::uint32_t index : mesh.indices) out.indices.push_back(base + index);
+    }
+    out.shared_edges.resize(out.triangle_count());
+    compute_shared_edges(out.positions.data(), 3 * sizeof(float), out.positions.size() / 3, out.indices.data(),
+                         out.triangle_count(), out.shared_edges.data());
+    return out;
+}
+
+std::vector<std::uint32_t> objects_with_role(const Scene& scene, std::string_view role) {
+    std::vector<std::uint32_t> ids;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+        const std::string* r = scene.objects[i].extra("role");
+        if (role.empty() || (r && *r == role)) ids.push_back(std::uint32_t(i));
+    }
+    return ids;
+}
+
+}  // namespace homcull
