@@ -118,9 +118,10 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
             const float d_tri = conservative_far(bound);
             if (!(d_tri > s.d0)) continue;  // behind what is already known: nothing to add
 
-            // Quick mask: drop the working layer when the triangle is nearer in depth to the
-            // reference layer than to it, then merge, and promote a full layer.
-            if (s.mask != 0 && std::abs(d_tri - s.d1) > std::abs(d_tri - s.d0)) s.mask = 0;
+            // Quick mask: drop the working layer when the triangle is farther in front of it than
+            // it is in front of the reference layer (d_tri - d1 > d1 - d0), then merge, and
+            // promote a full layer to the reference.
+            if (s.mask != 0 && 2.0f * s.d1 - (d_tri + s.d0) < 0.0f) s.mask = 0;
             s.d1 = s.mask == 0 ? d_tri : std::min(s.d1, d_tri);
             s.mask |= m;
             if (s.mask == valid_sample_mask(tx, ty, t.sample_width, t.sample_height)) {

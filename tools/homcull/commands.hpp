@@ -8,5 +8,7 @@ void register_info(CLI::App& app);
 void register_truth(CLI::App& app);
 void register_export(CLI::App& app);
 void register_path(CLI::App& app);
+void register_bench(CLI::App& app);
+void register_accuracy(CLI::App& app);
 
 }  // namespace homcull::cli

@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
     homcull::cli::register_truth(app);
     homcull::cli::register_export(app);
     homcull::cli::register_path(app);
+    homcull::cli::register_bench(app);
+    homcull::cli::register_accuracy(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

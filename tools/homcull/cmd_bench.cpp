@@ -1,0 +1,148 @@
+// homcull bench: speed of the occlusion buffer on fixed workloads (not a test: it times).
+//   s1:     ../shared/workloads/s1, the 100k triangles and 1M rectangles Intel MOC was measured on
+//   castle: the castle's role=occluder nodes from the views of data/views/castle.json
+#include "commands.hpp"
+#include "options.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/io/camera_path.hpp>
+#include <homcull/io/scene_io.hpp>
+#include <homcull/io/workload_s1.hpp>
+#include <homcull/occlusion_buffer.hpp>
+#include <homcull/world_triangles.hpp>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <memory>
+
+namespace homcull::cli {
+namespace {
+
+struct BenchOptions {
+    std::string workload = "s1", resolution = "1920x1080", isa = "scalar";
+    std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views = "data/views/castle.json";
+    int samples = 1, threads = 1, repeat = 0;
+    bool json = false;
+};
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+nlohmann::json stats_json(const RasterStats& s) {
+    return {{"triangles_in", s.triangles_in}, {"invalid", s.invalid}, {"outside", s.outside}, {"near_clipped", s.near_clipped},
+            {"too_large", s.too_large}, {"backface_culled", s.backface_culled}, {"degenerate", s.degenerate},
+            {"rasterized", s.rasterized}, {"subtiles_touched", s.subtiles_touched}};
+}
+
+void run_bench(const BenchOptions& o) {
+    if (o.isa != "scalar") throw Error("bench: --isa " + o.isa + " is not available yet (available: scalar)");
+    if (o.threads != 1) throw Error("bench: only --threads 1 is available yet (binned multithreading is not implemented)");
+    const Resolution res = parse_resolution(o.resolution);
+    BufferConfig config;
+    config.width = res.width;
+    config.height = res.height;
+    config.samples = o.samples;
+    nlohmann::json out = {{"workload", o.workload}, {"resolution", {res.width, res.height}}, {"samples", o.samples},
+                          {"threads", o.threads}, {"isa", o.isa}};
+
+    if (o.workload == "s1") {
+        const WorkloadS1 s1 = load_workload_s1(o.s1_folder);
+        config.near_w = 1.0f;  // the near clip plane MOC was measured with
+        OcclusionBuffer buffer(config);
+        TriangleInput in;
+        in.positions = s1.occluders.data();
+        in.position_components = 4;
+        in.position_stride = 16;
+        in.vertex_count = s1.occluder_count() * 3;
+        in.triangle_count = s1.occluder_count();
+        in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        in.backface = Backface::cw;
+        std::vector<double> render_ms, test_ms;
+        const int repeat = o.repeat > 0 ? o.repeat : 5;
+        std::size_t occluded = 0;
+        for (int r = 0; r < repeat; ++r) {
+            buffer.clear();
+            long long start = now_ns();
+            buffer.render(in);
+            render_ms.push_back(elapsed_ms(start));
+            start = now_ns();
+            std::size_t hidden = 0;
+            for (std::size_t k = 0; k < s1.rect_count(); ++k) {
+                const float* q = &s1.rects[5 * k];
+                hidden += buffer.test_rect(q[0], q[1], q[2], q[3], q[4]) == Visibility::occluded;
+            }
+            test_ms.push_back(elapsed_ms(start));
+            occluded = hidden;
+        }
+        const double ms = median(render_ms), rect_ms = median(test_ms);
+        out["ms"] = ms;
+        out["mtris_per_s"] = double(s1.occluder_count()) / (ms * 1e3);
+        out["rect_ms"] = rect_ms;
+        out["rect_tests_per_s"] = double(s1.rect_count()) / (rect_ms * 1e-3);
+        out["rects_occluded"] = occluded;
+        out["runs"] = repeat;
+        out["stats"] = stats_json(buffer.stats());
+    } else if (o.workload == "castle") {
+        const Scene castle = load_scene(o.scene);
+        const CameraPath views = read_camera_path(o.views);
+        const WorldTriangles occluders = gather_world_triangles(castle, objects_with_role(castle, "occluder"));
+        const int repeat = o.repeat > 0 ? o.repeat : 21;
+        nlohmann::json per_view = nlohmann::json::array();
+        std::vector<double> medians;
+        for (const Camera& view : views.frames) {
+            config.near_w = float(view.near_plane);
+            OcclusionBuffer buffer(config);
+            const TriangleInput in = occluders.input(clip_from_world(view, res.aspect()), Backface::cw);
+            std::vector<double> ms;
+            for (int r = 0; r < repeat; ++r) {
+                buffer.clear();
+                const long long start = now_ns();
+                buffer.render(in);
+                ms.push_back(elapsed_ms(start));
+            }
+            medians.push_back(median(ms));
+            per_view.push_back({{"ms", medians.back()}, {"stats", stats_json(buffer.stats())}});
+        }
+        out["ms"] = medians.empty() ? 0.0 : medians.front();  // view C0
+        out["mtris_per_s"] = double(occluders.triangle_count()) / (out["ms"].get<double>() * 1e3);
+        out["triangles"] = occluders.triangle_count();
+        out["views"] = per_view;
+        out["runs"] = repeat;
+    } else {
+        throw Error("bench: unknown workload '" + o.workload + "' (s1 or castle)");
+    }
+    if (o.json) {
+        fmt::print("{}\n", out.dump(1));
+        return;
+    }
+    fmt::print("workload {} at {}x{}, {}x{} samples, {} thread(s), {}: {:.2f} ms ({:.2f} Mtri/s)\n", o.workload, res.width,
+               res.height, o.samples, o.samples, o.threads, o.isa, out["ms"].get<double>(), out["mtris_per_s"].get<double>());
+    if (out.contains("rect_tests_per_s"))
+        fmt::print("rectangle tests: {:.1f} ms for 1M ({:.1f} M/s), {} occluded\n", out["rect_ms"].get<double>(),
+                   out["rect_tests_per_s"].get<double>() * 1e-6, out["rects_occluded"].get<std::size_t>());
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app) {
+    auto o = std::make_shared<BenchOptions>();
+    CLI::App* cmd = app.add_subcommand("bench", "Time the occlusion buffer on a fixed workload (s1 or castle); a benchmark, not a test");
+    cmd->add_option("--workload", o->workload, "s1 (../shared/workloads/s1) or castle (role=occluder nodes, data/views/castle.json)")
+        ->capture_default_str();
+    cmd->add_option("--resolution", o->resolution, "Occlusion buffer resolution WxH (pixels)")->capture_default_str();
+    cmd->add_option("--samples", o->samples, "S x S samples per pixel (1, 2 or 4)")->capture_default_str();
+    cmd->add_option("--threads", o->threads, "Threads")->capture_default_str();
+    cmd->add_option("--isa", o->isa, "Instruction set to force")->capture_default_str();
+    cmd->add_option("--repeat", o->repeat, "Runs to take the median of (0 = 5 for s1, 21 for castle)");
+    cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
+    cmd->add_option("--scene", o->scene, "Castle scene for --workload castle")->capture_default_str();
+    cmd->add_option("--views", o->views, "Camera path with the views for --workload castle")->capture_default_str();
+    cmd->add_flag("--json", o->json, "Print JSON on stdout");
+    cmd->callback([o] { run_bench(*o); });
+}
+
+}  // namespace homcull::cli
