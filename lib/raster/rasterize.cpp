@@ -1,16 +1,15 @@
-// Coverage: a sample is covered when, for each edge, the edge function exceeds the edge's
-// margin: edge_margin samples times the L1 length of the edge normal (so at least edge_margin
-// samples of distance) on a silhouette edge, and 0 (inclusive) on an edge shared with another
-// drawn triangle. Edge functions are evaluated in double from unsnapped vertices, always from
-// the edge's lower endpoint (by y, then x) and in one fixed order of operations (no fused
-// multiply-add): the two triangles of a shared edge then compute exactly opposite values, so
-// every sample near it lands in at least one of them, and results are the same on every target.
+// Coverage. A sample is covered when, for each edge, the edge function exceeds the edge's
+// threshold: edge_margin samples times the L1 length of the edge normal (so at least
+// edge_margin samples of distance) on a silhouette edge, and 0 (inclusive) on an edge shared
+// with another drawn triangle. It is computed per sample row: in a row each edge bounds the
+// covered samples on one side, at
+//     x_k = o_k.x + (threshold_k - sb_k * (y - o_k.y)) * (1 / sa_k)
+// (sa, sb the sign-normalized edge normal, o_k the edge's lower endpoint by y then x), in
+// double, in exactly this order, without fused multiply-add. That formula is the definition:
+// SIMD kernels evaluate it the same way and get the same bits. The two triangles of a shared
+// edge compute bit-identical x_k (negation is exact), one keeping samples at or right of it and
+// the other at or left of it, so every sample near a shared edge lands in at least one.
 //
-// Depth: the triangle's 1/w is linear in screen space; its minimum over the covered samples of
-// a subtile is at least the plane's minimum over their bounding rectangle (at a corner) and at
-// least the smallest vertex 1/w. That bound, rounded down to float and lowered by a relative
-// 2^-20, enters the subtile by the "quick mask" rule of masked occlusion culling (Hasselgren
-// et al. 2016, section 3.2).
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -52,23 +51,30 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
         area2 = -area2;
     }
     const glm::dvec2 v[3] = {p0, p1, p2};
-    // E_k(P) = sign_k * (a_k (P.x - o_k.x) + b_k (P.y - o_k.y)), o_k the edge's lower endpoint.
-    double a[3], b[3], sign[3], threshold[3];
-    glm::dvec2 origin[3];
+
+    // Edge k: E(P) = sa (P.x - o.x) + sb (P.y - o.y), positive inside.
+    struct Edge {
+        glm::dvec2 origin;
+        double sa, sb, inverse_sa, threshold;
+        bool shared;
+    } edges[3];
     for (int k = 0; k < 3; ++k) {
         const glm::dvec2& from = v[k];
         const glm::dvec2& to = v[(k + 1) % 3];
         const bool forward = from.y != to.y ? from.y < to.y : from.x < to.x;
         const glm::dvec2& lo = forward ? from : to;
         const glm::dvec2& hi = forward ? to : from;
-        origin[k] = lo;
-        a[k] = -(hi.y - lo.y);
-        b[k] = hi.x - lo.x;
-        sign[k] = forward ? 1.0 : -1.0;
-        threshold[k] = shared[k] ? 0.0 : t.edge_margin * (std::abs(a[k]) + std::abs(b[k]));
+        const double a = -(hi.y - lo.y), b = hi.x - lo.x, sign = forward ? 1.0 : -1.0;
+        Edge& e = edges[k];
+        e.origin = lo;
+        e.sa = sign * a;
+        e.sb = sign * b;
+        e.inverse_sa = e.sa != 0.0 ? 1.0 / e.sa : 0.0;
+        e.shared = shared[k];
+        e.threshold = shared[k] ? 0.0 : t.edge_margin * (std::abs(a) + std::abs(b));
     }
 
-    // Samples whose centres lie in the triangle's bounding box.
+    // Sample rows and columns whose centres lie in the triangle's bounding box.
     const double min_x = std::min({p0.x, p1.x, p2.x}), max_x = std::max({p0.x, p1.x, p2.x});
     const double min_y = std::min({p0.y, p1.y, p2.y}), max_y = std::max({p0.y, p1.y, p2.y});
     const int i0 = std::max(0, int(std::ceil(min_x - 0.5))), i1 = std::min(t.sample_width - 1, int(std::floor(max_x - 0.5)));
@@ -81,37 +87,54 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
     const double z_vertex_min = std::min({z0, z1, z2});
 
     std::uint64_t touched = 0;
-    for (int ty = j0 / kH; ty <= j1 / kH; ++ty)
-        for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {
-            std::uint32_t m = 0;
-            int cmin_x = kW, cmax_x = -1, cmin_y = kH, cmax_y = -1;
-            for (int j = 0; j < kH; ++j) {
-                const int sy = ty * kH + j;
-                if (sy < j0 || sy > j1) continue;
-                const double py = sy + 0.5;
-                for (int i = 0; i < kW; ++i) {
-                    const int sx = tx * kW + i;
-                    if (sx < i0 || sx > i1) continue;
-                    const double px = sx + 0.5;
-                    bool inside = true;
-                    for (int k = 0; k < 3 && inside; ++k) {
-                        const double e = sign[k] * (a[k] * (px - origin[k].x) + b[k] * (py - origin[k].y));
-                        inside = shared[k] ? e >= 0.0 : e > threshold[k];
-                    }
-                    if (!inside) continue;
-                    m |= 1u << (j * kW + i);
-                    cmin_x = std::min(cmin_x, i), cmax_x = std::max(cmax_x, i);
-                    cmin_y = std::min(cmin_y, j), cmax_y = std::max(cmax_y, j);
+    const int tx0 = i0 / kW, tx1 = i1 / kW;
+    for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
+        // The covered interval [first, last] of each of the subtile row's sample rows.
+        int first[kH], last[kH];
+        for (int j = 0; j < kH; ++j) {
+            const int sy = ty * kH + j;
+            first[j] = i0;
+            last[j] = i1;
+            if (sy < j0 || sy > j1) {
+                last[j] = first[j] - 1;
+                continue;
+            }
+            const double py = sy + 0.5;
+            for (const Edge& e : edges) {
+                const double c = e.threshold - e.sb * (py - e.origin.y);  // need sa * (x - o.x) > c
+                if (e.sa == 0.0) {
+                    if (e.shared ? !(0.0 >= c) : !(0.0 > c)) last[j] = first[j] - 1;
+                    continue;
                 }
+                const double x = e.origin.x + c * e.inverse_sa;  // boundary, in samples
+                if (e.sa > 0.0) first[j] = std::max(first[j], e.shared ? int(std::ceil(x - 0.5)) : int(std::floor(x - 0.5)) + 1);
+                else last[j] = std::min(last[j], e.shared ? int(std::floor(x - 0.5)) : int(std::ceil(x - 0.5)) - 1);
+            }
+        }
+        for (int tx = tx0; tx <= tx1; ++tx) {
+            std::uint32_t m = 0;
+            for (int j = 0; j < kH; ++j) {
+                const int lo = std::max(first[j] - tx * kW, 0), hi = std::min(last[j] - tx * kW, kW - 1);
+                if (lo <= hi) m |= ((0xFFu >> (kW - 1 - hi)) & (0xFFu << lo)) << (j * kW);
             }
             if (m == 0) continue;
             ++touched;
             OcclusionBuffer::Subtile& s = t.subtiles[std::size_t(ty) * std::size_t(t.subtiles_x) + std::size_t(tx)];
             s.covered |= m;
 
-            // Lower bound of 1/w over the covered samples.
-            const double x_far = (dzdx > 0.0 ? tx * kW + cmin_x : tx * kW + cmax_x) + 0.5;
-            const double y_far = (dzdy > 0.0 ? ty * kH + cmin_y : ty * kH + cmax_y) + 0.5;
+            // Lower bound of 1/w over the covered samples: the plane at the corner of their
+            // bounding rectangle where it is smallest, and never below the farthest vertex.
+            std::uint32_t columns = 0;
+            int row_min = kH, row_max = -1;
+            for (int j = 0; j < kH; ++j)
+                if ((m >> (j * kW)) & 0xFFu) {
+                    columns |= (m >> (j * kW)) & 0xFFu;
+                    row_min = std::min(row_min, j);
+                    row_max = j;
+                }
+            const int col_min = __builtin_ctz(columns), col_max = 31 - __builtin_clz(columns);
+            const double x_far = (dzdx > 0.0 ? tx * kW + col_min : tx * kW + col_max) + 0.5;
+            const double y_far = (dzdy > 0.0 ? ty * kH + row_min : ty * kH + row_max) + 0.5;
             const double plane_min = z0 + dzdx * (x_far - p0.x) + dzdy * (y_far - p0.y);
             const double bound = std::max(plane_min, z_vertex_min);
             if (!(bound > 0.0)) continue;
@@ -130,6 +153,7 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
                 s.d1 = 0.0f;
             }
         }
+    }
     return touched;
 }
 
