@@ -5,7 +5,7 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(HOMCULL_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/homcull")
-install(TARGETS homcull_core homcull_truth homcull_io EXPORT homcullTargets
+install(TARGETS homcull_core homcull_tbb homcull_truth homcull_io EXPORT homcullTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}

@@ -1,8 +1,8 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
-#include "raster/clip_polygon.hpp"
 #include "raster/rasterize.hpp"
+#include "raster/triangle_setup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,24 +13,21 @@ namespace homcull {
 namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-// Guard band in NDC units: triangles reaching beyond |x/w| or |y/w| = 32 are clipped there, so
-// that sample coordinates stay small enough for double edge functions to be exact to far
-// below the coverage margin.
-constexpr double kGuardBand = 32.0;
-
-glm::dvec4 transform(const std::array<float, 16>& m, double x, double y, double z, double w) {
-    // Column-major m[column * 4 + row]; one fixed order of operations.
-    glm::dvec4 r;
-    for (int row = 0; row < 4; ++row)
-        r[row] = double(m[row]) * x + double(m[4 + row]) * y + double(m[8 + row]) * z + double(m[12 + row]) * w;
-    return r;
-}
-
-bool finite4(const glm::dvec4& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.w);
-}
+constexpr std::size_t kChunkTriangles = 2048;  // triangles set up per task
+constexpr int kBandSubtileRows = 4;           // subtile rows rasterized per task (16 sample rows)
 
 }  // namespace
+
+// Set-up triangles of one chunk of the input, and per band the ones that touch it, in order.
+struct OcclusionBuffer::Chunk {
+    std::vector<detail::ScreenTriangle> triangles;
+    std::vector<std::vector<std::uint32_t>> bins;
+    RasterStats stats;
+};
+
+OcclusionBuffer::~OcclusionBuffer() = default;
+OcclusionBuffer::OcclusionBuffer(OcclusionBuffer&&) noexcept = default;
+OcclusionBuffer& OcclusionBuffer::operator=(OcclusionBuffer&&) noexcept = default;
 
 OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     validate_resolution({config.width, config.height});
@@ -45,6 +42,7 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     subtiles_x_ = (sample_width_ + kW - 1) / kW;
     subtiles_y_ = (sample_height_ + kH - 1) / kH;
     subtiles_.assign(std::size_t(subtiles_x_) * std::size_t(subtiles_y_), Subtile{});
+    band_touched_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
 }
 
 void OcclusionBuffer::clear() {
@@ -52,119 +50,89 @@ void OcclusionBuffer::clear() {
     stats_ = RasterStats{};
 }
 
-void OcclusionBuffer::render(const TriangleInput& in) {
+namespace {
+
+void run_tasks(const ParallelFor& parallel, std::size_t count, void (*task)(void*, std::size_t), void* data) {
+    if (parallel.run) parallel.run(parallel.user, count, task, data);
+    else
+        for (std::size_t i = 0; i < count; ++i) task(data, i);
+}
+
+}  // namespace
+
+void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& parallel) {
     if (in.triangle_count == 0) return;
     if (in.position_components != 3 && in.position_components != 4) throw Error("render: positions must have 3 or 4 components");
     if (!in.positions || in.position_stride < sizeof(float) * std::size_t(in.position_components))
         throw Error("render: positions missing, or stride smaller than one position");
     if (!in.indices && in.vertex_count < in.triangle_count * 3)
         throw Error("render: without indices, vertex_count must be at least 3 * triangle_count");
-    const auto* bytes = static_cast<const unsigned char*>(in.positions);
-    const detail::RasterTarget target{subtiles_.data(), subtiles_x_, subtiles_y_, sample_width_, sample_height_, config_.edge_margin};
-    const double near_w = config_.near_w;
 
-    for (std::size_t t = 0; t < in.triangle_count; ++t) {
-        ++stats_.triangles_in;
-        std::uint32_t index[3];
-        for (int k = 0; k < 3; ++k) {
-            const std::size_t n = 3 * t + std::size_t(k);
-            if (!in.indices) index[k] = std::uint32_t(n);
-            else if (in.indices_16bit) index[k] = static_cast<const std::uint16_t*>(in.indices)[n];
-            else index[k] = static_cast<const std::uint32_t*>(in.indices)[n];
-        }
-        if (index[0] >= in.vertex_count || index[1] >= in.vertex_count || index[2] >= in.vertex_count) {
-            ++stats_.invalid;
-            continue;
-        }
-        glm::dvec4 clip[3];
-        bool valid = true;
-        for (int k = 0; k < 3; ++k) {
-            float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-            std::memcpy(p, bytes + std::size_t(index[k]) * in.position_stride, sizeof(float) * std::size_t(in.position_components));
-            clip[k] = transform(in.model_to_clip, p[0], p[1], p[2], p[3]);
-            valid = valid && finite4(clip[k]);
-        }
-        if (!valid) {
-            ++stats_.invalid;
-            continue;
-        }
-        // Entirely outside one plane of the view frustum (or behind the near plane)?
-        auto all = [&](auto outside) { return outside(clip[0]) && outside(clip[1]) && outside(clip[2]); };
-        if (all([&](const glm::dvec4& c) { return c.w < near_w; }) || all([](const glm::dvec4& c) { return c.x > c.w; }) ||
-            all([](const glm::dvec4& c) { return c.x < -c.w; }) || all([](const glm::dvec4& c) { return c.y > c.w; }) ||
-            all([](const glm::dvec4& c) { return c.y < -c.w; })) {
-            ++stats_.outside;
-            continue;
-        }
-        double extent = 0.0, min_w = HUGE_VAL;
-        for (const auto& c : clip) {
-            extent = std::max({extent, std::abs(c.x), std::abs(c.y)});
-            min_w = std::min(min_w, c.w);
-        }
-        if (extent > 0x1.0p28 * std::max(near_w, min_w)) {
-            ++stats_.too_large;
-            continue;
-        }
-        bool needs_clip = false;
-        for (const auto& c : clip)
-            needs_clip = needs_clip || c.w < near_w || std::abs(c.x) > kGuardBand * c.w || std::abs(c.y) > kGuardBand * c.w;
-        const std::uint8_t shared_bits = in.shared_edges ? in.shared_edges[t] : 0;
-        const detail::ClipVertex corners[3] = {{clip[0].x, clip[0].y, clip[0].w}, {clip[1].x, clip[1].y, clip[1].w},
-                                               {clip[2].x, clip[2].y, clip[2].w}};
-        detail::ClipPolygon poly;
-        if (needs_clip) {
-            poly = detail::clip_triangle(corners, shared_bits, near_w, kGuardBand);
-        } else {
-            for (int k = 0; k < 3; ++k) {
-                poly.v[k] = corners[k];
-                poly.shared[k] = (shared_bits >> k) & 1u;
+    const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
+    const std::size_t bands = band_touched_.size();
+    if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
+
+    struct Job {
+        OcclusionBuffer* self;
+        const TriangleInput* in;
+        std::size_t chunk_count, bands;
+    } job{this, &in, chunk_count, bands};
+
+    // Phase 1: set up and bin each chunk.
+    run_tasks(parallel, chunk_count, [](void* data, std::size_t c) {
+        const Job& j = *static_cast<Job*>(data);
+        OcclusionBuffer& b = *j.self;
+        Chunk& chunk = b.chunks_[c];
+        chunk.triangles.clear();
+        chunk.stats = RasterStats{};
+        if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
+        for (auto& bin : chunk.bins) bin.clear();
+        const std::size_t end = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
+        for (std::size_t t = c * kChunkTriangles; t < end; ++t) {
+            const detail::SetupResult setup =
+                detail::setup_triangle(*j.in, t, b.config_.near_w, b.sample_width_, b.sample_height_, chunk.stats);
+            for (int k = 0; k < setup.count; ++k) {
+                const detail::ScreenTriangle& tri = setup.triangles[k];
+                const double min_y = std::min({tri.p[0].y, tri.p[1].y, tri.p[2].y});
+                const double max_y = std::max({tri.p[0].y, tri.p[1].y, tri.p[2].y});
+                const int j0 = std::max(0, int(std::ceil(min_y - 0.5)));
+                const int j1 = std::min(b.sample_height_ - 1, int(std::floor(max_y - 0.5)));
+                if (j0 > j1) continue;
+                const auto index = std::uint32_t(chunk.triangles.size());
+                chunk.triangles.push_back(tri);
+                for (int band = j0 / (kH * kBandSubtileRows); band <= j1 / (kH * kBandSubtileRows); ++band)
+                    chunk.bins[std::size_t(band)].push_back(index);
             }
-            poly.count = 3;
         }
-        stats_.near_clipped += needs_clip;
-        if (poly.count == 0) {
-            ++stats_.outside;
-            continue;
-        }
+    }, &job);
 
-        // Project to sample space (y down) with depth 1/w.
-        detail::ScreenTriangle fan[detail::ClipPolygon::kMax];
-        glm::dvec2 screen[detail::ClipPolygon::kMax];
-        double depth[detail::ClipPolygon::kMax];
-        for (int k = 0; k < poly.count; ++k) {
-            const double inv_w = 1.0 / poly.v[k].z;
-            screen[k] = {(poly.v[k].x * inv_w + 1.0) * 0.5 * sample_width_, (1.0 - poly.v[k].y * inv_w) * 0.5 * sample_height_};
-            depth[k] = inv_w;
+    // Phase 2: rasterize each band, chunk by chunk in order.
+    run_tasks(parallel, bands, [](void* data, std::size_t band) {
+        const Job& j = *static_cast<Job*>(data);
+        OcclusionBuffer& b = *j.self;
+        const int row_begin = int(band) * kBandSubtileRows;
+        const detail::RasterTarget target{b.subtiles_.data(), b.subtiles_x_, b.subtiles_y_, b.sample_width_, b.sample_height_,
+                                          b.config_.edge_margin, row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_)};
+        std::uint64_t touched = 0;
+        for (std::size_t c = 0; c < j.chunk_count; ++c) {
+            const Chunk& chunk = b.chunks_[c];
+            for (std::uint32_t index : chunk.bins[band]) touched += detail::rasterize_triangle(target, chunk.triangles[index]);
         }
-        // Orientation and degeneracy from homogeneous determinants det[x y w] (w > 0 after
-        // clipping): positive for counter-clockwise in NDC, and exactly zero for collinear
-        // input, before any division rounds it. Summed over the polygon's fan, because clipping
-        // may leave three consecutive vertices on one line.
-        auto det3 = [](const detail::ClipVertex& a, const detail::ClipVertex& b, const detail::ClipVertex& c) {
-            return a.x * (b.y * c.z - b.z * c.y) - a.y * (b.x * c.z - b.z * c.x) + a.z * (b.x * c.y - b.y * c.x);
-        };
-        double det = 0.0;
-        for (int k = 1; k + 1 < poly.count; ++k) det += det3(poly.v[0], poly.v[k], poly.v[k + 1]);
-        if (det == 0.0) {
-            ++stats_.degenerate;
-            continue;
-        }
-        const bool ccw_in_ndc = det > 0.0;
-        if ((in.backface == Backface::cw && !ccw_in_ndc) || (in.backface == Backface::ccw && ccw_in_ndc)) {
-            ++stats_.backface_culled;
-            continue;
-        }
-        // Fan triangles (0, k, k + 1): their diagonals are shared with each other.
-        int triangles = 0;
-        for (int k = 1; k + 1 < poly.count; ++k) {
-            const bool first = k == 1, last = k + 2 == poly.count;
-            const std::uint8_t bits = std::uint8_t((first ? poly.shared[0] : 1u) | (poly.shared[k] << 1) |
-                                                   ((last ? poly.shared[k + 1] : 1u) << 2));
-            fan[triangles++] = {{screen[0], screen[k], screen[k + 1]}, {depth[0], depth[k], depth[k + 1]}, bits};
-        }
-        for (int k = 0; k < triangles; ++k) stats_.subtiles_touched += detail::rasterize_triangle(target, fan[k]);
-        ++stats_.rasterized;
+        b.band_touched_[band] = touched;
+    }, &job);
+
+    for (std::size_t c = 0; c < chunk_count; ++c) {
+        const RasterStats& s = chunks_[c].stats;
+        stats_.triangles_in += s.triangles_in;
+        stats_.invalid += s.invalid;
+        stats_.outside += s.outside;
+        stats_.near_clipped += s.near_clipped;
+        stats_.too_large += s.too_large;
+        stats_.backface_culled += s.backface_culled;
+        stats_.degenerate += s.degenerate;
+        stats_.rasterized += s.rasterized;
     }
+    for (std::uint64_t touched : band_touched_) stats_.subtiles_touched += touched;
 }
 
 Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
@@ -209,15 +177,15 @@ Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float nd
 
 Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) const {
     // Incremental corner transform: the base corner plus the three transformed edge vectors.
-    const glm::dvec4 base = transform(m, box_min[0], box_min[1], box_min[2], 1.0);
-    const glm::dvec4 ex = transform(m, double(box_max[0]) - double(box_min[0]), 0, 0, 0);
-    const glm::dvec4 ey = transform(m, 0, double(box_max[1]) - double(box_min[1]), 0, 0);
-    const glm::dvec4 ez = transform(m, 0, 0, double(box_max[2]) - double(box_min[2]), 0);
+    const glm::dvec4 base = detail::transform_to_clip(m, box_min[0], box_min[1], box_min[2], 1.0);
+    const glm::dvec4 ex = detail::transform_to_clip(m, double(box_max[0]) - double(box_min[0]), 0, 0, 0);
+    const glm::dvec4 ey = detail::transform_to_clip(m, 0, double(box_max[1]) - double(box_min[1]), 0, 0);
+    const glm::dvec4 ez = detail::transform_to_clip(m, 0, 0, double(box_max[2]) - double(box_min[2]), 0);
     double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, min_w = HUGE_VAL;
     int behind = 0;
     for (int k = 0; k < 8; ++k) {
         const glm::dvec4 c = base + ((k & 1) ? ex : glm::dvec4(0)) + ((k & 2) ? ey : glm::dvec4(0)) + ((k & 4) ? ez : glm::dvec4(0));
-        if (!finite4(c)) return Visibility::visible;
+        if (!detail::finite_clip(c)) return Visibility::visible;
         if (c.w < double(config_.near_w)) {
             ++behind;
             continue;

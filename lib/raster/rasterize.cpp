@@ -88,7 +88,7 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
 
     std::uint64_t touched = 0;
     const int tx0 = i0 / kW, tx1 = i1 / kW;
-    for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
+    for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         // The covered interval [first, last] of each of the subtile row's sample rows.
         int first[kH], last[kH];
         for (int j = 0; j < kH; ++j) {

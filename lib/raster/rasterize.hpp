@@ -17,6 +17,7 @@ struct RasterTarget {
     int subtiles_x, subtiles_y;
     int sample_width, sample_height;
     double edge_margin;
+    int row_begin, row_end;  // the subtile rows [row_begin, row_end) this call may write
 };
 
 // Rasterizes a counter-clockwise-in-NDC or clockwise triangle (either; orientation is

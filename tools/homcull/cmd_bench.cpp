@@ -9,9 +9,11 @@
 #include <homcull/io/scene_io.hpp>
 #include <homcull/io/workload_s1.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/tbb_parallel_for.hpp>
 #include <homcull/world_triangles.hpp>
 
 #include <fmt/core.h>
+#include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -40,7 +42,10 @@ nlohmann::json stats_json(const RasterStats& s) {
 
 void run_bench(const BenchOptions& o) {
     if (o.isa != "scalar") throw Error("bench: --isa " + o.isa + " is not available yet (available: scalar)");
-    if (o.threads != 1) throw Error("bench: only --threads 1 is available yet (binned multithreading is not implemented)");
+    if (o.threads < 1) throw Error("bench: --threads must be at least 1");
+    // One thread: the library's serial path. More: TBB limited to that many threads.
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
+    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
     const Resolution res = parse_resolution(o.resolution);
     BufferConfig config;
     config.width = res.width;
@@ -67,7 +72,7 @@ void run_bench(const BenchOptions& o) {
         for (int r = 0; r < repeat; ++r) {
             buffer.clear();
             long long start = now_ns();
-            buffer.render(in);
+            buffer.render(in, parallel);
             render_ms.push_back(elapsed_ms(start));
             start = now_ns();
             std::size_t hidden = 0;
@@ -101,7 +106,7 @@ void run_bench(const BenchOptions& o) {
             for (int r = 0; r < repeat; ++r) {
                 buffer.clear();
                 const long long start = now_ns();
-                buffer.render(in);
+                buffer.render(in, parallel);
                 ms.push_back(elapsed_ms(start));
             }
             medians.push_back(median(ms));

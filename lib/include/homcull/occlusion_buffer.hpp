@@ -86,6 +86,15 @@ struct TriangleInput {
 void compute_shared_edges(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                           const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
 
+// The caller's job system, for render(): run(user, count, task, task_data) must call
+// task(task_data, i) once for every i in [0, count), in any order, on any threads, and return
+// when all calls have returned. The library creates no threads. Left empty, tasks run in
+// order on the calling thread. Results are the same bits whatever the threads.
+struct ParallelFor {
+    void (*run)(void* user, std::size_t count, void (*task)(void* task_data, std::size_t index), void* task_data) = nullptr;
+    void* user = nullptr;
+};
+
 class OcclusionBuffer {
 public:
     struct Subtile {
@@ -100,8 +109,12 @@ public:
     explicit OcclusionBuffer(const BufferConfig& config);
 
     void clear();
-    // Rasterizes occluders. Statistics accumulate until clear().
-    void render(const TriangleInput& input);
+    // Rasterizes occluders: triangles are set up in chunks and binned into bands of subtile
+    // rows, then each band is rasterized in submission order (so every subtile sees the same
+    // sequence of triangles whatever the threads). Scratch memory grows to the largest input
+    // seen and is reused: no allocation per frame after the first. Statistics accumulate until
+    // clear(). Not thread-safe with itself or with tests.
+    void render(const TriangleInput& input, const ParallelFor& parallel = {});
 
     // Occludee tests. Thread-safe with each other (no render in flight).
     // Screen rectangle in NDC (y up) with the nearest clip w of the occludee.
@@ -128,6 +141,16 @@ private:
     int subtiles_x_ = 0, subtiles_y_ = 0;
     std::vector<Subtile> subtiles_;
     RasterStats stats_;
+
+    // Render scratch, reused across frames.
+    struct Chunk;
+    std::vector<Chunk> chunks_;
+    std::vector<std::uint64_t> band_touched_;
+
+public:
+    ~OcclusionBuffer();
+    OcclusionBuffer(OcclusionBuffer&&) noexcept;
+    OcclusionBuffer& operator=(OcclusionBuffer&&) noexcept;
 };
 
 // A camera's view-projection matrix as a column-major float array for TriangleInput and

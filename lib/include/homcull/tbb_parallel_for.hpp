@@ -1,0 +1,10 @@
+#pragma once
+// A ParallelFor backed by oneTBB, for the tools and for engines without a job system of
+// their own (target homcull::tbb). Thread count: TBB's, which tbb::global_control limits.
+#include <homcull/occlusion_buffer.hpp>
+
+namespace homcull {
+
+ParallelFor tbb_parallel_for();
+
+}  // namespace homcull

@@ -1,0 +1,123 @@
+#include "raster/triangle_setup.hpp"
+
+#include "raster/clip_polygon.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace homcull::detail {
+namespace {
+
+// Guard band in NDC units: triangles reaching beyond |x/w| or |y/w| = 32 are clipped there, so
+// that sample coordinates stay small enough for double edge functions to be exact to far
+// below the coverage margin.
+constexpr double kGuardBand = 32.0;
+
+}  // namespace
+
+SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w, int sample_width, int sample_height,
+                           RasterStats& stats) {
+    SetupResult result;
+    const auto* bytes = static_cast<const unsigned char*>(in.positions);
+    ++stats.triangles_in;
+    std::uint32_t index[3];
+    for (int k = 0; k < 3; ++k) {
+        const std::size_t n = 3 * t + std::size_t(k);
+        if (!in.indices) index[k] = std::uint32_t(n);
+        else if (in.indices_16bit) index[k] = static_cast<const std::uint16_t*>(in.indices)[n];
+        else index[k] = static_cast<const std::uint32_t*>(in.indices)[n];
+    }
+    if (index[0] >= in.vertex_count || index[1] >= in.vertex_count || index[2] >= in.vertex_count) {
+        ++stats.invalid;
+        return result;
+    }
+    glm::dvec4 clip[3];
+    bool valid = true;
+    for (int k = 0; k < 3; ++k) {
+        float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+        std::memcpy(p, bytes + std::size_t(index[k]) * in.position_stride, sizeof(float) * std::size_t(in.position_components));
+        clip[k] = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
+        valid = valid && finite_clip(clip[k]);
+    }
+    if (!valid) {
+        ++stats.invalid;
+        return result;
+    }
+    // Entirely outside one plane of the view frustum (or behind the near plane)?
+    auto all = [&](auto outside) { return outside(clip[0]) && outside(clip[1]) && outside(clip[2]); };
+    if (all([&](const glm::dvec4& c) { return c.w < near_w; }) || all([](const glm::dvec4& c) { return c.x > c.w; }) ||
+        all([](const glm::dvec4& c) { return c.x < -c.w; }) || all([](const glm::dvec4& c) { return c.y > c.w; }) ||
+        all([](const glm::dvec4& c) { return c.y < -c.w; })) {
+        ++stats.outside;
+        return result;
+    }
+    double extent = 0.0, min_w = HUGE_VAL;
+    for (const auto& c : clip) {
+        extent = std::max({extent, std::abs(c.x), std::abs(c.y)});
+        min_w = std::min(min_w, c.w);
+    }
+    if (extent > 0x1.0p28 * std::max(near_w, min_w)) {
+        ++stats.too_large;
+        return result;
+    }
+    bool needs_clip = false;
+    for (const auto& c : clip)
+        needs_clip = needs_clip || c.w < near_w || std::abs(c.x) > kGuardBand * c.w || std::abs(c.y) > kGuardBand * c.w;
+    const std::uint8_t shared_bits = in.shared_edges ? in.shared_edges[t] : 0;
+    const ClipVertex corners[3] = {{clip[0].x, clip[0].y, clip[0].w}, {clip[1].x, clip[1].y, clip[1].w},
+                                           {clip[2].x, clip[2].y, clip[2].w}};
+    ClipPolygon poly;
+    if (needs_clip) {
+        poly = clip_triangle(corners, shared_bits, near_w, kGuardBand);
+    } else {
+        for (int k = 0; k < 3; ++k) {
+            poly.v[k] = corners[k];
+            poly.shared[k] = (shared_bits >> k) & 1u;
+        }
+        poly.count = 3;
+    }
+    stats.near_clipped += needs_clip;
+    if (poly.count == 0) {
+        ++stats.outside;
+        return result;
+    }
+
+    // Project to sample space (y down) with depth 1/w.
+    glm::dvec2 screen[ClipPolygon::kMax];
+    double depth[ClipPolygon::kMax];
+    for (int k = 0; k < poly.count; ++k) {
+        const double inv_w = 1.0 / poly.v[k].z;
+        screen[k] = {(poly.v[k].x * inv_w + 1.0) * 0.5 * sample_width, (1.0 - poly.v[k].y * inv_w) * 0.5 * sample_height};
+        depth[k] = inv_w;
+    }
+    // Orientation and degeneracy from homogeneous determinants det[x y w] (w > 0 after
+    // clipping): positive for counter-clockwise in NDC, and exactly zero for collinear
+    // input, before any division rounds it. Summed over the polygon's fan, because clipping
+    // may leave three consecutive vertices on one line.
+    auto det3 = [](const ClipVertex& a, const ClipVertex& b, const ClipVertex& c) {
+        return a.x * (b.y * c.z - b.z * c.y) - a.y * (b.x * c.z - b.z * c.x) + a.z * (b.x * c.y - b.y * c.x);
+    };
+    double det = 0.0;
+    for (int k = 1; k + 1 < poly.count; ++k) det += det3(poly.v[0], poly.v[k], poly.v[k + 1]);
+    if (det == 0.0) {
+        ++stats.degenerate;
+        return result;
+    }
+    const bool ccw_in_ndc = det > 0.0;
+    if ((in.backface == Backface::cw && !ccw_in_ndc) || (in.backface == Backface::ccw && ccw_in_ndc)) {
+        ++stats.backface_culled;
+        return result;
+    }
+    // Fan triangles (0, k, k + 1): their diagonals are shared with each other.
+    for (int k = 1; k + 1 < poly.count; ++k) {
+        const bool first = k == 1, last = k + 2 == poly.count;
+        const std::uint8_t bits = std::uint8_t((first ? poly.shared[0] : 1u) | (poly.shared[k] << 1) |
+                                               ((last ? poly.shared[k + 1] : 1u) << 2));
+        result.triangles[result.count++] = {{screen[0], screen[k], screen[k + 1]}, {depth[0], depth[k], depth[k + 1]}, bits};
+    }
+    if (result.count > 0) ++stats.rasterized;
+    return result;
+}
+
+}  // namespace homcull::detail
