@@ -95,3 +95,48 @@ TEST(RenderThreads, CityFromAboveSameBits) {
 
 }  // namespace
 }  // namespace homcull
+
+namespace homcull {
+namespace {
+
+// The pyramid-accelerated rectangle test answers exactly as the exhaustive definition.
+TEST(RectTest, PyramidAnswersEqualExhaustiveOnes) {
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<float> ndc(-1.3f, 1.3f), w(1.0f, 80.0f), size(0.01f, 0.5f), unit(0.0f, 1.0f);
+    for (int samples : {1, 2, 4}) {
+        std::vector<float> xyzw;
+        for (int t = 0; t < 6000; ++t) {
+            const float cx = ndc(rng), cy = ndc(rng), r = size(rng), wk = w(rng);
+            for (int k = 0; k < 3; ++k)
+                xyzw.insert(xyzw.end(), {(cx + r * float(k == 1) - r * float(k == 2)) * wk, (cy + r * float(k == 2)) * wk, 0.0f, wk});
+        }
+        TriangleInput in;
+        in.positions = xyzw.data();
+        in.position_components = 4;
+        in.position_stride = 16;
+        in.vertex_count = xyzw.size() / 4;
+        in.triangle_count = in.vertex_count / 3;
+        in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        in.backface = Backface::none;
+        BufferConfig config;
+        config.width = 157;  // odd sizes: partial subtiles at the right and bottom
+        config.height = 93;
+        config.samples = samples;
+        config.near_w = 1.0f;
+        OcclusionBuffer buffer(config);
+        buffer.render(in);
+        std::size_t occluded = 0, mismatches = 0;
+        for (int k = 0; k < 200000; ++k) {
+            const float x0 = ndc(rng), y0 = ndc(rng);
+            const float x1 = x0 + size(rng) * unit(rng) * 2, y1 = y0 + size(rng) * unit(rng) * 2, wq = w(rng);
+            const Visibility fast = buffer.test_rect(x0, y0, x1, y1, wq);
+            mismatches += fast != buffer.test_rect_exhaustive(x0, y0, x1, y1, wq);
+            occluded += fast == Visibility::occluded;
+        }
+        EXPECT_EQ(mismatches, 0u) << "samples " << samples;
+        EXPECT_GT(occluded, 20000u);  // the test exercises both answers
+    }
+}
+
+}  // namespace
+}  // namespace homcull

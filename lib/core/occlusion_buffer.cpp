@@ -43,11 +43,43 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     subtiles_y_ = (sample_height_ + kH - 1) / kH;
     subtiles_.assign(std::size_t(subtiles_x_) * std::size_t(subtiles_y_), Subtile{});
     band_touched_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
+    levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: the subtiles themselves
+    std::size_t size = 0;
+    while (levels_.back().width > 1 || levels_.back().height > 1) {
+        const Level& below = levels_.back();
+        levels_.push_back({(below.width + 1) / 2, (below.height + 1) / 2, size});
+        size += std::size_t(levels_.back().width) * std::size_t(levels_.back().height);
+    }
+    pyramid_.assign(size, 0.0f);
 }
 
 void OcclusionBuffer::clear() {
     std::fill(subtiles_.begin(), subtiles_.end(), Subtile{});
+    std::fill(pyramid_.begin(), pyramid_.end(), 0.0f);
     stats_ = RasterStats{};
+}
+
+float OcclusionBuffer::min_d0(int level, int x, int y) const {
+    if (level == 0) return subtiles_[std::size_t(y) * std::size_t(subtiles_x_) + std::size_t(x)].d0;
+    const Level& l = levels_[std::size_t(level)];
+    return pyramid_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)];
+}
+
+void OcclusionBuffer::build_pyramid() {
+    for (std::size_t level = 1; level < levels_.size(); ++level) {
+        const Level& below = levels_[level - 1];
+        const Level& here = levels_[level];
+        for (int y = 0; y < here.height; ++y)
+            for (int x = 0; x < here.width; ++x) {
+                float m = min_d0(int(level) - 1, 2 * x, 2 * y);
+                if (2 * x + 1 < below.width) m = std::min(m, min_d0(int(level) - 1, 2 * x + 1, 2 * y));
+                if (2 * y + 1 < below.height) {
+                    m = std::min(m, min_d0(int(level) - 1, 2 * x, 2 * y + 1));
+                    if (2 * x + 1 < below.width) m = std::min(m, min_d0(int(level) - 1, 2 * x + 1, 2 * y + 1));
+                }
+                pyramid_[here.offset + std::size_t(y) * std::size_t(here.width) + std::size_t(x)] = m;
+            }
+    }
 }
 
 namespace {
@@ -133,45 +165,115 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         stats_.rasterized += s.rasterized;
     }
     for (std::uint64_t touched : band_touched_) stats_.subtiles_touched += touched;
+    build_pyramid();
 }
 
-Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
+bool OcclusionBuffer::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, RectQuery& q,
+                              Visibility& decided) const {
     if (!std::isfinite(ndc_min_x) || !std::isfinite(ndc_min_y) || !std::isfinite(ndc_max_x) || !std::isfinite(ndc_max_y) ||
-        !std::isfinite(w_min) || !(ndc_min_x <= ndc_max_x) || !(ndc_min_y <= ndc_max_y))
-        return Visibility::visible;  // nothing to reason with: never cull
-    if (w_min < config_.near_w) return Visibility::visible;
-    if (ndc_max_x < -1.0f || ndc_min_x > 1.0f || ndc_max_y < -1.0f || ndc_min_y > 1.0f) return Visibility::view_culled;
-
+        !std::isfinite(w_min) || !(ndc_min_x <= ndc_max_x) || !(ndc_min_y <= ndc_max_y)) {
+        decided = Visibility::visible;  // nothing to reason with: never cull
+        return false;
+    }
+    if (w_min < config_.near_w) {
+        decided = Visibility::visible;
+        return false;
+    }
+    if (ndc_max_x < -1.0f || ndc_min_x > 1.0f || ndc_max_y < -1.0f || ndc_min_y > 1.0f) {
+        decided = Visibility::view_culled;
+        return false;
+    }
     // The samples whose centres lie in the rectangle.
     const double sx0 = (double(ndc_min_x) + 1.0) * 0.5 * sample_width_, sx1 = (double(ndc_max_x) + 1.0) * 0.5 * sample_width_;
     const double sy0 = (1.0 - double(ndc_max_y)) * 0.5 * sample_height_, sy1 = (1.0 - double(ndc_min_y)) * 0.5 * sample_height_;
-    const int i0 = std::max(0, int(std::ceil(sx0 - 0.5))), i1 = std::min(sample_width_ - 1, int(std::floor(sx1 - 0.5)));
-    const int j0 = std::max(0, int(std::ceil(sy0 - 0.5))), j1 = std::min(sample_height_ - 1, int(std::floor(sy1 - 0.5)));
-    if (i0 > i1 || j0 > j1) return Visibility::occluded;  // covers no sample: invisible at every sample
-
+    q.i0 = std::max(0, int(std::ceil(sx0 - 0.5)));
+    q.i1 = std::min(sample_width_ - 1, int(std::floor(sx1 - 0.5)));
+    q.j0 = std::max(0, int(std::ceil(sy0 - 0.5)));
+    q.j1 = std::min(sample_height_ - 1, int(std::floor(sy1 - 0.5)));
+    if (q.i0 > q.i1 || q.j0 > q.j1) {
+        decided = Visibility::occluded;  // covers no sample: invisible at every sample
+        return false;
+    }
     // Nearest 1/w of the occludee, rounded up and raised by a relative 2^-20.
     const double d = 1.0 / double(w_min);
-    float d_near = float(d);
-    if (double(d_near) < d) d_near = std::nextafter(d_near, std::numeric_limits<float>::infinity());
-    d_near *= 1.0f + 0x1.0p-20f;
+    q.d_near = float(d);
+    if (double(q.d_near) < d) q.d_near = std::nextafter(q.d_near, std::numeric_limits<float>::infinity());
+    q.d_near *= 1.0f + 0x1.0p-20f;
+    return true;
+}
 
-    for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
-        std::uint32_t row_mask = 0;  // rectangle rows within this subtile row
-        for (int j = 0; j < kH; ++j) {
-            const int sy = ty * kH + j;
-            if (sy >= j0 && sy <= j1) row_mask |= 0xFFu << (j * kW);
+// Whether subtile (tx, ty) hides the rectangle's samples in it.
+bool OcclusionBuffer::subtile_hides(int tx, int ty, const RectQuery& q) const {
+    const int c0 = std::max(0, q.i0 - tx * kW), c1 = std::min(kW - 1, q.i1 - tx * kW);
+    const int r0 = std::max(0, q.j0 - ty * kH), r1 = std::min(kH - 1, q.j1 - ty * kH);
+    const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
+    std::uint32_t rect = 0;
+    for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
+    const Subtile& s = subtiles_[std::size_t(ty) * std::size_t(subtiles_x_) + std::size_t(tx)];
+    const float bound = (s.mask != 0 && (rect & ~s.mask) == 0) ? std::max(s.d0, s.d1) : s.d0;
+    return q.d_near < bound;
+}
+
+Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y,
+                                                 float w_min) const {
+    RectQuery q;
+    Visibility decided;
+    if (!prepare(ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min, q, decided)) return decided;
+    for (int ty = q.j0 / kH; ty <= q.j1 / kH; ++ty)
+        for (int tx = q.i0 / kW; tx <= q.i1 / kW; ++tx)
+            if (!subtile_hides(tx, ty, q)) return Visibility::visible;
+    return Visibility::occluded;
+}
+
+// Is there a subtile in [x0, x1] x [y0, y1] (subtile units) within the pyramid cell whose d0
+// is at or below d_near? Cells whose minimum is above d_near are pruned.
+bool OcclusionBuffer::any_farther_or_equal(int level, int x, int y, int x0, int y0, int x1, int y1, float d_near) const {
+    const int cx0 = x << level, cy0 = y << level, cx1 = ((x + 1) << level) - 1, cy1 = ((y + 1) << level) - 1;
+    if (cx1 < x0 || cx0 > x1 || cy1 < y0 || cy0 > y1) return false;
+    if (d_near < min_d0(level, x, y)) return false;
+    if (level == 0 || (cx0 >= x0 && cx1 <= x1 && cy0 >= y0 && cy1 <= y1)) return true;
+    const Level& below = levels_[std::size_t(level) - 1];
+    for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx)
+            if (2 * x + dx < below.width && 2 * y + dy < below.height &&
+                any_farther_or_equal(level - 1, 2 * x + dx, 2 * y + dy, x0, y0, x1, y1, d_near))
+                return true;
+    return false;
+}
+
+Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
+    RectQuery q;
+    Visibility decided;
+    if (!prepare(ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min, q, decided)) return decided;
+    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+
+    // Coarse check: the level where the subtile range spans at most 2 x 2 cells. Their minimum
+    // d0 is at most any covered subtile's bound, so d_near below it hides the rectangle.
+    int level = 0;
+    while ((tx1 >> level) - (tx0 >> level) > 1 || (ty1 >> level) - (ty0 >> level) > 1) ++level;
+    float coarse = INFINITY;
+    for (int y = ty0 >> level; y <= ty1 >> level; ++y)
+        for (int x = tx0 >> level; x <= tx1 >> level; ++x) coarse = std::min(coarse, min_d0(level, x, y));
+    if (q.d_near < coarse) return Visibility::occluded;
+
+    // Interior subtiles (all their samples in the rectangle): their bound is d0, so the
+    // rectangle is visible there iff some d0 <= d_near. Border subtiles: the exact test.
+    const bool left_full = q.i0 % kW == 0, right_full = q.i1 % kW == kW - 1 && q.i1 < sample_width_;
+    const bool top_full = q.j0 % kH == 0, bottom_full = q.j1 % kH == kH - 1;
+    const int ix0 = left_full ? tx0 : tx0 + 1, ix1 = right_full ? tx1 : tx1 - 1;
+    const int iy0 = top_full ? ty0 : ty0 + 1, iy1 = bottom_full ? ty1 : ty1 - 1;
+    for (int ty = ty0; ty <= ty1; ++ty)
+        for (int tx = tx0; tx <= tx1; ++tx) {
+            if (ty >= iy0 && ty <= iy1 && tx >= ix0 && tx <= ix1) {  // skip the interior run
+                tx = ix1;
+                continue;
+            }
+            if (!subtile_hides(tx, ty, q)) return Visibility::visible;
         }
-        for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {
-            const int c0 = std::max(0, i0 - tx * kW), c1 = std::min(kW - 1, i1 - tx * kW);
-            const std::uint32_t columns = ((1u << (c1 + 1)) - 1u) & ~((1u << c0) - 1u);
-            std::uint32_t rect = 0;
-            for (int j = 0; j < kH; ++j) rect |= columns << (j * kW);
-            rect &= row_mask;
-            const Subtile& s = subtiles_[std::size_t(ty) * std::size_t(subtiles_x_) + std::size_t(tx)];
-            const float bound = (s.mask != 0 && (rect & ~s.mask) == 0) ? std::max(s.d0, s.d1) : s.d0;
-            if (!(d_near < bound)) return Visibility::visible;
-        }
-    }
+    if (ix0 <= ix1 && iy0 <= iy1)
+        for (int y = ty0 >> level; y <= ty1 >> level; ++y)
+            for (int x = tx0 >> level; x <= tx1 >> level; ++x)
+                if (any_farther_or_equal(level, x, y, ix0, iy0, ix1, iy1, q.d_near)) return Visibility::visible;
     return Visibility::occluded;
 }
 

@@ -117,8 +117,14 @@ public:
     void render(const TriangleInput& input, const ParallelFor& parallel = {});
 
     // Occludee tests. Thread-safe with each other (no render in flight).
-    // Screen rectangle in NDC (y up) with the nearest clip w of the occludee.
+    // Screen rectangle in NDC (y up) with the nearest clip w of the occludee. Occluded when
+    // every sample whose centre lies in it has an occluder nearer than w_min, by the subtile
+    // bounds: d0, or max(d0, d1) where the rectangle's samples are all in the working layer.
+    // Answered with a pyramid of the farthest depth (Greene, Kass, Miller, "Hierarchical
+    // Z-buffer visibility", SIGGRAPH 1993): a coarse check, then a pruned search.
     Visibility test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
+    // The same answers, by visiting every subtile: the definition test_rect is checked against.
+    Visibility test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
     // World (or model) AABB under a model-to-clip matrix (column-major).
     Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
 
@@ -141,6 +147,26 @@ private:
     int subtiles_x_ = 0, subtiles_y_ = 0;
     std::vector<Subtile> subtiles_;
     RasterStats stats_;
+
+    // Farthest-depth pyramid: level l >= 1 holds, per cell of 2^l x 2^l subtiles, the minimum
+    // d0; rebuilt at the end of render().
+    struct Level {
+        int width, height;
+        std::size_t offset;
+    };
+    std::vector<Level> levels_;
+    std::vector<float> pyramid_;
+    void build_pyramid();
+    float min_d0(int level, int x, int y) const;
+    bool any_farther_or_equal(int level, int x, int y, int x0, int y0, int x1, int y1, float d_near) const;
+    // Shared by both rectangle tests: the sample range and nearest 1/w, or a decided answer.
+    struct RectQuery {
+        int i0, i1, j0, j1;
+        float d_near;
+    };
+    bool prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, RectQuery& q,
+                 Visibility& decided) const;
+    bool subtile_hides(int tx, int ty, const RectQuery& q) const;
 
     // Render scratch, reused across frames.
     struct Chunk;
