@@ -1,9 +1,11 @@
 #pragma once
 // Small scenes built in code, with answers known by construction, and paths for test files.
 #include <homcull/camera.hpp>
+#include <homcull/occlusion_buffer.hpp>
 #include <homcull/scene.hpp>
 
 #include <string>
+#include <vector>
 
 namespace homcull::test {
 
@@ -13,6 +15,12 @@ std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::
 std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::vec3 hi);
 // A camera at the origin looking down -z with the given vertical field of view.
 Camera camera_down_minus_z(double fov_y_degrees = 90.0, double near_plane = 0.1, double far_plane = 1000.0);
+
+// `count` random small triangles as clip-space xyzw (12 floats each): centres uniform in NDC
+// [-1.2, 1.2]^2 (or `extent`), sizes up to `max_size` NDC, w uniform in [1, 80] per vertex.
+std::vector<float> random_clip_triangles(std::uint64_t seed, int count, float max_size, float extent = 1.2f);
+// An identity-matrix TriangleInput over clip-space xyzw triangles, no backface culling.
+TriangleInput clip_space_input(const std::vector<float>& xyzw);
 
 // A fresh, empty folder for one test's files.
 std::string temp_dir(const std::string& test_name);

@@ -21,17 +21,24 @@ std::array<float, 16> xyw_to_clip() {
     return m;
 }
 
+// A TriangleInput over (x, y, w) vertices, three per triangle, no backface culling.
+TriangleInput xyw_input(const std::vector<float>& v) {
+    TriangleInput in;
+    in.positions = v.data();
+    in.vertex_count = v.size() / 3;
+    in.triangle_count = v.size() / 9;
+    in.model_to_clip = xyw_to_clip();
+    in.backface = Backface::none;
+    return in;
+}
+
 struct Soup {
     std::vector<float> xyz;  // (x, y, w) per vertex, three vertices per triangle
     void add(float x0, float y0, float x1, float y1, float x2, float y2, float w) {
         xyz.insert(xyz.end(), {x0 * w, y0 * w, w, x1 * w, y1 * w, w, x2 * w, y2 * w, w});  // NDC corners at depth w
     }
     TriangleInput input(Backface backface = Backface::none) const {
-        TriangleInput in;
-        in.positions = xyz.data();
-        in.vertex_count = xyz.size() / 3;
-        in.triangle_count = xyz.size() / 9;
-        in.model_to_clip = xyw_to_clip();
+        TriangleInput in = xyw_input(xyz);
         in.backface = backface;
         return in;
     }
@@ -113,12 +120,7 @@ TEST(OcclusionBuffer, CoverageAndDepthAreConservativeOnRandomTriangles) {
                 x[k] = pos(rng), y[k] = pos(rng), w[k] = depth(rng);
                 v.insert(v.end(), {x[k] * w[k], y[k] * w[k], w[k]});
             }
-            TriangleInput in;
-            in.positions = v.data();
-            in.vertex_count = 3;
-            in.triangle_count = 1;
-            in.model_to_clip = xyw_to_clip();
-            in.backface = Backface::none;
+            TriangleInput in = xyw_input(v);
             buffer.render(in);
             std::vector<std::uint8_t> covered;
             std::vector<float> stored;
@@ -165,12 +167,7 @@ TEST(OcclusionBuffer, NearPlaneClippingKeepsOnlyWhatIsInFront) {
     OcclusionBuffer buffer = make_buffer(64, 64);
     // A floor-like triangle from w = 0.1 (behind near = 0.5) to w = 20.
     const std::vector<float> v = {-5.0f, -1.0f, 0.1f, 5.0f, -1.0f, 0.1f, 0.0f, -1.0f, 20.0f};
-    TriangleInput in;
-    in.positions = v.data();
-    in.vertex_count = 3;
-    in.triangle_count = 1;
-    in.model_to_clip = xyw_to_clip();
-    in.backface = Backface::none;
+    TriangleInput in = xyw_input(v);
     buffer.render(in);
     EXPECT_EQ(buffer.stats().near_clipped, 1u);
     EXPECT_EQ(buffer.stats().rasterized, 1u);
@@ -218,12 +215,7 @@ TEST(OcclusionBuffer, BadTrianglesAreSkippedAndCounted) {
 TEST(OcclusionBuffer, HugeTrianglesAreClippedToTheGuardBand) {
     OcclusionBuffer buffer = make_buffer(40, 30, 2);
     const std::vector<float> v = {1e7f, 1e7f, 1, -1e7f, 1e7f, 1, 0, -1e7f, 1};  // NDC +-1e7 at w = 1
-    TriangleInput in;
-    in.positions = v.data();
-    in.vertex_count = 3;
-    in.triangle_count = 1;
-    in.model_to_clip = xyw_to_clip();
-    in.backface = Backface::none;
+    TriangleInput in = xyw_input(v);
     buffer.render(in);
     EXPECT_EQ(buffer.stats().near_clipped, 1u);
     EXPECT_EQ(buffer.stats().rasterized, 1u);

@@ -35,24 +35,8 @@ bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
 
 TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     // Many overlapping random triangles (more than one chunk) at several depths.
-    std::mt19937_64 rng(5);
-    std::uniform_real_distribution<float> ndc(-1.2f, 1.2f), w(1.0f, 80.0f), size(0.005f, 0.3f);
-    std::vector<float> xyzw;
-    for (int t = 0; t < 9000; ++t) {
-        const float cx = ndc(rng), cy = ndc(rng), r = size(rng);
-        for (int k = 0; k < 3; ++k) {
-            const float wk = w(rng);
-            xyzw.insert(xyzw.end(), {(cx + r * float(k == 1) - r * float(k == 2)) * wk, (cy + r * float(k == 2)) * wk, 0.0f, wk});
-        }
-    }
-    TriangleInput in;
-    in.positions = xyzw.data();
-    in.position_components = 4;
-    in.position_stride = 16;
-    in.vertex_count = xyzw.size() / 4;
-    in.triangle_count = in.vertex_count / 3;
-    in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    in.backface = Backface::none;
+    const std::vector<float> xyzw = test::random_clip_triangles(5, 9000, 0.3f);
+    const TriangleInput in = test::clip_space_input(xyzw);
     BufferConfig config;
     config.width = 333;
     config.height = 201;
@@ -104,20 +88,8 @@ TEST(RectTest, PyramidAnswersEqualExhaustiveOnes) {
     std::mt19937_64 rng(17);
     std::uniform_real_distribution<float> ndc(-1.3f, 1.3f), w(1.0f, 80.0f), size(0.01f, 0.5f), unit(0.0f, 1.0f);
     for (int samples : {1, 2, 4}) {
-        std::vector<float> xyzw;
-        for (int t = 0; t < 6000; ++t) {
-            const float cx = ndc(rng), cy = ndc(rng), r = size(rng), wk = w(rng);
-            for (int k = 0; k < 3; ++k)
-                xyzw.insert(xyzw.end(), {(cx + r * float(k == 1) - r * float(k == 2)) * wk, (cy + r * float(k == 2)) * wk, 0.0f, wk});
-        }
-        TriangleInput in;
-        in.positions = xyzw.data();
-        in.position_components = 4;
-        in.position_stride = 16;
-        in.vertex_count = xyzw.size() / 4;
-        in.triangle_count = in.vertex_count / 3;
-        in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-        in.backface = Backface::none;
+        const std::vector<float> xyzw = test::random_clip_triangles(100 + std::uint64_t(samples), 6000, 0.5f, 1.3f);
+        const TriangleInput in = test::clip_space_input(xyzw);
         BufferConfig config;
         config.width = 157;  // odd sizes: partial subtiles at the right and bottom
         config.height = 93;

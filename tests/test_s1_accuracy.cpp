@@ -15,44 +15,20 @@
 namespace homcull {
 namespace {
 
-struct Counts {
-    std::size_t hidden = 0, false_culls = 0, missed = 0;
-};
-
-Counts measure(const WorkloadS1& s1, int width, int height, int samples) {
+RectAccuracy measure(const WorkloadS1& s1, int width, int height, int samples) {
     BufferConfig config;
     config.width = width;
     config.height = height;
     config.samples = samples;
     config.near_w = 1.0f;
     OcclusionBuffer buffer(config);
-    TriangleInput in;
-    in.positions = s1.occluders.data();
-    in.position_components = 4;
-    in.position_stride = 16;
-    in.vertex_count = s1.occluder_count() * 3;
-    in.triangle_count = s1.occluder_count();
-    in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    in.backface = Backface::cw;
-    buffer.render(in, tbb_parallel_for());
-    ExactDepth exact(buffer.sample_width(), buffer.sample_height());
-    for (std::size_t t = 0; t < s1.occluder_count(); ++t) {
-        const float* v = &s1.occluders[12 * t];
-        exact.add_triangle(v, v + 4, v + 8, true);
-    }
-    exact.finish();
-    Counts c;
-    for (std::size_t k = 0; k < s1.rect_count(); ++k) {
-        const float* q = &s1.rects[5 * k];
-        const bool truly = exact.hidden(q[0], q[1], q[2], q[3], q[4]);
-        const bool said = buffer.test_rect(q[0], q[1], q[2], q[3], q[4]) != Visibility::visible;
-        c.hidden += truly;
-        c.false_culls += said && !truly;
-        c.missed += truly && !said;
-    }
+    buffer.render(s1.occluder_input(), tbb_parallel_for());
+    const ExactDepth exact =
+        exact_depth_of_triangles(s1.occluders.data(), s1.occluder_count(), buffer.sample_width(), buffer.sample_height(), true);
+    const RectAccuracy a = count_rect_accuracy(buffer, exact, s1.rects.data(), s1.rect_count());
     std::printf("[ s1       ] %dx%d, S = %d: %zu truly hidden, %zu false culls, %zu missed (%.2f %%)\n", width, height, samples,
-                c.hidden, c.false_culls, c.missed, 100.0 * double(c.missed) / double(c.hidden));
-    return c;
+                a.truly_hidden, a.false_culls, a.missed_culls, 100.0 * double(a.missed_culls) / double(a.truly_hidden));
+    return a;
 }
 
 TEST(S1Accuracy, NoFalseCullsAndFewerMissesThanMoc) {
@@ -60,12 +36,12 @@ TEST(S1Accuracy, NoFalseCullsAndFewerMissesThanMoc) {
     if (!std::filesystem::exists(folder + "/rects_ndc_xmin_ymin_xmax_ymax_wmin_f32.bin"))
         GTEST_SKIP() << folder << " is missing (the shared workload S1)";
     const WorkloadS1 s1 = load_workload_s1(folder);
-    const Counts high = measure(s1, 480, 270, 4);  // the samples of a 1920x1080 display
+    const RectAccuracy high = measure(s1, 480, 270, 4);  // the samples of a 1920x1080 display
     EXPECT_EQ(high.false_culls, 0u);
-    EXPECT_LE(double(high.missed), 0.036 * double(high.hidden));
-    const Counts low = measure(s1, 640, 360, 1);
+    EXPECT_LE(double(high.missed_culls), 0.036 * double(high.truly_hidden));
+    const RectAccuracy low = measure(s1, 640, 360, 1);
     EXPECT_EQ(low.false_culls, 0u);
-    EXPECT_LE(double(low.missed), 0.176 * double(low.hidden));
+    EXPECT_LE(double(low.missed_culls), 0.176 * double(low.truly_hidden));
 }
 
 }  // namespace

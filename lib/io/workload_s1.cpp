@@ -22,6 +22,18 @@ std::vector<float> read_floats(const std::string& path, std::size_t count) {
 
 }  // namespace
 
+TriangleInput WorkloadS1::occluder_input() const {
+    TriangleInput in;
+    in.positions = occluders.data();
+    in.position_components = 4;
+    in.position_stride = 4 * sizeof(float);
+    in.vertex_count = occluder_count() * 3;
+    in.triangle_count = occluder_count();
+    in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    in.backface = Backface::cw;
+    return in;
+}
+
 WorkloadS1 load_workload_s1(const std::string& folder) {
     WorkloadS1 w;
     w.occluders = read_floats(folder + "/occluders_clip_xyzw_f32.bin", 100000 * 12);

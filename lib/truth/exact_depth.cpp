@@ -80,4 +80,26 @@ bool ExactDepth::hidden(float ndc_min_x, float ndc_min_y, float ndc_max_x, float
     return true;
 }
 
+ExactDepth exact_depth_of_triangles(const float* xyzw, std::size_t triangle_count, int sample_width, int sample_height,
+                                    bool cull_clockwise) {
+    ExactDepth exact(sample_width, sample_height);
+    for (std::size_t t = 0; t < triangle_count; ++t) exact.add_triangle(xyzw + 12 * t, xyzw + 12 * t + 4, xyzw + 12 * t + 8, cull_clockwise);
+    exact.finish();
+    return exact;
+}
+
+RectAccuracy count_rect_accuracy(const OcclusionBuffer& buffer, const ExactDepth& exact, const float* r, std::size_t count) {
+    RectAccuracy a;
+    a.rects = count;
+    for (std::size_t k = 0; k < count; ++k, r += 5) {
+        const bool truly = exact.hidden(r[0], r[1], r[2], r[3], r[4]);
+        const bool said = buffer.test_rect(r[0], r[1], r[2], r[3], r[4]) != Visibility::visible;
+        a.truly_hidden += truly;
+        a.culled += said;
+        a.false_culls += said && !truly;
+        a.missed_culls += truly && !said;
+    }
+    return a;
+}
+
 }  // namespace homcull

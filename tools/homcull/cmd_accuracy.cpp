@@ -35,35 +35,13 @@ void register_accuracy(CLI::App& app) {
         config.samples = o->samples;
         config.near_w = 1.0f;
         OcclusionBuffer buffer(config);
-        TriangleInput in;
-        in.positions = s1.occluders.data();
-        in.position_components = 4;
-        in.position_stride = 16;
-        in.vertex_count = s1.occluder_count() * 3;
-        in.triangle_count = s1.occluder_count();
-        in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-        in.backface = Backface::cw;
-        buffer.render(in);
-
-        long long start = now_ns();
-        ExactDepth exact(buffer.sample_width(), buffer.sample_height());
-        for (std::size_t t = 0; t < s1.occluder_count(); ++t) {
-            const float* v = &s1.occluders[12 * t];
-            exact.add_triangle(v, v + 4, v + 8, /*cull_clockwise=*/true);
-        }
-        exact.finish();
+        buffer.render(s1.occluder_input());
+        const long long start = now_ns();
+        const ExactDepth exact = exact_depth_of_triangles(s1.occluders.data(), s1.occluder_count(), buffer.sample_width(),
+                                                          buffer.sample_height(), /*cull_clockwise=*/true);
         const double exact_ms = elapsed_ms(start);
-
-        std::size_t hidden = 0, culled = 0, false_culls = 0, missed = 0;
-        for (std::size_t k = 0; k < s1.rect_count(); ++k) {
-            const float* q = &s1.rects[5 * k];
-            const bool truly_hidden = exact.hidden(q[0], q[1], q[2], q[3], q[4]);
-            const bool said_hidden = buffer.test_rect(q[0], q[1], q[2], q[3], q[4]) != Visibility::visible;
-            hidden += truly_hidden;
-            culled += said_hidden;
-            false_culls += said_hidden && !truly_hidden;
-            missed += truly_hidden && !said_hidden;
-        }
+        const RectAccuracy a = count_rect_accuracy(buffer, exact, s1.rects.data(), s1.rect_count());
+        const std::size_t hidden = a.truly_hidden, culled = a.culled, false_culls = a.false_culls, missed = a.missed_culls;
         const double missed_share = hidden ? double(missed) / double(hidden) : 0.0;
         if (o->json) {
             fmt::print("{}\n", nlohmann::json{{"resolution", {res.width, res.height}}, {"samples", o->samples},

@@ -58,14 +58,7 @@ void run_bench(const BenchOptions& o) {
         const WorkloadS1 s1 = load_workload_s1(o.s1_folder);
         config.near_w = 1.0f;  // the near clip plane MOC was measured with
         OcclusionBuffer buffer(config);
-        TriangleInput in;
-        in.positions = s1.occluders.data();
-        in.position_components = 4;
-        in.position_stride = 16;
-        in.vertex_count = s1.occluder_count() * 3;
-        in.triangle_count = s1.occluder_count();
-        in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-        in.backface = Backface::cw;
+        const TriangleInput in = s1.occluder_input();
         std::vector<double> render_ms, test_ms;
         const int repeat = o.repeat > 0 ? o.repeat : 5;
         std::size_t occluded = 0;

@@ -1,6 +1,8 @@
 #pragma once
 // Workload S1 (../shared/workloads/s1, see its README): the synthetic occluder stress test
 // Intel MOC was measured on. Little-endian float32, no header.
+#include <homcull/occlusion_buffer.hpp>
+
 #include <string>
 #include <vector>
 
@@ -12,6 +14,9 @@ struct WorkloadS1 {
     std::vector<float> occludee_tris;  // like occluders, a second draw
     std::size_t occluder_count() const { return occluders.size() / 12; }
     std::size_t rect_count() const { return rects.size() / 5; }
+    // The occluders as MOC was measured on them: clip-space xyzw, identity matrix, clockwise
+    // triangles culled (all of S1's are counter-clockwise).
+    TriangleInput occluder_input() const;
 };
 
 // Reads the three files from `folder`; throws homcull::Error naming a missing or short file.

@@ -2,6 +2,8 @@
 // An exact reference for screen-space workloads (S1): the nearest clip w of a set of
 // triangles at every sample centre, computed in double, and "is this rectangle hidden?"
 // answered from it exactly (per-row sparse tables of the maximum).
+#include <homcull/occlusion_buffer.hpp>
+
 #include <cstdint>
 #include <vector>
 
@@ -34,5 +36,17 @@ private:
     std::vector<float> depth_;
     std::vector<float> row_max_;  // per row, per level: max over [i, i + 2^level)
 };
+
+// The exact depth of clip-space triangles (x, y, z, w per vertex, 12 floats a triangle).
+ExactDepth exact_depth_of_triangles(const float* xyzw, std::size_t triangle_count, int sample_width, int sample_height,
+                                    bool cull_clockwise);
+
+// An occlusion buffer's rectangle answers against the exact ones: a false cull is a
+// rectangle said hidden (occluded or view-culled) that is not; a missed cull the reverse.
+struct RectAccuracy {
+    std::size_t rects = 0, truly_hidden = 0, culled = 0, false_culls = 0, missed_culls = 0;
+};
+RectAccuracy count_rect_accuracy(const OcclusionBuffer& buffer, const ExactDepth& exact, const float* rects_xyxyw,
+                                 std::size_t rect_count);
 
 }  // namespace homcull
