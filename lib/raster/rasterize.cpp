@@ -20,6 +20,17 @@ namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 
+// floor and ceil of doubles well inside the int range (sample coordinates stay within the guard
+// band), exact, without a libm call.
+inline int floor_int(double x) {
+    const int i = int(x);  // truncates toward zero
+    return i - (double(i) > x);
+}
+inline int ceil_int(double x) {
+    const int i = int(x);
+    return i + (double(i) < x);
+}
+
 // Round a positive double down to float, then lower it by a relative 2^-20.
 float conservative_far(double d) {
     float f = float(d);
@@ -107,11 +118,23 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
                     continue;
                 }
                 const double x = e.origin.x + c * e.inverse_sa;  // boundary, in samples
-                if (e.sa > 0.0) first[j] = std::max(first[j], e.shared ? int(std::ceil(x - 0.5)) : int(std::floor(x - 0.5)) + 1);
-                else last[j] = std::min(last[j], e.shared ? int(std::floor(x - 0.5)) : int(std::ceil(x - 0.5)) - 1);
+                // The boundary may lie far outside the buffer for a nearly horizontal edge: clamp
+                // before converting to int (the interval is clamped to [i0, i1] anyway).
+                const double xs = std::clamp(x - 0.5, double(i0) - 2.0, double(i1) + 2.0);
+                if (e.sa > 0.0) first[j] = std::max(first[j], e.shared ? ceil_int(xs) : floor_int(xs) + 1);
+                else last[j] = std::min(last[j], e.shared ? floor_int(xs) : ceil_int(xs) - 1);
             }
         }
-        for (int tx = tx0; tx <= tx1; ++tx) {
+        // Only the subtile columns the row intervals reach.
+        int reach_lo = i1 + 1, reach_hi = i0 - 1;
+        for (int j = 0; j < kH; ++j)
+            if (first[j] <= last[j]) {
+                reach_lo = std::min(reach_lo, first[j]);
+                reach_hi = std::max(reach_hi, last[j]);
+            }
+        if (reach_lo > reach_hi) continue;
+        const std::uint32_t full_row = ty + 1 < t.subtiles_y ? 0xFFFFFFFFu : 0u;  // see valid_sample_mask
+        for (int tx = std::max(tx0, reach_lo / kW); tx <= std::min(tx1, reach_hi / kW); ++tx) {
             std::uint32_t m = 0;
             for (int j = 0; j < kH; ++j) {
                 const int lo = std::max(first[j] - tx * kW, 0), hi = std::min(last[j] - tx * kW, kW - 1);
@@ -147,7 +170,9 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
             if (s.mask != 0 && 2.0f * s.d1 - (d_tri + s.d0) < 0.0f) s.mask = 0;
             s.d1 = s.mask == 0 ? d_tri : std::min(s.d1, d_tri);
             s.mask |= m;
-            if (s.mask == valid_sample_mask(tx, ty, t.sample_width, t.sample_height)) {
+            const std::uint32_t full = (full_row && tx + 1 < t.subtiles_x) ? 0xFFFFFFFFu
+                                                                           : valid_sample_mask(tx, ty, t.sample_width, t.sample_height);
+            if (s.mask == full) {
                 s.d0 = s.d1;
                 s.mask = 0;
                 s.d1 = 0.0f;
