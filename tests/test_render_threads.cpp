@@ -2,6 +2,7 @@
 // which the caller's job system runs the tasks.
 #include "support.hpp"
 
+#include <homcull/error.hpp>
 #include <homcull/generate.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/tbb_parallel_for.hpp>
@@ -108,6 +109,55 @@ TEST(RectTest, PyramidAnswersEqualExhaustiveOnes) {
         EXPECT_EQ(mismatches, 0u) << "samples " << samples;
         EXPECT_GT(occluded, 20000u);  // the test exercises both answers
     }
+}
+
+}  // namespace
+}  // namespace homcull
+
+namespace homcull {
+namespace {
+
+// Every instruction set gives the scalar reference's bits: S1-like random triangles at every
+// sample count, and a city seen from the street (shared edges, near clipping).
+TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
+    const std::vector<float> xyzw = test::random_clip_triangles(23, 20000, 0.4f);
+    const Scene city = generate_scene("city:seed=8,blocks=6");
+    const WorldTriangles occluders = gather_world_triangles(city, objects_with_role(city, ""));
+    Camera street;
+    street.eye = {-3, 1.7, -40};
+    street.target = {20, 3, 10};
+    auto render_all = [&](std::vector<OcclusionBuffer>& out) {
+        for (int samples : {1, 2, 4}) {
+            BufferConfig config;
+            config.width = 301;
+            config.height = 173;
+            config.samples = samples;
+            config.near_w = 1.0f;
+            out.emplace_back(config);
+            out.back().render(test::clip_space_input(xyzw));
+        }
+        BufferConfig config;
+        config.width = 777;
+        config.height = 333;
+        config.near_w = float(street.near_plane);
+        out.emplace_back(config);
+        out.back().render(occluders.input(clip_from_world(street, 777.0 / 333.0), Backface::none));
+    };
+    select_isa("scalar");
+    std::vector<OcclusionBuffer> reference;
+    render_all(reference);
+    const std::vector<std::string> isas = available_isas();
+    EXPECT_GE(isas.size(), 2u) << "no SIMD instruction set available";
+    for (const std::string& isa : isas) {
+        select_isa(isa);
+        EXPECT_EQ(selected_isa(), isa);
+        std::vector<OcclusionBuffer> buffers;
+        render_all(buffers);
+        for (std::size_t k = 0; k < buffers.size(); ++k)
+            EXPECT_TRUE(same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
+    }
+    select_isa("best");
+    EXPECT_THROW(select_isa("mmx"), Error);
 }
 
 }  // namespace

@@ -93,9 +93,13 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
     if (i0 > i1 || j0 > j1) return 0;
 
     // Depth plane d(P) = z0 + dzdx (P.x - p0.x) + dzdy (P.y - p0.y).
-    const double dzdx = ((z1 - z0) * (p2.y - p0.y) - (z2 - z0) * (p1.y - p0.y)) / area2;
-    const double dzdy = ((z2 - z0) * (p1.x - p0.x) - (z1 - z0) * (p2.x - p0.x)) / area2;
-    const double z_vertex_min = std::min({z0, z1, z2});
+    PreparedTriangle prepared;
+    prepared.x0 = p0.x;
+    prepared.y0 = p0.y;
+    prepared.z0 = z0;
+    prepared.dzdx = ((z1 - z0) * (p2.y - p0.y) - (z2 - z0) * (p1.y - p0.y)) / area2;
+    prepared.dzdy = ((z2 - z0) * (p1.x - p0.x) - (z1 - z0) * (p2.x - p0.x)) / area2;
+    prepared.z_vertex_min = std::min({z0, z1, z2});
 
     std::uint64_t touched = 0;
     const int tx0 = i0 / kW, tx1 = i1 / kW;
@@ -133,50 +137,57 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
                 reach_hi = std::max(reach_hi, last[j]);
             }
         if (reach_lo > reach_hi) continue;
-        const std::uint32_t full_row = ty + 1 < t.subtiles_y ? 0xFFFFFFFFu : 0u;  // see valid_sample_mask
-        for (int tx = std::max(tx0, reach_lo / kW); tx <= std::min(tx1, reach_hi / kW); ++tx) {
-            std::uint32_t m = 0;
-            for (int j = 0; j < kH; ++j) {
-                const int lo = std::max(first[j] - tx * kW, 0), hi = std::min(last[j] - tx * kW, kW - 1);
-                if (lo <= hi) m |= ((0xFFu >> (kW - 1 - hi)) & (0xFFu << lo)) << (j * kW);
-            }
-            if (m == 0) continue;
-            ++touched;
-            OcclusionBuffer::Subtile& s = t.subtiles[std::size_t(ty) * std::size_t(t.subtiles_x) + std::size_t(tx)];
-            s.covered |= m;
+        const int tx_begin = std::max(tx0, reach_lo / kW), tx_end = std::min(tx1, reach_hi / kW);
+        touched += t.kernel(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end, first, last, prepared,
+                            t.subtiles_x, t.subtiles_y, t.sample_width, t.sample_height);
+    }
+    return touched;
+}
 
-            // Lower bound of 1/w over the covered samples: the plane at the corner of their
-            // bounding rectangle where it is smallest, and never below the farthest vertex.
-            std::uint32_t columns = 0;
-            int row_min = kH, row_max = -1;
-            for (int j = 0; j < kH; ++j)
-                if ((m >> (j * kW)) & 0xFFu) {
-                    columns |= (m >> (j * kW)) & 0xFFu;
-                    row_min = std::min(row_min, j);
-                    row_max = j;
-                }
-            const int col_min = __builtin_ctz(columns), col_max = 31 - __builtin_clz(columns);
-            const double x_far = (dzdx > 0.0 ? tx * kW + col_min : tx * kW + col_max) + 0.5;
-            const double y_far = (dzdy > 0.0 ? ty * kH + row_min : ty * kH + row_max) + 0.5;
-            const double plane_min = z0 + dzdx * (x_far - p0.x) + dzdy * (y_far - p0.y);
-            const double bound = std::max(plane_min, z_vertex_min);
-            if (!(bound > 0.0)) continue;
-            const float d_tri = conservative_far(bound);
-            if (!(d_tri > s.d0)) continue;  // behind what is already known: nothing to add
+std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const int first[4],
+                                           const int last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
+                                           int sample_width, int sample_height) {
+    std::uint64_t touched = 0;
+    const std::uint32_t full_row = ty + 1 < subtiles_y ? 0xFFFFFFFFu : 0u;  // see valid_sample_mask
+    for (int tx = tx_begin; tx <= tx_end; ++tx) {
+        std::uint32_t m = 0;
+        int col_min = kW, col_max = -1, row_min = kH, row_max = -1;
+        for (int j = 0; j < kH; ++j) {
+            const int lo = std::max(first[j] - tx * kW, 0), hi = std::min(last[j] - tx * kW, kW - 1);
+            if (lo > hi) continue;
+            m |= ((0xFFu >> (kW - 1 - hi)) & (0xFFu << lo)) << (j * kW);
+            col_min = std::min(col_min, lo);
+            col_max = std::max(col_max, hi);
+            row_min = std::min(row_min, j);
+            row_max = j;
+        }
+        if (m == 0) continue;
+        ++touched;
+        OcclusionBuffer::Subtile& s = row[tx];
+        s.covered |= m;
 
-            // Quick mask: drop the working layer when the triangle is farther in front of it than
-            // it is in front of the reference layer (d_tri - d1 > d1 - d0), then merge, and
-            // promote a full layer to the reference.
-            if (s.mask != 0 && 2.0f * s.d1 - (d_tri + s.d0) < 0.0f) s.mask = 0;
-            s.d1 = s.mask == 0 ? d_tri : std::min(s.d1, d_tri);
-            s.mask |= m;
-            const std::uint32_t full = (full_row && tx + 1 < t.subtiles_x) ? 0xFFFFFFFFu
-                                                                           : valid_sample_mask(tx, ty, t.sample_width, t.sample_height);
-            if (s.mask == full) {
-                s.d0 = s.d1;
-                s.mask = 0;
-                s.d1 = 0.0f;
-            }
+        // Lower bound of 1/w over the covered samples: the plane at the corner of their
+        // bounding rectangle where it is smallest, and never below the farthest vertex.
+        const double x_far = (tri.dzdx > 0.0 ? tx * kW + col_min : tx * kW + col_max) + 0.5;
+        const double y_far = (tri.dzdy > 0.0 ? ty * kH + row_min : ty * kH + row_max) + 0.5;
+        const double plane_min = tri.z0 + tri.dzdx * (x_far - tri.x0) + tri.dzdy * (y_far - tri.y0);
+        const double bound = std::max(plane_min, tri.z_vertex_min);
+        if (!(bound > 0.0)) continue;
+        const float d_tri = conservative_far(bound);
+        if (!(d_tri > s.d0)) continue;  // behind what is already known: nothing to add
+
+        // Quick mask: drop the working layer when the triangle is farther in front of it than
+        // it is in front of the reference layer (d_tri - d1 > d1 - d0), then merge, and
+        // promote a full layer to the reference.
+        if (s.mask != 0 && 2.0f * s.d1 - (d_tri + s.d0) < 0.0f) s.mask = 0;
+        s.d1 = s.mask == 0 ? d_tri : std::min(s.d1, d_tri);
+        s.mask |= m;
+        const std::uint32_t full =
+            (full_row && tx + 1 < subtiles_x) ? 0xFFFFFFFFu : valid_sample_mask(tx, ty, sample_width, sample_height);
+        if (s.mask == full) {
+            s.d0 = s.d1;
+            s.mask = 0;
+            s.d1 = 0.0f;
         }
     }
     return touched;

@@ -1,9 +1,17 @@
-// homcull accuracy: false and missed culls of the occlusion buffer on workload S1's 1M
-// rectangles, against an exact double-precision depth at the same sample centres.
+// homcull accuracy: false and missed culls of the occlusion buffer.
+//   S1 (default): workload S1's 1M rectangles against an exact double-precision depth at the
+//                 same sample centres.
+//   --scene F:    every object's AABB test against Embree ground truth at the display's pixel
+//                 centres, from the frames of --path, or of a generated walk or orbit.
 #include "commands.hpp"
 #include "options.hpp"
 
+#include <homcull/error.hpp>
+#include <homcull/io/camera_path.hpp>
+#include <homcull/io/scene_io.hpp>
 #include <homcull/io/workload_s1.hpp>
+#include <homcull/truth/culling_accuracy.hpp>
+#include <homcull/truth/walk_path.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/truth/exact_depth.hpp>
 
@@ -14,19 +22,81 @@
 
 namespace homcull::cli {
 
+namespace {
+
+template <class Options>
+void run_scene_accuracy(const Options& o) {
+    const Resolution display = parse_resolution(o.resolution);
+    const Scene scene = load_scene(o.scene);
+    const RayScene rays(scene);
+    CameraPath views;
+    if (!o.path.empty()) views = read_camera_path(o.path);
+    else if (o.walk > 0) {
+        WalkOptions walk;
+        walk.frames = o.walk * 10;
+        const CameraPath full = walk_path(rays, scene, walk);
+        for (std::size_t k = 0; k < full.frames.size(); k += 10) views.frames.push_back(full.frames[k]);
+    } else if (o.orbit > 0) {
+        const Aabb b = scene.bounds();
+        views = orbit_path(glm::dvec3(b.min), glm::dvec3(b.max), o.orbit);
+    } else {
+        throw Error("accuracy --scene needs views: --path P, --walk N or --orbit N");
+    }
+    std::vector<std::uint32_t> ids = objects_with_role(scene, o.occluders == "role" ? "occluder" : "");
+    if (ids.empty()) ids = objects_with_role(scene, "");
+    const WorldTriangles occluders = gather_world_triangles(scene, ids);
+    CullingTally tally;
+    for (std::size_t k = 0; k < views.frames.size(); ++k) {
+        tally_culling(scene, rays, occluders, views.frames[k], display, o.samples, tally);
+        if (!o.json) fmt::print(stderr, "\rview {}/{}", k + 1, views.frames.size());
+    }
+    if (!o.json) fmt::print(stderr, "\n");
+    if (o.json) {
+        fmt::print("{}\n", nlohmann::json{{"scene", scene.source}, {"display", {display.width, display.height}}, {"samples", o.samples},
+                                          {"views", tally.views}, {"occluder_triangles", occluders.triangle_count()},
+                                          {"visible", tally.visible}, {"hidden_in_frustum", tally.hidden_in_frustum},
+                                          {"culled_hidden", tally.culled_hidden}, {"missed_culls", tally.missed_culls()},
+                                          {"false_culls", tally.false_culls}, {"robust_false_culls", tally.robust_false_culls},
+                                          {"efficiency", tally.efficiency()}, {"false_cull_reports", tally.false_cull_reports}}
+                                .dump(1));
+        return;
+    }
+    fmt::print("{}: {} views at {}x{} (buffer {}x{}, {}x{} samples), {} occluder triangles\n", scene.source, tally.views,
+               display.width, display.height, display.width / o.samples, display.height / o.samples, o.samples, o.samples,
+               occluders.triangle_count());
+    fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %), missed {}\n",
+               tally.false_culls, tally.robust_false_culls, tally.culled_hidden, tally.hidden_in_frustum, 100.0 * tally.efficiency(),
+               tally.missed_culls());
+    for (const std::string& line : tally.false_cull_reports) fmt::print("false cull: {}\n", line);
+}
+
+}  // namespace
+
 void register_accuracy(CLI::App& app) {
     struct Options {
         std::string resolution = "1920x1080", s1_folder = "../shared/workloads/s1";
-        int samples = 1;
+        std::string scene, path, occluders = "role";
+        int samples = 1, walk = 0, orbit = 0;
         bool json = false;
     };
     auto o = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("accuracy", "False and missed culls on workload S1's rectangles against exact depth");
-    cmd->add_option("--resolution", o->resolution, "Occlusion buffer resolution WxH (pixels)")->capture_default_str();
-    cmd->add_option("--samples", o->samples, "S x S samples per pixel (1, 2 or 4)")->capture_default_str();
+    cmd->add_option("--resolution", o->resolution, "S1: buffer resolution WxH; --scene: display resolution WxH")->capture_default_str();
+    cmd->add_option("--samples", o->samples, "S x S samples per buffer pixel (1, 2 or 4); with --scene the buffer is display / S")
+        ->capture_default_str();
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
+    cmd->add_option("--scene", o->scene, "Measure on a scene against Embree ground truth instead of S1");
+    cmd->add_option("--path", o->path, "--scene: camera path whose frames are the views");
+    cmd->add_option("--walk", o->walk, "--scene: views from a generated walk (N views, every 10th frame)");
+    cmd->add_option("--orbit", o->orbit, "--scene: N views on an orbit");
+    cmd->add_option("--occluders", o->occluders, "--scene: role (objects with role=occluder, or all if none has a role) or all")
+        ->capture_default_str()->check(CLI::IsMember({"role", "all"}));
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o] {
+        if (!o->scene.empty()) {
+            run_scene_accuracy(*o);
+            return;
+        }
         const Resolution res = parse_resolution(o->resolution);
         const WorkloadS1 s1 = load_workload_s1(o->s1_folder);
         BufferConfig config;

@@ -23,7 +23,7 @@ namespace homcull::cli {
 namespace {
 
 struct BenchOptions {
-    std::string workload = "s1", resolution = "1920x1080", isa = "scalar";
+    std::string workload = "s1", resolution = "1920x1080", isa = "best";
     std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views = "data/views/castle.json";
     int samples = 1, threads = 1, repeat = 0;
     bool json = false;
@@ -41,7 +41,7 @@ nlohmann::json stats_json(const RasterStats& s) {
 }
 
 void run_bench(const BenchOptions& o) {
-    if (o.isa != "scalar") throw Error("bench: --isa " + o.isa + " is not available yet (available: scalar)");
+    select_isa(o.isa);
     if (o.threads < 1) throw Error("bench: --threads must be at least 1");
     // One thread: the library's serial path. More: TBB limited to that many threads.
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
@@ -52,7 +52,7 @@ void run_bench(const BenchOptions& o) {
     config.height = res.height;
     config.samples = o.samples;
     nlohmann::json out = {{"workload", o.workload}, {"resolution", {res.width, res.height}}, {"samples", o.samples},
-                          {"threads", o.threads}, {"isa", o.isa}};
+                          {"threads", o.threads}, {"isa", selected_isa()}};
 
     if (o.workload == "s1") {
         const WorkloadS1 s1 = load_workload_s1(o.s1_folder);
@@ -118,7 +118,7 @@ void run_bench(const BenchOptions& o) {
         return;
     }
     fmt::print("workload {} at {}x{}, {}x{} samples, {} thread(s), {}: {:.2f} ms ({:.2f} Mtri/s)\n", o.workload, res.width,
-               res.height, o.samples, o.samples, o.threads, o.isa, out["ms"].get<double>(), out["mtris_per_s"].get<double>());
+               res.height, o.samples, o.samples, o.threads, selected_isa(), out["ms"].get<double>(), out["mtris_per_s"].get<double>());
     if (out.contains("rect_tests_per_s"))
         fmt::print("rectangle tests: {:.1f} ms for 1M ({:.1f} M/s), {} occluded\n", out["rect_ms"].get<double>(),
                    out["rect_tests_per_s"].get<double>() * 1e-6, out["rects_occluded"].get<std::size_t>());
@@ -134,7 +134,8 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--resolution", o->resolution, "Occlusion buffer resolution WxH (pixels)")->capture_default_str();
     cmd->add_option("--samples", o->samples, "S x S samples per pixel (1, 2 or 4)")->capture_default_str();
     cmd->add_option("--threads", o->threads, "Threads")->capture_default_str();
-    cmd->add_option("--isa", o->isa, "Instruction set to force")->capture_default_str();
+    cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
+        ->capture_default_str();
     cmd->add_option("--repeat", o->repeat, "Runs to take the median of (0 = 5 for s1, 21 for castle)");
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
     cmd->add_option("--scene", o->scene, "Castle scene for --workload castle")->capture_default_str();

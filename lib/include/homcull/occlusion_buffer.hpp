@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace homcull {
@@ -178,6 +179,17 @@ public:
     OcclusionBuffer(OcclusionBuffer&&) noexcept;
     OcclusionBuffer& operator=(OcclusionBuffer&&) noexcept;
 };
+
+// Instruction sets. Rendering runs SIMD kernels compiled for several instruction sets and
+// chosen at run time (Google Highway); every one gives the same bits as the plain scalar
+// reference path. For tests, benchmarks and users who want to pin one:
+//   available_isas(): "scalar" and the SIMD ones this CPU and build support (avx512, avx2,
+//                     sse4, emu128), best first after "scalar".
+//   select_isa(name): "best" (the default), "scalar", or one of those; process-wide, not to
+//                     be called while a render is in flight. Throws homcull::Error otherwise.
+std::vector<std::string> available_isas();
+void select_isa(const std::string& name);
+std::string selected_isa();
 
 // A camera's view-projection matrix as a column-major float array for TriangleInput and
 // test_aabb (projection_matrix * view_matrix).
