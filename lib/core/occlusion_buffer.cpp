@@ -18,10 +18,11 @@ constexpr int kBandSubtileRows = 4;           // subtile rows rasterized per tas
 
 }  // namespace
 
-// Set-up triangles of one chunk of the input, and per band the ones that touch it, in order.
+// The set-up triangles of one chunk of the input, copied into the bin of every band they
+// touch, in order: each band then reads its triangles sequentially (binning by index made
+// almost every read a cache miss).
 struct OcclusionBuffer::Chunk {
-    std::vector<detail::ScreenTriangle> triangles;
-    std::vector<std::vector<std::uint32_t>> bins;
+    std::vector<std::vector<detail::ScreenTriangle>> bins;
     RasterStats stats;
 };
 
@@ -115,7 +116,6 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         const Job& j = *static_cast<Job*>(data);
         OcclusionBuffer& b = *j.self;
         Chunk& chunk = b.chunks_[c];
-        chunk.triangles.clear();
         chunk.stats = RasterStats{};
         if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
         for (auto& bin : chunk.bins) bin.clear();
@@ -130,10 +130,8 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
                 const int j0 = std::max(0, int(std::ceil(min_y - 0.5)));
                 const int j1 = std::min(b.sample_height_ - 1, int(std::floor(max_y - 0.5)));
                 if (j0 > j1) continue;
-                const auto index = std::uint32_t(chunk.triangles.size());
-                chunk.triangles.push_back(tri);
                 for (int band = j0 / (kH * kBandSubtileRows); band <= j1 / (kH * kBandSubtileRows); ++band)
-                    chunk.bins[std::size_t(band)].push_back(index);
+                    chunk.bins[std::size_t(band)].push_back(tri);
             }
         }
     }, &job);
@@ -149,7 +147,7 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         std::uint64_t touched = 0;
         for (std::size_t c = 0; c < j.chunk_count; ++c) {
             const Chunk& chunk = b.chunks_[c];
-            for (std::uint32_t index : chunk.bins[band]) touched += detail::rasterize_triangle(target, chunk.triangles[index]);
+            for (const detail::ScreenTriangle& tri : chunk.bins[band]) touched += detail::rasterize_triangle(target, tri);
         }
         b.band_touched_[band] = touched;
     }, &job);
