@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job, end to end on a scene the project generates: installs the dependencies,
-# builds, generates a city, walks through it, and computes exact per-object visibility
-# (Embree ground truth) along the walk. Prints what it found and where its output went.
+# builds, generates a city, walks through it, computes exact per-object visibility (Embree
+# ground truth) along the walk, and culls with the occlusion buffer, counting its false and
+# missed culls against that truth. Prints what it found and where its output went.
 # Usage: scripts/demo.sh [output folder]   (default: out/demo)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,8 +33,16 @@ echo "== frame 60 in detail"
   | head -16
 
 echo
+echo "== occlusion culling along the walk: the occlusion buffer's answers for every object's box"
+echo "   against the exact visibility above (1280x720 display, 320x180 buffer with 4x4 samples)"
+"$homcull" accuracy --scene "$out/city.glb" --path "$out/city_walk.json" --resolution 1280x720 --samples 4 2>/dev/null
+"$homcull" accuracy --scene "$out/city.glb" --path "$out/city_walk.json" --resolution 1280x720 --samples 4 --json \
+  > "$out/culling_accuracy.json" 2>/dev/null
+
+echo
 echo "== output in $out/"
 echo "   city.glb                the generated scene (binary glTF; open it in any glTF viewer)"
 echo "   city_walk.json          the camera path (DESIGN.md path format)"
 echo "   frame*_ids.png          the object seen by every sample, one colour per object"
 echo "   frame60_truth.json      per-object results for frame 60 (homcull truth --json)"
+echo "   culling_accuracy.json   false culls, missed culls and culling efficiency along the walk"
