@@ -44,8 +44,8 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     subtiles_y_ = (sample_height_ + kH - 1) / kH;
     subtiles_.assign(std::size_t(subtiles_x_) * std::size_t(subtiles_y_), Subtile{});
     band_touched_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
-    levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: the subtiles themselves
-    std::size_t size = 0;
+    levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
+    std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
     while (levels_.back().width > 1 || levels_.back().height > 1) {
         const Level& below = levels_.back();
         levels_.push_back({(below.width + 1) / 2, (below.height + 1) / 2, size});
@@ -60,13 +60,13 @@ void OcclusionBuffer::clear() {
     stats_ = RasterStats{};
 }
 
-float OcclusionBuffer::min_d0(int level, int x, int y) const {
-    if (level == 0) return subtiles_[std::size_t(y) * std::size_t(subtiles_x_) + std::size_t(x)].d0;
+inline float OcclusionBuffer::min_d0(int level, int x, int y) const {
     const Level& l = levels_[std::size_t(level)];
     return pyramid_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)];
 }
 
 void OcclusionBuffer::build_pyramid() {
+    for (std::size_t i = 0; i < subtiles_.size(); ++i) pyramid_[i] = subtiles_[i].d0;
     for (std::size_t level = 1; level < levels_.size(); ++level) {
         const Level& below = levels_[level - 1];
         const Level& here = levels_[level];
@@ -84,6 +84,15 @@ void OcclusionBuffer::build_pyramid() {
 }
 
 namespace {
+
+// std::nextafter(f, +infinity) for a non-negative finite float, without a libm call.
+float next_float_up(float f) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    ++bits;
+    std::memcpy(&f, &bits, sizeof bits);
+    return f;
+}
 
 void run_tasks(const ParallelFor& parallel, std::size_t count, void (*task)(void*, std::size_t), void* data) {
     if (parallel.run) parallel.run(parallel.user, count, task, data);
@@ -196,7 +205,7 @@ bool OcclusionBuffer::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x,
     // Nearest 1/w of the occludee, rounded up and raised by a relative 2^-20.
     const double d = 1.0 / double(w_min);
     q.d_near = float(d);
-    if (double(q.d_near) < d) q.d_near = std::nextafter(q.d_near, std::numeric_limits<float>::infinity());
+    if (double(q.d_near) < d) q.d_near = next_float_up(q.d_near);
     q.d_near *= 1.0f + 0x1.0p-20f;
     return true;
 }
@@ -254,6 +263,13 @@ Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float nd
     for (int y = ty0 >> level; y <= ty1 >> level; ++y)
         for (int x = tx0 >> level; x <= tx1 >> level; ++x) coarse = std::min(coarse, min_d0(level, x, y));
     if (q.d_near < coarse) return Visibility::occluded;
+    // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound
+    // (>= d0) is above d_near and the rectangle is hidden. Most hidden rectangles end here.
+    bool any_at_or_behind = false;
+    for (int y = ty0 >> level; y <= ty1 >> level && !any_at_or_behind; ++y)
+        for (int x = tx0 >> level; x <= tx1 >> level && !any_at_or_behind; ++x)
+            any_at_or_behind = any_farther_or_equal(level, x, y, tx0, ty0, tx1, ty1, q.d_near);
+    if (!any_at_or_behind) return Visibility::occluded;
 
     // Interior subtiles (all their samples in the rectangle): their bound is d0, so the
     // rectangle is visible there iff some d0 <= d_near. Border subtiles: the exact test.

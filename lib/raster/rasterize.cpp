@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace homcull::detail {
 namespace {
@@ -34,7 +35,12 @@ inline int ceil_int(double x) {
 // Round a positive double down to float, then lower it by a relative 2^-20.
 float conservative_far(double d) {
     float f = float(d);
-    if (double(f) > d) f = std::nextafter(f, 0.0f);
+    if (double(f) > d) {  // one float step towards zero (f > 0 here): the bits minus one
+        std::uint32_t bits;
+        std::memcpy(&bits, &f, sizeof bits);
+        --bits;
+        std::memcpy(&f, &bits, sizeof bits);
+    }
     return f * (1.0f - 0x1.0p-20f);
 }
 
