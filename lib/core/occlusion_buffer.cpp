@@ -152,7 +152,7 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         const int row_begin = int(band) * kBandSubtileRows;
         const detail::RasterTarget target{b.subtiles_.data(), b.subtiles_x_, b.subtiles_y_, b.sample_width_, b.sample_height_,
                                           b.config_.edge_margin, row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_),
-                                          detail::selected_subtile_row_kernel()};
+                                          detail::selected_rows_kernel()};
         std::uint64_t touched = 0;
         for (std::size_t c = 0; c < j.chunk_count; ++c) {
             const Chunk& chunk = b.chunks_[c];

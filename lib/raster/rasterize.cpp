@@ -69,12 +69,7 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
     }
     const glm::dvec2 v[3] = {p0, p1, p2};
 
-    // Edge k: E(P) = sa (P.x - o.x) + sb (P.y - o.y), positive inside.
-    struct Edge {
-        glm::dvec2 origin;
-        double sa, sb, inverse_sa, threshold;
-        bool shared;
-    } edges[3];
+    TriangleEdges edges;
     for (int k = 0; k < 3; ++k) {
         const glm::dvec2& from = v[k];
         const glm::dvec2& to = v[(k + 1) % 3];
@@ -82,13 +77,13 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
         const glm::dvec2& lo = forward ? from : to;
         const glm::dvec2& hi = forward ? to : from;
         const double a = -(hi.y - lo.y), b = hi.x - lo.x, sign = forward ? 1.0 : -1.0;
-        Edge& e = edges[k];
-        e.origin = lo;
-        e.sa = sign * a;
-        e.sb = sign * b;
-        e.inverse_sa = e.sa != 0.0 ? 1.0 / e.sa : 0.0;
-        e.shared = shared[k];
-        e.threshold = shared[k] ? 0.0 : t.edge_margin * (std::abs(a) + std::abs(b));
+        edges.ox[k] = lo.x;
+        edges.oy[k] = lo.y;
+        edges.sa[k] = sign * a;
+        edges.sb[k] = sign * b;
+        edges.inverse_sa[k] = edges.sa[k] != 0.0 ? 1.0 / edges.sa[k] : 0.0;
+        edges.shared[k] = shared[k];
+        edges.threshold[k] = shared[k] ? 0.0 : t.edge_margin * (std::abs(a) + std::abs(b));
     }
 
     // Sample rows and columns whose centres lie in the triangle's bounding box.
@@ -107,6 +102,11 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
     prepared.dzdy = ((z2 - z0) * (p1.x - p0.x) - (z1 - z0) * (p2.x - p0.x)) / area2;
     prepared.z_vertex_min = std::min({z0, z1, z2});
 
+    return t.kernel(t, edges, prepared, i0, i1, j0, j1);
+}
+
+std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdges& edges, const PreparedTriangle& prepared, int i0,
+                                       int i1, int j0, int j1) {
     std::uint64_t touched = 0;
     const int tx0 = i0 / kW, tx1 = i1 / kW;
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
@@ -121,18 +121,18 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
                 continue;
             }
             const double py = sy + 0.5;
-            for (const Edge& e : edges) {
-                const double c = e.threshold - e.sb * (py - e.origin.y);  // need sa * (x - o.x) > c
-                if (e.sa == 0.0) {
-                    if (e.shared ? !(0.0 >= c) : !(0.0 > c)) last[j] = first[j] - 1;
+            for (int k = 0; k < 3; ++k) {
+                const double c = edges.threshold[k] - edges.sb[k] * (py - edges.oy[k]);  // need sa * (x - o.x) > c
+                if (edges.sa[k] == 0.0) {
+                    if (edges.shared[k] ? !(0.0 >= c) : !(0.0 > c)) last[j] = first[j] - 1;
                     continue;
                 }
-                const double x = e.origin.x + c * e.inverse_sa;  // boundary, in samples
+                const double x = edges.ox[k] + c * edges.inverse_sa[k];  // boundary, in samples
                 // The boundary may lie far outside the buffer for a nearly horizontal edge: clamp
                 // before converting to int (the interval is clamped to [i0, i1] anyway).
                 const double xs = std::clamp(x - 0.5, double(i0) - 2.0, double(i1) + 2.0);
-                if (e.sa > 0.0) first[j] = std::max(first[j], e.shared ? ceil_int(xs) : floor_int(xs) + 1);
-                else last[j] = std::min(last[j], e.shared ? floor_int(xs) : ceil_int(xs) - 1);
+                if (edges.sa[k] > 0.0) first[j] = std::max(first[j], edges.shared[k] ? ceil_int(xs) : floor_int(xs) + 1);
+                else last[j] = std::min(last[j], edges.shared[k] ? floor_int(xs) : ceil_int(xs) - 1);
             }
         }
         // Only the subtile columns the row intervals reach.
@@ -144,8 +144,8 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
             }
         if (reach_lo > reach_hi) continue;
         const int tx_begin = std::max(tx0, reach_lo / kW), tx_end = std::min(tx1, reach_hi / kW);
-        touched += t.kernel(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end, first, last, prepared,
-                            t.subtiles_x, t.subtiles_y, t.sample_width, t.sample_height);
+        touched += update_subtile_row_reference(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end,
+                                                first, last, prepared, t.subtiles_x, t.subtiles_y, t.sample_width, t.sample_height);
     }
     return touched;
 }

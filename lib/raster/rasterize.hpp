@@ -15,12 +15,14 @@ struct ScreenTriangle {
 };
 
 struct PreparedTriangle;
+struct TriangleEdges;
+struct RasterTarget;
 
-// Updates the subtiles (tx_begin..tx_end, ty) from the row intervals [first[j], last[j]] of
-// the subtile row's four sample rows. Returns the number of subtiles updated.
-using SubtileRowKernel = std::uint64_t (*)(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const int first[4],
-                                           const int last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
-                                           int sample_width, int sample_height);
+// Rasterizes the rows of a prepared triangle: for each subtile row in the target's band and
+// the triangle's sample rows [j0, j1], the coverage interval of each sample row (within
+// columns [i0, i1]), then the subtile-row update. Returns the number of subtiles updated.
+using TriangleRowsKernel = std::uint64_t (*)(const RasterTarget& target, const TriangleEdges& edges, const PreparedTriangle& tri,
+                                             int i0, int i1, int j0, int j1);
 
 struct RasterTarget {
     OcclusionBuffer::Subtile* subtiles;
@@ -28,7 +30,15 @@ struct RasterTarget {
     int sample_width, sample_height;
     double edge_margin;
     int row_begin, row_end;  // the subtile rows [row_begin, row_end) this call may write
-    SubtileRowKernel kernel;
+    TriangleRowsKernel kernel;
+};
+
+// The three edge functions of a triangle oriented positive inside: for edge k,
+// E(P) = sa (P.x - ox) + sb (P.y - oy), (ox, oy) its lower endpoint (by y, then x); covered
+// samples have E > threshold, or E >= 0 on a shared edge (threshold 0).
+struct TriangleEdges {
+    double ox[3], oy[3], sa[3], sb[3], inverse_sa[3], threshold[3];
+    bool shared[3];
 };
 
 // What the subtile-row kernels need of a triangle: its depth plane
@@ -40,7 +50,9 @@ struct PreparedTriangle {
 // Rasterizes a triangle of either orientation. Returns the number of subtiles updated.
 std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangle& triangle);
 
-// The scalar reference kernel.
+// The scalar reference of the subtile-row update: the subtiles (tx_begin..tx_end, ty) from the
+// row intervals [first[j], last[j]] of the subtile row's four sample rows. Returns the number
+// of subtiles updated.
 std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const int first[4],
                                            const int last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
                                            int sample_width, int sample_height);
@@ -49,7 +61,11 @@ std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty
 // subtiles may be partly outside the sample grid).
 std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_height);
 
+// The reference row loop: scalar intervals and update_subtile_row_reference.
+std::uint64_t rasterize_rows_reference(const RasterTarget& target, const TriangleEdges& edges, const PreparedTriangle& tri, int i0,
+                                       int i1, int j0, int j1);
+
 // The kernel for the selected instruction set (see select_isa in occlusion_buffer.hpp).
-SubtileRowKernel selected_subtile_row_kernel();
+TriangleRowsKernel selected_rows_kernel();
 
 }  // namespace homcull::detail

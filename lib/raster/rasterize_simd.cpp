@@ -1,6 +1,7 @@
-// SIMD kernels of the subtile-row update, compiled once per instruction set with Google
-// Highway and chosen at run time. Each lane is one subtile and computes exactly what
-// update_subtile_row_reference computes for it: the same double and float operations in the
+// SIMD kernels of the row loop (coverage intervals of a subtile row's 4 sample rows as lanes)
+// and of the subtile-row update (subtiles as lanes), compiled once per instruction set with
+// Google Highway and chosen at run time. Each lane computes exactly what the reference
+// (rasterize_rows_reference, update_subtile_row_reference) computes for it: the same double and float operations in the
 // same order (no fused multiply-add), so every target gives the reference's bits. Subtiles go
 // in blocks of as many lanes as a double vector has (2 on SSE4, 4 on AVX2, 8 on AVX-512), with
 // the int32 and float vectors rebound to that lane count.
@@ -19,7 +20,8 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const int first[4], const int last[4],
+std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
+                               const std::int32_t last[4],
                                const PreparedTriangle& tri, int subtiles_x, int subtiles_y, int sample_width, int sample_height) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     const hn::ScalableTag<double> dd;
@@ -124,6 +126,55 @@ std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_beg
     return touched;
 }
 
+// The reference's row loop with the 4 sample rows of a subtile row as vector lanes (2 at a
+// time on SSE4): each lane evaluates rasterize_rows_reference's formula for its row.
+std::uint64_t RasterizeRows(const RasterTarget& t, const TriangleEdges& e, const PreparedTriangle& tri, int i0, int i1, int j0,
+                            int j1) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const hn::CappedTag<double, kH> d4;
+    const hn::Rebind<std::int32_t, decltype(d4)> di4;
+    const int lanes = int(hn::Lanes(d4));
+    const auto lo_clamp = hn::Set(d4, double(i0) - 2.0), hi_clamp = hn::Set(d4, double(i1) + 2.0);
+    const auto half = hn::Set(d4, 0.5), one = hn::Set(d4, 1.0), zero = hn::Zero(d4);
+    const int tx0 = i0 / kW, tx1 = i1 / kW;
+    std::uint64_t touched = 0;
+    for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
+        HWY_ALIGN std::int32_t first[kH], last[kH];
+        for (int j = 0; j < kH; j += lanes) {
+            const auto sy = hn::Iota(d4, double(ty * kH + j));
+            const auto py = hn::Add(sy, half);
+            auto lo = hn::Set(d4, double(i0)), hi = hn::Set(d4, double(i1));
+            auto empty = hn::Or(hn::Lt(sy, hn::Set(d4, double(j0))), hn::Gt(sy, hn::Set(d4, double(j1))));
+            for (int k = 0; k < 3; ++k) {
+                const auto c = hn::Sub(hn::Set(d4, e.threshold[k]), hn::Mul(hn::Set(d4, e.sb[k]), hn::Sub(py, hn::Set(d4, e.oy[k]))));
+                if (e.sa[k] == 0.0) {
+                    empty = hn::Or(empty, e.shared[k] ? hn::Gt(c, zero) : hn::Ge(c, zero));
+                    continue;
+                }
+                const auto x = hn::Add(hn::Set(d4, e.ox[k]), hn::Mul(c, hn::Set(d4, e.inverse_sa[k])));
+                const auto v = hn::Sub(x, half);
+                const auto xs = hn::IfThenElse(hn::Lt(v, lo_clamp), lo_clamp, hn::IfThenElse(hn::Lt(hi_clamp, v), hi_clamp, v));
+                if (e.sa[k] > 0.0) lo = hn::Max(lo, e.shared[k] ? hn::Ceil(xs) : hn::Add(hn::Floor(xs), one));
+                else hi = hn::Min(hi, e.shared[k] ? hn::Floor(xs) : hn::Sub(hn::Ceil(xs), one));
+            }
+            hi = hn::IfThenElse(empty, hn::Sub(lo, one), hi);
+            hn::Store(hn::DemoteTo(di4, lo), di4, first + j);
+            hn::Store(hn::DemoteTo(di4, hi), di4, last + j);
+        }
+        int reach_lo = i1 + 1, reach_hi = i0 - 1;
+        for (int j = 0; j < kH; ++j)
+            if (first[j] <= last[j]) {
+                reach_lo = std::min(reach_lo, first[j]);
+                reach_hi = std::max(reach_hi, last[j]);
+            }
+        if (reach_lo > reach_hi) continue;
+        const int tx_begin = std::max(tx0, reach_lo / kW), tx_end = std::min(tx1, reach_hi / kW);
+        touched += UpdateSubtileRow(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end, first, last, tri,
+                                    t.subtiles_x, t.subtiles_y, t.sample_width, t.sample_height);
+    }
+    return touched;
+}
+
 }  // namespace homcull::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -136,17 +187,15 @@ HWY_AFTER_NAMESPACE();
 namespace homcull {
 namespace detail {
 
-HWY_EXPORT(UpdateSubtileRow);
+HWY_EXPORT(RasterizeRows);
 
 namespace {
 
 // The selected kernel: the reference, or Highway's choice among the allowed targets.
 std::atomic<bool> use_reference{false};
 
-std::uint64_t dispatch(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const int first[4], const int last[4],
-                       const PreparedTriangle& tri, int subtiles_x, int subtiles_y, int sample_width, int sample_height) {
-    return HWY_DYNAMIC_DISPATCH(UpdateSubtileRow)(row, ty, tx_begin, tx_end, first, last, tri, subtiles_x, subtiles_y,
-                                                  sample_width, sample_height);
+std::uint64_t dispatch(const RasterTarget& t, const TriangleEdges& e, const PreparedTriangle& tri, int i0, int i1, int j0, int j1) {
+    return HWY_DYNAMIC_DISPATCH(RasterizeRows)(t, e, tri, i0, i1, j0, j1);
 }
 
 struct NamedTarget {
@@ -157,7 +206,7 @@ const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4
 
 }  // namespace
 
-SubtileRowKernel selected_subtile_row_kernel() { return use_reference ? &update_subtile_row_reference : &dispatch; }
+TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_rows_reference : &dispatch; }
 
 }  // namespace detail
 
