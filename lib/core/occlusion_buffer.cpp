@@ -136,8 +136,8 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
                 const detail::ScreenTriangle& tri = setup.triangles[k];
                 const double min_y = std::min({tri.p[0].y, tri.p[1].y, tri.p[2].y});
                 const double max_y = std::max({tri.p[0].y, tri.p[1].y, tri.p[2].y});
-                const int j0 = std::max(0, int(std::ceil(min_y - 0.5)));
-                const int j1 = std::min(b.sample_height_ - 1, int(std::floor(max_y - 0.5)));
+                int j0, j1;
+                detail::sample_span(min_y, max_y, b.sample_height_, j0, j1);
                 if (j0 > j1) continue;
                 for (int band = j0 / (kH * kBandSubtileRows); band <= j1 / (kH * kBandSubtileRows); ++band)
                     chunk.bins[std::size_t(band)].push_back(tri);
@@ -194,10 +194,8 @@ bool OcclusionBuffer::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x,
     // The samples whose centres lie in the rectangle.
     const double sx0 = (double(ndc_min_x) + 1.0) * 0.5 * sample_width_, sx1 = (double(ndc_max_x) + 1.0) * 0.5 * sample_width_;
     const double sy0 = (1.0 - double(ndc_max_y)) * 0.5 * sample_height_, sy1 = (1.0 - double(ndc_min_y)) * 0.5 * sample_height_;
-    q.i0 = std::max(0, int(std::ceil(sx0 - 0.5)));
-    q.i1 = std::min(sample_width_ - 1, int(std::floor(sx1 - 0.5)));
-    q.j0 = std::max(0, int(std::ceil(sy0 - 0.5)));
-    q.j1 = std::min(sample_height_ - 1, int(std::floor(sy1 - 0.5)));
+    detail::sample_span(sx0, sx1, sample_width_, q.i0, q.i1);
+    detail::sample_span(sy0, sy1, sample_height_, q.j0, q.j1);
     if (q.i0 > q.i1 || q.j0 > q.j1) {
         decided = Visibility::occluded;  // covers no sample: invisible at every sample
         return false;

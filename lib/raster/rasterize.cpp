@@ -89,8 +89,9 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
     // Sample rows and columns whose centres lie in the triangle's bounding box.
     const double min_x = std::min({p0.x, p1.x, p2.x}), max_x = std::max({p0.x, p1.x, p2.x});
     const double min_y = std::min({p0.y, p1.y, p2.y}), max_y = std::max({p0.y, p1.y, p2.y});
-    const int i0 = std::max(0, int(std::ceil(min_x - 0.5))), i1 = std::min(t.sample_width - 1, int(std::floor(max_x - 0.5)));
-    const int j0 = std::max(0, int(std::ceil(min_y - 0.5))), j1 = std::min(t.sample_height - 1, int(std::floor(max_y - 0.5)));
+    int i0, i1, j0, j1;
+    sample_span(min_x, max_x, t.sample_width, i0, i1);
+    sample_span(min_y, max_y, t.sample_height, j0, j1);
     if (i0 > i1 || j0 > j1) return 0;
 
     // Depth plane d(P) = z0 + dzdx (P.x - p0.x) + dzdy (P.y - p0.y).
@@ -108,10 +109,9 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
 std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdges& edges, const PreparedTriangle& prepared, int i0,
                                        int i1, int j0, int j1) {
     std::uint64_t touched = 0;
-    const int tx0 = i0 / kW, tx1 = i1 / kW;
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         // The covered interval [first, last] of each of the subtile row's sample rows.
-        int first[kH], last[kH];
+        std::int32_t first[kH], last[kH];
         for (int j = 0; j < kH; ++j) {
             const int sy = ty * kH + j;
             first[j] = i0;
@@ -135,23 +135,16 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdge
                 else last[j] = std::min(last[j], edges.shared[k] ? floor_int(xs) : ceil_int(xs) - 1);
             }
         }
-        // Only the subtile columns the row intervals reach.
-        int reach_lo = i1 + 1, reach_hi = i0 - 1;
-        for (int j = 0; j < kH; ++j)
-            if (first[j] <= last[j]) {
-                reach_lo = std::min(reach_lo, first[j]);
-                reach_hi = std::max(reach_hi, last[j]);
-            }
-        if (reach_lo > reach_hi) continue;
-        const int tx_begin = std::max(tx0, reach_lo / kW), tx_end = std::min(tx1, reach_hi / kW);
+        int tx_begin, tx_end;
+        if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         touched += update_subtile_row_reference(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end,
                                                 first, last, prepared, t.subtiles_x, t.subtiles_y, t.sample_width, t.sample_height);
     }
     return touched;
 }
 
-std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const int first[4],
-                                           const int last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
+std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end,
+                                           const std::int32_t first[4], const std::int32_t last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
                                            int sample_width, int sample_height) {
     std::uint64_t touched = 0;
     const std::uint32_t full_row = ty + 1 < subtiles_y ? 0xFFFFFFFFu : 0u;  // see valid_sample_mask

@@ -5,6 +5,10 @@
 // (rasterize_simd.cpp) that must give the same bits.
 #include <homcull/occlusion_buffer.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
 namespace homcull::detail {
 
 // A triangle in sample space (x right, y down, in samples) with depth d = 1/w per vertex.
@@ -53,9 +57,34 @@ std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangl
 // The scalar reference of the subtile-row update: the subtiles (tx_begin..tx_end, ty) from the
 // row intervals [first[j], last[j]] of the subtile row's four sample rows. Returns the number
 // of subtiles updated.
-std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const int first[4],
-                                           const int last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
+std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end,
+                                           const std::int32_t first[4], const std::int32_t last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
                                            int sample_width, int sample_height);
+
+// The samples of a grid of `count` whose centres (i + 0.5) lie in [lo, hi]: [first, last],
+// empty when first > last. The one rule for what a span of the screen covers, used by the
+// triangle bounding box, the binning and the rectangle tests.
+inline void sample_span(double lo, double hi, int count, int& first, int& last) {
+    first = std::max(0, int(std::ceil(lo - 0.5)));
+    last = std::min(count - 1, int(std::floor(hi - 0.5)));
+}
+
+// The subtile columns [tx_begin, tx_end] that a subtile row's sample-row intervals
+// [first[j], last[j]] reach, within the triangle's columns [i0, i1]; false when none.
+inline bool reached_subtile_columns(const std::int32_t first[4], const std::int32_t last[4], int i0, int i1, int& tx_begin,
+                                    int& tx_end) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth;
+    int reach_lo = i1 + 1, reach_hi = i0 - 1;
+    for (int j = 0; j < OcclusionBuffer::kSubtileHeight; ++j)
+        if (first[j] <= last[j]) {
+            reach_lo = std::min(reach_lo, int(first[j]));
+            reach_hi = std::max(reach_hi, int(last[j]));
+        }
+    if (reach_lo > reach_hi) return false;
+    tx_begin = std::max(i0 / kW, reach_lo / kW);
+    tx_end = std::min(i1 / kW, reach_hi / kW);
+    return true;
+}
 
 // The mask of the samples of subtile (tx, ty) that exist (the buffer's right and bottom
 // subtiles may be partly outside the sample grid).

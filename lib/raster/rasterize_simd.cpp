@@ -20,11 +20,12 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+constexpr int kMaxLanes = 16;  // the tail buffer below; CappedTag keeps wide (SVE) vectors within it
+
 std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
-                               const std::int32_t last[4],
-                               const PreparedTriangle& tri, int subtiles_x, int subtiles_y, int sample_width, int sample_height) {
+                               const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    const hn::ScalableTag<double> dd;
+    const hn::CappedTag<double, kMaxLanes> dd;
     const hn::Rebind<float, decltype(dd)> df;
     const hn::Rebind<std::int32_t, decltype(dd)> di;
     const hn::Rebind<std::uint32_t, decltype(dd)> du;
@@ -39,7 +40,7 @@ std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_beg
     for (int j = 0; j < rows; ++j) replicate |= 1u << (j * kW);
 
     std::uint64_t touched = 0;
-    OcclusionBuffer::Subtile tail[16];  // partial blocks at the end of the range
+    OcclusionBuffer::Subtile tail[kMaxLanes];  // partial blocks at the end of the range
     for (int tx = tx_begin; tx <= tx_end; tx += lanes) {
         const int n = std::min(lanes, tx_end - tx + 1);
         OcclusionBuffer::Subtile* block = row + tx;
@@ -121,8 +122,6 @@ std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_beg
         hn::StoreInterleaved4(d0, d1, hn::BitCast(df, mask), hn::BitCast(df, covered), df, reinterpret_cast<float*>(block));
         if (block == tail) std::memcpy(row + tx, tail, sizeof(OcclusionBuffer::Subtile) * std::size_t(n));
     }
-    (void)subtiles_x;
-    (void)subtiles_y;
     return touched;
 }
 
@@ -130,13 +129,12 @@ std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_beg
 // time on SSE4): each lane evaluates rasterize_rows_reference's formula for its row.
 std::uint64_t RasterizeRows(const RasterTarget& t, const TriangleEdges& e, const PreparedTriangle& tri, int i0, int i1, int j0,
                             int j1) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<double, kH> d4;
     const hn::Rebind<std::int32_t, decltype(d4)> di4;
     const int lanes = int(hn::Lanes(d4));
     const auto lo_clamp = hn::Set(d4, double(i0) - 2.0), hi_clamp = hn::Set(d4, double(i1) + 2.0);
     const auto half = hn::Set(d4, 0.5), one = hn::Set(d4, 1.0), zero = hn::Zero(d4);
-    const int tx0 = i0 / kW, tx1 = i1 / kW;
     std::uint64_t touched = 0;
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         HWY_ALIGN std::int32_t first[kH], last[kH];
@@ -161,16 +159,10 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const TriangleEdges& e, const
             hn::Store(hn::DemoteTo(di4, lo), di4, first + j);
             hn::Store(hn::DemoteTo(di4, hi), di4, last + j);
         }
-        int reach_lo = i1 + 1, reach_hi = i0 - 1;
-        for (int j = 0; j < kH; ++j)
-            if (first[j] <= last[j]) {
-                reach_lo = std::min(reach_lo, first[j]);
-                reach_hi = std::max(reach_hi, last[j]);
-            }
-        if (reach_lo > reach_hi) continue;
-        const int tx_begin = std::max(tx0, reach_lo / kW), tx_end = std::min(tx1, reach_hi / kW);
+        int tx_begin, tx_end;
+        if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         touched += UpdateSubtileRow(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end, first, last, tri,
-                                    t.subtiles_x, t.subtiles_y, t.sample_width, t.sample_height);
+                                    t.sample_width, t.sample_height);
     }
     return touched;
 }

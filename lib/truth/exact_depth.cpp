@@ -13,6 +13,8 @@ ExactDepth::ExactDepth(int sample_width, int sample_height)
     if (sample_width < 1 || sample_height < 1) throw Error("exact depth: the sample grid must be at least 1x1");
 }
 
+// The sample-span rule (centres in [lo, hi]) is written out here again on purpose rather than
+// shared with the rasterizer: this is the oracle, and a shared helper would hide a shared bug.
 void ExactDepth::add_triangle(const float* a, const float* b, const float* c, bool cull_clockwise) {
     const float* v[3] = {a, b, c};
     double x[3], y[3], inv_w[3];
