@@ -26,8 +26,8 @@ void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t
 }
 
 bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
-    const auto& x = a.subtiles();
-    const auto& y = b.subtiles();
+    const auto x = a.subtiles();
+    const auto y = b.subtiles();
     if (x.size() != y.size()) return false;
     for (std::size_t i = 0; i < x.size(); ++i)
         if (x[i].d0 != y[i].d0 || x[i].d1 != y[i].d1 || x[i].mask != y[i].mask || x[i].covered != y[i].covered) return false;

@@ -40,9 +40,17 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     sample_height_ = config.height * config.samples;
     if (double(sample_width_) * sample_height_ > double(1 << 28))
         throw Error("occlusion buffer: more than 2^28 samples; lower the resolution or the samples");
+    if (sample_width_ > (1 << 22) || sample_height_ > (1 << 22))  // sample coordinates stay exact in float (conservative_depth)
+        throw Error("occlusion buffer: more than 2^22 samples in a row or column; lower the resolution or the samples");
     subtiles_x_ = (sample_width_ + kW - 1) / kW;
     subtiles_y_ = (sample_height_ + kH - 1) / kH;
-    subtiles_.assign(std::size_t(subtiles_x_) * std::size_t(subtiles_y_), Subtile{});
+    stride_ = std::size_t(subtiles_x_ + detail::kMaxSimdLanes - 1 + detail::kMaxSimdLanes - 1) / detail::kMaxSimdLanes *
+              detail::kMaxSimdLanes;
+    const std::size_t plane = stride_ * std::size_t(subtiles_y_);
+    d0_.assign(plane, 0.0f);
+    d1_.assign(plane, 0.0f);
+    mask_.assign(plane, 0u);
+    covered_.assign(plane, 0u);
     band_touched_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
     std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
@@ -55,7 +63,10 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
 }
 
 void OcclusionBuffer::clear() {
-    std::fill(subtiles_.begin(), subtiles_.end(), Subtile{});
+    std::fill(d0_.begin(), d0_.end(), 0.0f);
+    std::fill(d1_.begin(), d1_.end(), 0.0f);
+    std::fill(mask_.begin(), mask_.end(), 0u);
+    std::fill(covered_.begin(), covered_.end(), 0u);
     std::fill(pyramid_.begin(), pyramid_.end(), 0.0f);
     stats_ = RasterStats{};
 }
@@ -66,7 +77,8 @@ inline float OcclusionBuffer::min_d0(int level, int x, int y) const {
 }
 
 void OcclusionBuffer::build_pyramid() {
-    for (std::size_t i = 0; i < subtiles_.size(); ++i) pyramid_[i] = subtiles_[i].d0;
+    for (int ty = 0; ty < subtiles_y_; ++ty)
+        std::copy_n(d0_.begin() + std::ptrdiff_t(at(0, ty)), subtiles_x_, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_);
     for (std::size_t level = 1; level < levels_.size(); ++level) {
         const Level& below = levels_[level - 1];
         const Level& here = levels_[level];
@@ -150,7 +162,7 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         const Job& j = *static_cast<Job*>(data);
         OcclusionBuffer& b = *j.self;
         const int row_begin = int(band) * kBandSubtileRows;
-        const detail::RasterTarget target{b.subtiles_.data(), b.subtiles_x_, b.subtiles_y_, b.sample_width_, b.sample_height_,
+        const detail::RasterTarget target{{b.d0_.data(), b.d1_.data(), b.mask_.data(), b.covered_.data(), b.stride_}, b.subtiles_x_, b.subtiles_y_, b.sample_width_, b.sample_height_,
                                           b.config_.edge_margin, row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_),
                                           detail::selected_rows_kernel()};
         std::uint64_t touched = 0;
@@ -215,8 +227,8 @@ bool OcclusionBuffer::subtile_hides(int tx, int ty, const RectQuery& q) const {
     const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
     std::uint32_t rect = 0;
     for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
-    const Subtile& s = subtiles_[std::size_t(ty) * std::size_t(subtiles_x_) + std::size_t(tx)];
-    const float bound = (s.mask != 0 && (rect & ~s.mask) == 0) ? std::max(s.d0, s.d1) : s.d0;
+    const std::size_t i = at(tx, ty);
+    const float bound = (mask_[i] != 0 && (rect & ~mask_[i]) == 0) ? std::max(d0_[i], d1_[i]) : d0_[i];
     return q.d_near < bound;
 }
 
@@ -317,11 +329,24 @@ Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_ma
     return test_rect(down(min_x), down(min_y), up(max_x), up(max_y), down(min_w));
 }
 
+OcclusionBuffer::Subtile OcclusionBuffer::subtile(int tx, int ty) const {
+    const std::size_t i = at(tx, ty);
+    return {d0_[i], d1_[i], mask_[i], covered_[i]};
+}
+
+std::vector<OcclusionBuffer::Subtile> OcclusionBuffer::subtiles() const {
+    std::vector<Subtile> all;
+    all.reserve(std::size_t(subtiles_x_) * std::size_t(subtiles_y_));
+    for (int ty = 0; ty < subtiles_y_; ++ty)
+        for (int tx = 0; tx < subtiles_x_; ++tx) all.push_back(subtile(tx, ty));
+    return all;
+}
+
 void OcclusionBuffer::read_coverage(std::vector<std::uint8_t>& covered) const {
     covered.assign(std::size_t(sample_width_) * std::size_t(sample_height_), 0);
     for (int y = 0; y < sample_height_; ++y)
         for (int x = 0; x < sample_width_; ++x) {
-            const Subtile& s = subtiles_[std::size_t(y / kH) * std::size_t(subtiles_x_) + std::size_t(x / kW)];
+            const Subtile s = subtile(x / kW, y / kH);
             covered[std::size_t(y) * std::size_t(sample_width_) + std::size_t(x)] = (s.covered >> ((y % kH) * kW + x % kW)) & 1u;
         }
 }
@@ -330,7 +355,7 @@ void OcclusionBuffer::read_depth(std::vector<float>& w) const {
     w.assign(std::size_t(sample_width_) * std::size_t(sample_height_), INFINITY);
     for (int y = 0; y < sample_height_; ++y)
         for (int x = 0; x < sample_width_; ++x) {
-            const Subtile& s = subtiles_[std::size_t(y / kH) * std::size_t(subtiles_x_) + std::size_t(x / kW)];
+            const Subtile s = subtile(x / kW, y / kH);
             const bool in_mask = (s.mask >> ((y % kH) * kW + x % kW)) & 1u;
             const float d = in_mask ? std::max(s.d0, s.d1) : s.d0;
             w[std::size_t(y) * std::size_t(sample_width_) + std::size_t(x)] = d > 0.0f ? 1.0f / d : INFINITY;

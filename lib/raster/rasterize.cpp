@@ -32,16 +32,14 @@ inline int ceil_int(double x) {
     return i + (double(i) < x);
 }
 
-// Round a positive double down to float, then lower it by a relative 2^-20.
-float conservative_far(double d) {
-    float f = float(d);
-    if (double(f) > d) {  // one float step towards zero (f > 0 here): the bits minus one
-        std::uint32_t bits;
-        std::memcpy(&bits, &f, sizeof bits);
-        --bits;
-        std::memcpy(&f, &bits, sizeof bits);
-    }
-    return f * (1.0f - 0x1.0p-20f);
+// float(v) rounded towards -infinity / +infinity.
+float float_down(double v) {
+    const float f = float(v);
+    return double(f) > v ? std::nextafter(f, -INFINITY) : f;
+}
+float float_up(double v) {
+    const float f = float(v);
+    return double(f) < v ? std::nextafter(f, INFINITY) : f;
 }
 
 }  // namespace
@@ -53,6 +51,34 @@ std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_hei
     std::uint32_t mask = 0;
     for (int j = 0; j < rows; ++j) mask |= row_bits << (j * kW);
     return mask;
+}
+
+// The plane d(X, Y) = z0 + dzdx (X - x0) + dzdy (Y - y0) through the vertices, rewritten as
+// a + dzdy Y + dzdx X and evaluated in float (conservative_depth). Its float evaluation at
+// sample centres (|X| <= width, |Y| <= height, exact in float) differs from the double plane
+// by at most 2^-24 for each of the 5 roundings (a, dzdy, dzdx, two products, two sums) times the
+// magnitudes involved, that is less than 2^-21 (|a| + |dzdx| width + |dzdy| height); the
+// subtraction of `error` rounds by less than 2^-25 of the same; `error` = 2^-20 of it covers
+// both, plus the double rounding of a (2^-40 of its terms is far more than it needs).
+PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], double area2, int width, int height) {
+    const double dzdx = ((d[1] - d[0]) * (p[2].y - p[0].y) - (d[2] - d[0]) * (p[1].y - p[0].y)) / area2;
+    const double dzdy = ((d[2] - d[0]) * (p[1].x - p[0].x) - (d[1] - d[0]) * (p[2].x - p[0].x)) / area2;
+    const double a = d[0] - dzdx * p[0].x - dzdy * p[0].y;
+    const double magnitude = std::abs(a) + std::abs(dzdx) * width + std::abs(dzdy) * height;
+    const double error = 0x1.0p-20 * magnitude + 0x1.0p-40 * (std::abs(d[0]) + std::abs(dzdx * p[0].x) + std::abs(dzdy * p[0].y));
+    PreparedTriangle tri;
+    tri.z_vertex_min = float_down(std::min({d[0], d[1], d[2]}));
+    if (std::isfinite(error) && magnitude < 0x1.0p100) {
+        tri.a = float(a);
+        tri.dzdx = float(dzdx);
+        tri.dzdy = float(dzdy);
+        tri.error = float_up(error);
+    } else {  // a plane too steep for float (a sliver seen edge-on): the farthest vertex alone
+        tri.a = tri.dzdx = tri.dzdy = tri.error = 0.0f;
+    }
+    tri.far_is_left = tri.dzdx > 0.0f;
+    tri.far_is_top = tri.dzdy > 0.0f;
+    return tri;
 }
 
 std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tri) {
@@ -94,15 +120,8 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
     sample_span(min_y, max_y, t.sample_height, j0, j1);
     if (i0 > i1 || j0 > j1) return 0;
 
-    // Depth plane d(P) = z0 + dzdx (P.x - p0.x) + dzdy (P.y - p0.y).
-    PreparedTriangle prepared;
-    prepared.x0 = p0.x;
-    prepared.y0 = p0.y;
-    prepared.z0 = z0;
-    prepared.dzdx = ((z1 - z0) * (p2.y - p0.y) - (z2 - z0) * (p1.y - p0.y)) / area2;
-    prepared.dzdy = ((z2 - z0) * (p1.x - p0.x) - (z1 - z0) * (p2.x - p0.x)) / area2;
-    prepared.z_vertex_min = std::min({z0, z1, z2});
-
+    const double depth[3] = {z0, z1, z2};
+    const PreparedTriangle prepared = prepare_depth_plane(v, depth, area2, t.sample_width, t.sample_height);
     return t.kernel(t, edges, prepared, i0, i1, j0, j1);
 }
 
@@ -137,57 +156,50 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdge
         }
         int tx_begin, tx_end;
         if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
-        touched += update_subtile_row_reference(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end,
-                                                first, last, prepared, t.subtiles_x, t.subtiles_y, t.sample_width, t.sample_height);
+        touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, first, last, prepared, t.sample_width, t.sample_height);
     }
     return touched;
 }
 
-std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end,
-                                           const std::int32_t first[4], const std::int32_t last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
-                                           int sample_width, int sample_height) {
+std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
+                                           const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
     std::uint64_t touched = 0;
-    const std::uint32_t full_row = ty + 1 < subtiles_y ? 0xFFFFFFFFu : 0u;  // see valid_sample_mask
     for (int tx = tx_begin; tx <= tx_end; ++tx) {
+        // The coverage mask, and the column and row of its bounding rectangle where the depth
+        // plane is smallest.
         std::uint32_t m = 0;
-        int col_min = kW, col_max = -1, row_min = kH, row_max = -1;
+        int far_column = tri.far_is_left ? kW : -1, far_row = kH;
         for (int j = 0; j < kH; ++j) {
             const int lo = std::max(first[j] - tx * kW, 0), hi = std::min(last[j] - tx * kW, kW - 1);
             if (lo > hi) continue;
             m |= ((0xFFu >> (kW - 1 - hi)) & (0xFFu << lo)) << (j * kW);
-            col_min = std::min(col_min, lo);
-            col_max = std::max(col_max, hi);
-            row_min = std::min(row_min, j);
-            row_max = j;
+            far_column = tri.far_is_left ? std::min(far_column, lo) : std::max(far_column, hi);
+            if (!tri.far_is_top || far_row == kH) far_row = j;
         }
         if (m == 0) continue;
         ++touched;
-        OcclusionBuffer::Subtile& s = row[tx];
-        s.covered |= m;
+        const std::size_t i = std::size_t(ty) * planes.stride + std::size_t(tx);
+        planes.covered[i] |= m;
 
-        // Lower bound of 1/w over the covered samples: the plane at the corner of their
-        // bounding rectangle where it is smallest, and never below the farthest vertex.
-        const double x_far = (tri.dzdx > 0.0 ? tx * kW + col_min : tx * kW + col_max) + 0.5;
-        const double y_far = (tri.dzdy > 0.0 ? ty * kH + row_min : ty * kH + row_max) + 0.5;
-        const double plane_min = tri.z0 + tri.dzdx * (x_far - tri.x0) + tri.dzdy * (y_far - tri.y0);
-        const double bound = std::max(plane_min, tri.z_vertex_min);
-        if (!(bound > 0.0)) continue;
-        const float d_tri = conservative_far(bound);
-        if (!(d_tri > s.d0)) continue;  // behind what is already known: nothing to add
+        const float d_tri = conservative_depth(tri, tx * kW + far_column, ty * kH + far_row);
+        float d0 = planes.d0[i], d1 = planes.d1[i];
+        std::uint32_t mask = planes.mask[i];
+        if (!(d_tri > d0)) continue;  // behind what is already known (or no bound): nothing to add
 
         // Quick mask: drop the working layer when the triangle is farther in front of it than
         // it is in front of the reference layer (d_tri - d1 > d1 - d0), then merge, and
         // promote a full layer to the reference.
-        if (s.mask != 0 && 2.0f * s.d1 - (d_tri + s.d0) < 0.0f) s.mask = 0;
-        s.d1 = s.mask == 0 ? d_tri : std::min(s.d1, d_tri);
-        s.mask |= m;
-        const std::uint32_t full =
-            (full_row && tx + 1 < subtiles_x) ? 0xFFFFFFFFu : valid_sample_mask(tx, ty, sample_width, sample_height);
-        if (s.mask == full) {
-            s.d0 = s.d1;
-            s.mask = 0;
-            s.d1 = 0.0f;
+        if (mask != 0 && 2.0f * d1 - (d_tri + d0) < 0.0f) mask = 0;
+        d1 = mask == 0 ? d_tri : std::min(d1, d_tri);
+        mask |= m;
+        if (mask == valid_sample_mask(tx, ty, sample_width, sample_height)) {
+            d0 = d1;
+            mask = 0;
+            d1 = 0.0f;
         }
+        planes.d0[i] = d0;
+        planes.d1[i] = d1;
+        planes.mask[i] = mask;
     }
     return touched;
 }

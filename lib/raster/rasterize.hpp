@@ -28,8 +28,21 @@ struct RasterTarget;
 using TriangleRowsKernel = std::uint64_t (*)(const RasterTarget& target, const TriangleEdges& edges, const PreparedTriangle& tri,
                                              int i0, int i1, int j0, int j1);
 
+// The widest SIMD vector the kernels use, in 32-bit lanes: subtile rows are padded so that a
+// vector of this many subtiles loads and stores within the row (see OcclusionBuffer::stride_).
+constexpr int kMaxSimdLanes = 16;
+
+// The buffer's subtile planes (OcclusionBuffer's layout): element (tx, ty) at ty * stride + tx.
+struct SubtilePlanes {
+    float* d0;
+    float* d1;
+    std::uint32_t* mask;
+    std::uint32_t* covered;
+    std::size_t stride;
+};
+
 struct RasterTarget {
-    OcclusionBuffer::Subtile* subtiles;
+    SubtilePlanes planes;
     int subtiles_x, subtiles_y;
     int sample_width, sample_height;
     double edge_margin;
@@ -45,11 +58,31 @@ struct TriangleEdges {
     bool shared[3];
 };
 
-// What the subtile-row kernels need of a triangle: its depth plane
-// d(P) = z0 + dzdx (P.x - x0) + dzdy (P.y - y0) and its smallest vertex depth.
+// What the subtile-row kernels need of a triangle: its depth plane in float,
+//     d(X, Y) ~ (a + dzdy * Y) + dzdx * X,
+// evaluated at sample centres with exactly these float operations, an amount `error` that
+// the float evaluation never exceeds, and its smallest vertex depth rounded down. See
+// prepare_depth_plane.
 struct PreparedTriangle {
-    double x0, y0, z0, dzdx, dzdy, z_vertex_min;
+    float a, dzdx, dzdy, error, z_vertex_min;
+    bool far_is_left, far_is_top;  // where the plane is smallest: towards lower X, lower Y
 };
+
+// The depth plane of a triangle with vertices p[k] and depths d[k] (counter-clockwise,
+// twice its area `area2` > 0), for a sample grid of width x height.
+PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], double area2, int width, int height);
+
+// The conservative depth a triangle enters a subtile with, given the column and row (in
+// samples) of the covered samples' corner where the plane is smallest: the plane lowered by
+// its error bound, never below the farthest vertex, lowered by a relative 2^-20, as float.
+// Values <= 0 mean "no bound": the subtile's depth is left alone. The SIMD kernels evaluate
+// the same operations lane by lane.
+inline float conservative_depth(const PreparedTriangle& tri, int column, int row) {
+    const float x = float(column) + 0.5f, y = float(row) + 0.5f;  // exact: |column|, |row| < 2^23
+    const float plane = (tri.a + tri.dzdy * y) + tri.dzdx * x;
+    const float bound = std::max(plane - tri.error, tri.z_vertex_min);
+    return bound * (1.0f - 0x1.0p-20f);
+}
 
 // Rasterizes a triangle of either orientation. Returns the number of subtiles updated.
 std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangle& triangle);
@@ -57,9 +90,8 @@ std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangl
 // The scalar reference of the subtile-row update: the subtiles (tx_begin..tx_end, ty) from the
 // row intervals [first[j], last[j]] of the subtile row's four sample rows. Returns the number
 // of subtiles updated.
-std::uint64_t update_subtile_row_reference(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end,
-                                           const std::int32_t first[4], const std::int32_t last[4], const PreparedTriangle& tri, int subtiles_x, int subtiles_y,
-                                           int sample_width, int sample_height);
+std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
+                                           const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height);
 
 // The samples of a grid of `count` whose centres (i + 0.5) lie in [lo, hi]: [first, last],
 // empty when first > last. The one rule for what a span of the screen covers, used by the

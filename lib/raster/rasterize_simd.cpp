@@ -1,10 +1,9 @@
 // SIMD kernels of the row loop (coverage intervals of a subtile row's 4 sample rows as lanes)
-// and of the subtile-row update (subtiles as lanes), compiled once per instruction set with
-// Google Highway and chosen at run time. Each lane computes exactly what the reference
-// (rasterize_rows_reference, update_subtile_row_reference) computes for it: the same double and float operations in the
-// same order (no fused multiply-add), so every target gives the reference's bits. Subtiles go
-// in blocks of as many lanes as a double vector has (2 on SSE4, 4 on AVX2, 8 on AVX-512), with
-// the int32 and float vectors rebound to that lane count.
+// and of the subtile-row update (subtiles as lanes, 4 on SSE4, 8 on AVX2, 16 on AVX-512),
+// compiled once per instruction set with Google Highway and chosen at run time. Each lane
+// computes exactly what the reference (rasterize_rows_reference, update_subtile_row_reference)
+// computes for it: the same double and float operations in the same order (no fused
+// multiply-add), so every target gives the reference's bits.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/rasterize_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -14,113 +13,101 @@
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
-#include <cstring>
 
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-constexpr int kMaxLanes = 16;  // the tail buffer below; CappedTag keeps wide (SVE) vectors within it
-
-std::uint64_t UpdateSubtileRow(OcclusionBuffer::Subtile* row, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
+// The subtiles tx..tx + lanes - 1 of a row as vector lanes, float and 32-bit integer, at most
+// kMaxSimdLanes (wider vectors, as SVE may have, are capped: the rows are padded for that many).
+std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    const hn::CappedTag<double, kMaxLanes> dd;
-    const hn::Rebind<float, decltype(dd)> df;
-    const hn::Rebind<std::int32_t, decltype(dd)> di;
-    const hn::Rebind<std::uint32_t, decltype(dd)> du;
-    const int lanes = int(hn::Lanes(dd));
+    const hn::CappedTag<float, kMaxSimdLanes> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::RebindToUnsigned<decltype(df)> du;
+    const int lanes = int(hn::Lanes(df));
     using VI = hn::Vec<decltype(di)>;
     using VU = hn::Vec<decltype(du)>;
+    using VF = hn::Vec<decltype(df)>;
 
-    // The valid-sample mask of this subtile row's subtiles: all ones but in the last column
-    // and the last row of subtiles (see valid_sample_mask).
+    // The valid-sample mask of this row's subtiles (see valid_sample_mask): all ones except in
+    // the last column and the last row of subtiles, as (row bits of the lane's columns) x
+    // (one bit per existing row).
     const int rows = std::min(kH, sample_height - ty * kH);
     std::uint32_t replicate = 0;
     for (int j = 0; j < rows; ++j) replicate |= 1u << (j * kW);
 
+    // Per sample row j: its interval as lane-independent values.
+    VI first_v[kH], last_v[kH];
+    for (int j = 0; j < kH; ++j) {
+        first_v[j] = hn::Set(di, first[j]);
+        last_v[j] = hn::Set(di, last[j]);
+    }
+    const VI zero_i = hn::Zero(di), seven = hn::Set(di, kW - 1), eight = hn::Set(di, kW);
+    const VU byte = hn::Set(du, 0xFFu);
+    const VF a = hn::Set(df, tri.a), dzdx = hn::Set(df, tri.dzdx), dzdy = hn::Set(df, tri.dzdy), error = hn::Set(df, tri.error);
+    const VF z_vertex_min = hn::Set(df, tri.z_vertex_min), half = hn::Set(df, 0.5f), lower = hn::Set(df, 1.0f - 0x1.0p-20f);
+
     std::uint64_t touched = 0;
-    OcclusionBuffer::Subtile tail[kMaxLanes];  // partial blocks at the end of the range
+    const std::size_t row = std::size_t(ty) * planes.stride;
     for (int tx = tx_begin; tx <= tx_end; tx += lanes) {
-        const int n = std::min(lanes, tx_end - tx + 1);
-        OcclusionBuffer::Subtile* block = row + tx;
-        if (n < lanes) {
-            std::memcpy(tail, block, sizeof(OcclusionBuffer::Subtile) * std::size_t(n));
-            block = tail;
-        }
         const VI column0 = hn::ShiftLeft<3>(hn::Iota(di, tx));  // tx * 8 per lane
 
-        // Masks and the bounding rectangle of the covered samples, as the reference.
+        // Mask and far corner, as the reference (lanes past tx_end get empty masks).
         VU m = hn::Zero(du);
-        VI col_min = hn::Set(di, kW), col_max = hn::Set(di, -1), row_min = hn::Set(di, kH), row_max = hn::Set(di, -1);
+        VI far_column = tri.far_is_left ? eight : hn::Set(di, -1), far_row = hn::Set(di, kH);
         for (int j = 0; j < kH; ++j) {
-            const VI lo = hn::Max(hn::Sub(hn::Set(di, first[j]), column0), hn::Zero(di));
-            const VI hi = hn::Min(hn::Sub(hn::Set(di, last[j]), column0), hn::Set(di, kW - 1));
+            const VI lo = hn::Max(hn::Sub(first_v[j], column0), zero_i);
+            const VI hi = hn::Min(hn::Sub(last_v[j], column0), seven);
             const auto empty = hn::Gt(lo, hi);
             // Shift counts clamped to [0, 8]: only lanes with lo <= hi (both in [0, 7]) are kept.
-            const VU lo_u = hn::BitCast(du, hn::Min(lo, hn::Set(di, kW)));
-            const VU right = hn::BitCast(du, hn::Min(hn::Max(hn::Sub(hn::Set(di, kW - 1), hi), hn::Zero(di)), hn::Set(di, kW)));
-            const VU bits = hn::And(hn::Shr(hn::Set(du, 0xFFu), right), hn::Shl(hn::Set(du, 0xFFu), lo_u));
+            const VU lo_u = hn::BitCast(du, hn::Min(lo, eight));
+            const VU right = hn::BitCast(du, hn::Min(hn::Max(hn::Sub(seven, hi), zero_i), eight));
+            const VU bits = hn::And(hn::Shr(byte, right), hn::Shl(byte, lo_u));
             m = hn::Or(m, hn::ShiftLeftSame(hn::IfThenZeroElse(hn::RebindMask(du, empty), bits), j * kW));
-            col_min = hn::IfThenElse(empty, col_min, hn::Min(col_min, lo));
-            col_max = hn::IfThenElse(empty, col_max, hn::Max(col_max, hi));
-            row_min = hn::IfThenElse(hn::AndNot(empty, hn::Eq(row_min, hn::Set(di, kH))), hn::Set(di, j), row_min);
-            row_max = hn::IfThenElse(empty, row_max, hn::Set(di, j));
+            far_column = tri.far_is_left ? hn::IfThenElse(empty, far_column, hn::Min(far_column, lo))
+                                         : hn::IfThenElse(empty, far_column, hn::Max(far_column, hi));
+            const auto take_row = tri.far_is_top ? hn::AndNot(empty, hn::Eq(far_row, hn::Set(di, kH))) : hn::Not(empty);
+            far_row = hn::IfThenElse(take_row, hn::Set(di, j), far_row);
         }
         const auto active = hn::Ne(m, hn::Zero(du));
-        if (hn::AllFalse(du, active)) {
-            if (block == tail) std::memcpy(row + tx, tail, sizeof(OcclusionBuffer::Subtile) * std::size_t(n));
-            continue;
-        }
+        if (hn::AllFalse(du, active)) continue;
         touched += hn::CountTrue(du, active);
 
-        hn::Vec<decltype(df)> d0, d1, mask_f, covered_f;
-        hn::LoadInterleaved4(df, reinterpret_cast<const float*>(block), d0, d1, mask_f, covered_f);
-        VU mask = hn::BitCast(du, mask_f);
-        const VU covered = hn::Or(hn::BitCast(du, covered_f), m);
+        const std::size_t i = row + std::size_t(tx);
+        VF d0 = hn::LoadU(df, planes.d0 + i), d1 = hn::LoadU(df, planes.d1 + i);
+        VU mask = hn::LoadU(du, planes.mask + i);
+        hn::StoreU(hn::Or(hn::LoadU(du, planes.covered + i), m), du, planes.covered + i);
 
-        // Depth bound, in double.
-        const VI x_far_i = hn::Add(column0, tri.dzdx > 0.0 ? col_min : col_max);
-        const VI y_far_i = hn::Add(hn::Set(di, ty * kH), tri.dzdy > 0.0 ? row_min : row_max);
-        const auto half = hn::Set(dd, 0.5);
-        const auto x_far = hn::Add(hn::PromoteTo(dd, x_far_i), half);
-        const auto y_far = hn::Add(hn::PromoteTo(dd, y_far_i), half);
-        const auto plane_min = hn::Add(hn::Add(hn::Set(dd, tri.z0), hn::Mul(hn::Set(dd, tri.dzdx), hn::Sub(x_far, hn::Set(dd, tri.x0)))),
-                                       hn::Mul(hn::Set(dd, tri.dzdy), hn::Sub(y_far, hn::Set(dd, tri.y0))));
-        // std::max(plane_min, z_vertex_min): plane_min unless it is smaller.
-        const auto zv = hn::Set(dd, tri.z_vertex_min);
-        const auto bound = hn::IfThenElse(hn::Lt(plane_min, zv), zv, plane_min);
-        // conservative_far: round to float, step down one ulp if that rounded up, lower by 2^-20.
-        // (The reference skips bound <= 0; here such lanes get d_tri <= 0, which never passes
-        // d_tri > d0 >= 0 below. The double comparison reaches the float lanes as a demoted 0/1.)
-        auto f = hn::DemoteTo(df, bound);
-        const auto rounded_up_d = hn::Gt(hn::PromoteTo(dd, f), bound);
-        const auto rounded_up = hn::Gt(hn::DemoteTo(df, hn::IfThenElseZero(rounded_up_d, hn::Set(dd, 1.0))), hn::Zero(df));
-        f = hn::IfThenElse(rounded_up, hn::BitCast(df, hn::Sub(hn::BitCast(du, f), hn::Set(du, 1u))), f);
-        const auto d_tri = hn::Mul(f, hn::Set(df, 1.0f - 0x1.0p-20f));
+        // conservative_depth, lane by lane.
+        const VF x = hn::Add(hn::ConvertTo(df, hn::Add(column0, far_column)), half);
+        const VF y = hn::Add(hn::ConvertTo(df, hn::Add(hn::Set(di, ty * kH), far_row)), half);
+        const VF plane = hn::Add(hn::Add(a, hn::Mul(dzdy, y)), hn::Mul(dzdx, x));
+        const VF lowered = hn::Sub(plane, error);
+        const VF bound = hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered);  // std::max(lowered, z_vertex_min)
+        const VF d_tri = hn::Mul(bound, lower);
 
         const auto update = hn::And(hn::RebindMask(df, active), hn::Gt(d_tri, d0));
+        if (hn::AllFalse(df, update)) continue;
         // Quick mask, lane by lane as the reference.
         const auto mask_nonzero = hn::RebindMask(df, hn::Ne(mask, hn::Zero(du)));
         const auto discard = hn::And(mask_nonzero, hn::Lt(hn::Sub(hn::Mul(hn::Set(df, 2.0f), d1), hn::Add(d_tri, d0)), hn::Zero(df)));
         const VU kept = hn::IfThenZeroElse(hn::RebindMask(du, discard), mask);
         const auto kept_empty = hn::RebindMask(df, hn::Eq(kept, hn::Zero(du)));
-        auto d1_new = hn::IfThenElse(kept_empty, d_tri, hn::Min(d1, d_tri));
+        VF d1_new = hn::IfThenElse(kept_empty, d_tri, hn::Min(d1, d_tri));
         VU mask_new = hn::Or(kept, m);
-        // Full mask per lane: all ones, or the valid samples in the last column or row.
-        const VI columns = hn::Min(hn::Sub(hn::Set(di, sample_width), column0), hn::Set(di, kW));
-        const VU row_bits = hn::Shr(hn::Set(du, 0xFFu), hn::BitCast(du, hn::Max(hn::Sub(hn::Set(di, kW), columns), hn::Zero(di))));
+        const VI columns = hn::Min(hn::Sub(hn::Set(di, sample_width), column0), eight);
+        const VU row_bits = hn::Shr(byte, hn::BitCast(du, hn::Max(hn::Sub(eight, columns), zero_i)));
         const VU full = hn::Mul(row_bits, hn::Set(du, replicate));
         const auto promote = hn::RebindMask(df, hn::Eq(mask_new, full));
-        const auto d0_new = hn::IfThenElse(promote, d1_new, d0);
+        const VF d0_new = hn::IfThenElse(promote, d1_new, d0);
         mask_new = hn::IfThenZeroElse(hn::RebindMask(du, promote), mask_new);
         d1_new = hn::IfThenZeroElse(promote, d1_new);
 
-        d0 = hn::IfThenElse(update, d0_new, d0);
-        d1 = hn::IfThenElse(update, d1_new, d1);
-        mask = hn::IfThenElse(hn::RebindMask(du, update), mask_new, mask);
-        hn::StoreInterleaved4(d0, d1, hn::BitCast(df, mask), hn::BitCast(df, covered), df, reinterpret_cast<float*>(block));
-        if (block == tail) std::memcpy(row + tx, tail, sizeof(OcclusionBuffer::Subtile) * std::size_t(n));
+        hn::StoreU(hn::IfThenElse(update, d0_new, d0), df, planes.d0 + i);
+        hn::StoreU(hn::IfThenElse(update, d1_new, d1), df, planes.d1 + i);
+        hn::StoreU(hn::IfThenElse(hn::RebindMask(du, update), mask_new, mask), du, planes.mask + i);
     }
     return touched;
 }
@@ -161,8 +148,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const TriangleEdges& e, const
         }
         int tx_begin, tx_end;
         if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
-        touched += UpdateSubtileRow(t.subtiles + std::size_t(ty) * std::size_t(t.subtiles_x), ty, tx_begin, tx_end, first, last, tri,
-                                    t.sample_width, t.sample_height);
+        touched += UpdateSubtileRow(t.planes, ty, tx_begin, tx_end, first, last, tri, t.sample_width, t.sample_height);
     }
     return touched;
 }

@@ -133,7 +133,9 @@ public:
     int sample_width() const { return sample_width_; }
     int sample_height() const { return sample_height_; }
     const RasterStats& stats() const { return stats_; }
-    const std::vector<Subtile>& subtiles() const { return subtiles_; }
+    // One subtile's state, and a row-major copy of all of them (for tests and dumps).
+    Subtile subtile(int tx, int ty) const;
+    std::vector<Subtile> subtiles() const;
     int subtiles_x() const { return subtiles_x_; }
     int subtiles_y() const { return subtiles_y_; }
 
@@ -146,7 +148,13 @@ private:
     BufferConfig config_;
     int sample_width_ = 0, sample_height_ = 0;
     int subtiles_x_ = 0, subtiles_y_ = 0;
-    std::vector<Subtile> subtiles_;
+    // The subtiles as four planes (structure of arrays, so that SIMD kernels load a run of
+    // subtiles as one vector per field), row-major with a padded row stride: a full vector
+    // load starting at any subtile of a row stays within the row's padding.
+    std::size_t stride_ = 0;
+    std::vector<float> d0_, d1_;
+    std::vector<std::uint32_t> mask_, covered_;
+    std::size_t at(int tx, int ty) const { return std::size_t(ty) * stride_ + std::size_t(tx); }
     RasterStats stats_;
 
     // Farthest-depth pyramid: level l >= 1 holds, per cell of 2^l x 2^l subtiles, the minimum
