@@ -96,7 +96,11 @@ std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, 
 // The samples of a grid of `count` whose centres (i + 0.5) lie in [lo, hi]: [first, last],
 // empty when first > last. The one rule for what a span of the screen covers, used by the
 // triangle bounding box, the binning and the rectangle tests.
+// lo and hi are first clamped to [-1, count + 1], which changes no non-empty answer and keeps
+// the conversions to int defined for any finite input.
 inline void sample_span(double lo, double hi, int count, int& first, int& last) {
+    lo = std::min(std::max(lo, -1.0), double(count) + 1.0);
+    hi = std::min(std::max(hi, -1.0), double(count) + 1.0);
     first = std::max(0, int(std::ceil(lo - 0.5)));
     last = std::min(count - 1, int(std::floor(hi - 0.5)));
 }
@@ -128,5 +132,7 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& target, const Triangl
 
 // The kernel for the selected instruction set (see select_isa in occlusion_buffer.hpp).
 TriangleRowsKernel selected_rows_kernel();
+// Whether select_isa chose the plain scalar reference paths.
+bool scalar_reference_selected();
 
 }  // namespace homcull::detail

@@ -20,7 +20,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 // The subtiles tx..tx + lanes - 1 of a row as vector lanes, float and 32-bit integer, at most
 // kMaxSimdLanes (wider vectors, as SVE may have, are capped: the rows are padded for that many).
-std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
+HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<float, kMaxSimdLanes> df;
@@ -185,6 +185,7 @@ const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4
 }  // namespace
 
 TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_rows_reference : &dispatch; }
+bool scalar_reference_selected() { return use_reference; }
 
 }  // namespace detail
 

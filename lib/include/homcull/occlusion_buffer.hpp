@@ -18,6 +18,7 @@
 // rasterizer and an exact ray cast (edges shared by two drawn triangles need none); a triangle's depth enters the buffer as a lower bound of 1/w over the samples it
 // covers, lowered by a relative 2^-20. So the buffer never claims an occluder where there is
 // none, nor nearer than it is, and occludee tests never hide what is visible at the samples.
+#include <homcull/aabb.hpp>
 #include <homcull/camera.hpp>
 
 #include <array>
@@ -26,6 +27,10 @@
 #include <vector>
 
 namespace homcull {
+namespace detail {
+struct RectQuery;
+struct SubtileView;
+}  // namespace detail
 
 enum class Backface : std::uint8_t {
     none,  // rasterize both sides
@@ -96,6 +101,12 @@ struct ParallelFor {
     void* user = nullptr;
 };
 
+// A screen rectangle to test: NDC (y up) bounds and the occludee's nearest clip w. The layout
+// of S1's rectangle file (5 floats).
+struct ScreenRect {
+    float ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min;
+};
+
 class OcclusionBuffer {
 public:
     struct Subtile {
@@ -128,6 +139,12 @@ public:
     Visibility test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
     // World (or model) AABB under a model-to-clip matrix (column-major).
     Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
+    // Batches: results[k] is what test_rect / test_aabb answer for item k, bit for bit. The
+    // rectangles' first stage (validity, frustum, sample span, nearest depth and the coarse
+    // pyramid check, which decides most hidden rectangles) runs with one rectangle per SIMD
+    // lane; the rest one at a time. No allocation; thread-safe like the single tests.
+    void test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const;
+    void test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& model_to_clip, Visibility* results) const;
 
     const BufferConfig& config() const { return config_; }
     int sample_width() const { return sample_width_; }
@@ -165,17 +182,18 @@ private:
     };
     std::vector<Level> levels_;
     std::vector<float> pyramid_;
+    std::vector<std::int32_t> level_offset_, level_width_;  // levels_ as arrays, for SIMD gathers
     void build_pyramid();
-    float min_d0(int level, int x, int y) const;
+    float min_d0(int level, int x, int y) const {
+        const Level& l = levels_[std::size_t(level)];
+        return pyramid_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)];
+    }
     bool any_farther_or_equal(int level, int x, int y, int x0, int y0, int x1, int y1, float d_near) const;
-    // Shared by both rectangle tests: the sample range and nearest 1/w, or a decided answer.
-    struct RectQuery {
-        int i0, i1, j0, j1;
-        float d_near;
-    };
-    bool prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, RectQuery& q,
+    // Shared by the rectangle tests: the sample range and nearest 1/w, or a decided answer.
+    bool prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, detail::RectQuery& q,
                  Visibility& decided) const;
-    bool subtile_hides(int tx, int ty, const RectQuery& q) const;
+    Visibility test_prepared_rect(const detail::RectQuery& q) const;
+    detail::SubtileView subtile_view() const;
 
     // Render scratch, reused across frames.
     struct Chunk;

@@ -1,0 +1,70 @@
+#pragma once
+// The coarse stage of the batched rectangle tests (OcclusionBuffer::test_rects), shared by
+// the scalar path (OcclusionBuffer::prepare and the start of test_rect) and the SIMD kernel
+// in rect_tests_simd.cpp, which must decide exactly the rectangles the scalar path decides
+// at that stage, with the same answers.
+#include <homcull/occlusion_buffer.hpp>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+namespace homcull::detail {
+
+// What the coarse stage reads of a buffer.
+struct CoarseRectView {
+    const float* pyramid;               // all levels, level l at level_offset[l], rows of level_width[l]
+    const std::int32_t* level_offset;
+    const std::int32_t* level_width;
+    int levels;
+    int sample_width, sample_height;
+    float near_w;
+};
+
+// A rectangle test after OcclusionBuffer::prepare: the samples [i0, i1] x [j0, j1] whose
+// centres lie in it, and its nearest 1/w rounded up (an occluder hides it where its bound is
+// above d_near).
+struct RectQuery {
+    int i0, i1, j0, j1;
+    float d_near;
+};
+
+// The subtile planes (OcclusionBuffer's layout, rows padded for full-vector loads).
+struct SubtileView {
+    const float* d0;
+    const float* d1;
+    const std::uint32_t* mask;
+    std::size_t stride;
+};
+
+// Whether subtile (tx, ty) hides the rectangle's samples in it: its bound there is d0, or
+// max(d0, d1) when they all lie in the working layer's mask.
+inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery& q) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const int c0 = std::max(0, q.i0 - tx * kW), c1 = std::min(kW - 1, q.i1 - tx * kW);
+    const int r0 = std::max(0, q.j0 - ty * kH), r1 = std::min(kH - 1, q.j1 - ty * kH);
+    const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
+    std::uint32_t rect = 0;
+    for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
+    const std::size_t i = std::size_t(ty) * v.stride + std::size_t(tx);
+    const float bound = (v.mask[i] != 0 && (rect & ~v.mask[i]) == 0) ? std::max(v.d0[i], v.d1[i]) : v.d0[i];
+    return q.d_near < bound;
+}
+
+// The exact stage after the coarse check, scanning the subtile rows in SIMD: occluded when
+// every subtile the rectangle reaches hides it. Null when the scalar reference is selected
+// (test_rect then searches the pyramid; the answers are the same).
+using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q, int sample_width);
+RectScanKernel selected_rect_scan_kernel();
+
+// results[k] for rectangle k: a Visibility the coarse stage decided, or kUndecided.
+constexpr std::uint8_t kUndecided = 0xFF;
+
+// The coarse stage for the rectangles [0, count), in SIMD lanes for the selected instruction
+// set; for the undecided ones, queries[k] is what prepare() computes. Null when the scalar
+// reference is selected.
+using CoarseRectKernel = void (*)(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, std::uint8_t* results,
+                                  RectQuery* queries);
+CoarseRectKernel selected_coarse_rect_kernel();
+
+}  // namespace homcull::detail

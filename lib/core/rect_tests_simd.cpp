@@ -1,0 +1,190 @@
+// The coarse stage of batched rectangle tests with one rectangle per SIMD lane, compiled per
+// instruction set with Google Highway and chosen at run time. Each lane repeats what
+// OcclusionBuffer::prepare and the coarse check at the start of OcclusionBuffer::test_rect do
+// for its rectangle, with the same double and float operations, so it decides exactly the
+// rectangles they decide there, with the same answers; the others (kUndecided) go on to
+// RectScan with the query computed here. On S1 about three rectangles in four are decided here.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "core/rect_tests_simd.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/highway.h>
+
+#include "core/rect_tests.hpp"
+#include "raster/rasterize.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+HWY_BEFORE_NAMESPACE();
+namespace homcull::detail::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+constexpr int kMaxScanLanes = kMaxSimdLanes;  // rows are padded for this many (rasterize.hpp)
+
+void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, std::uint8_t* results,
+                     RectQuery* queries) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const hn::CappedTag<double, 8> dd;  // one rectangle per double lane
+    const hn::Rebind<float, decltype(dd)> df;
+    const hn::Rebind<std::int32_t, decltype(dd)> di;
+    const hn::Rebind<std::uint32_t, decltype(dd)> du;
+    using VD = hn::Vec<decltype(dd)>;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const std::size_t lanes = hn::Lanes(dd);
+
+    const VD one = hn::Set(dd, 1.0), half = hn::Set(dd, 0.5), minus_one = hn::Set(dd, -1.0);
+    const VD width = hn::Set(dd, double(view.sample_width)), height = hn::Set(dd, double(view.sample_height));
+    const VF infinity = hn::Set(df, INFINITY), one_f = hn::Set(df, 1.0f), minus_one_f = hn::Set(df, -1.0f);
+    const VI code_visible = hn::Set(di, int(Visibility::visible)), code_occluded = hn::Set(di, int(Visibility::occluded));
+    const VI code_view_culled = hn::Set(di, int(Visibility::view_culled)), code_undecided = hn::Set(di, kUndecided);
+
+    HWY_ALIGN float field[5][8];
+    HWY_ALIGN std::int32_t code_out[8], i0_out[8], i1_out[8], j0_out[8], j1_out[8];
+    HWY_ALIGN float d_near_out[8];
+    for (std::size_t base = 0; base < count; base += lanes) {
+        const std::size_t n = std::min(lanes, count - base);
+        for (std::size_t k = 0; k < lanes; ++k) {  // to structure of arrays; missing lanes get rectangle 0 of the block
+            const ScreenRect& r = rects[base + (k < n ? k : 0)];
+            field[0][k] = r.ndc_min_x, field[1][k] = r.ndc_min_y, field[2][k] = r.ndc_max_x, field[3][k] = r.ndc_max_y;
+            field[4][k] = r.w_min;
+        }
+        const VF min_x = hn::LoadU(df, field[0]), min_y = hn::LoadU(df, field[1]), max_x = hn::LoadU(df, field[2]);
+        const VF max_y = hn::LoadU(df, field[3]), w_min = hn::LoadU(df, field[4]);
+
+        // prepare(): invalid input and the near plane (visible), outside the frustum.
+        auto finite = hn::And(hn::And(hn::Lt(hn::Abs(min_x), infinity), hn::Lt(hn::Abs(min_y), infinity)),
+                              hn::And(hn::Lt(hn::Abs(max_x), infinity), hn::Lt(hn::Abs(max_y), infinity)));
+        finite = hn::And(finite, hn::Lt(hn::Abs(w_min), infinity));
+        const auto valid = hn::And(finite, hn::And(hn::Ge(max_x, min_x), hn::Ge(max_y, min_y)));
+        const auto visible = hn::Or(hn::Not(valid), hn::Lt(w_min, hn::Set(df, view.near_w)));
+        const auto outside = hn::Or(hn::Or(hn::Lt(max_x, minus_one_f), hn::Gt(min_x, one_f)),
+                                    hn::Or(hn::Lt(max_y, minus_one_f), hn::Gt(min_y, one_f)));
+        VI code = hn::IfThenElse(hn::RebindMask(di, visible), code_visible,
+                                 hn::IfThenElse(hn::RebindMask(di, outside), code_view_culled, code_undecided));
+
+        // The samples whose centres lie in the rectangle (sample_span, clamped the same way).
+        const VD sx0 = hn::Mul(hn::Mul(hn::Add(hn::PromoteTo(dd, min_x), one), half), width);
+        const VD sx1 = hn::Mul(hn::Mul(hn::Add(hn::PromoteTo(dd, max_x), one), half), width);
+        const VD sy0 = hn::Mul(hn::Mul(hn::Sub(one, hn::PromoteTo(dd, max_y)), half), height);
+        const VD sy1 = hn::Mul(hn::Mul(hn::Sub(one, hn::PromoteTo(dd, min_y)), half), height);
+        const auto span = [&](VD lo, VD hi, VD count_d, VI& first, VI& last) {
+            const VD top = hn::Add(count_d, one);
+            lo = hn::Min(hn::Max(lo, minus_one), top);
+            hi = hn::Min(hn::Max(hi, minus_one), top);
+            first = hn::Max(hn::DemoteTo(di, hn::Ceil(hn::Sub(lo, half))), hn::Zero(di));
+            last = hn::Min(hn::DemoteTo(di, hn::Floor(hn::Sub(hi, half))), hn::Sub(hn::DemoteTo(di, count_d), hn::Set(di, 1)));
+        };
+        // (Invalid lanes may hold NaN here: their spans are garbage, but they are decided, and
+        // their indices are zeroed before the gathers below.)
+        VI i0, i1, j0, j1;
+        span(sx0, sx1, width, i0, i1);
+        span(sy0, sy1, height, j0, j1);
+        const auto empty = hn::Or(hn::Gt(i0, i1), hn::Gt(j0, j1));
+        code = hn::IfThenElse(hn::And(empty, hn::Eq(code, code_undecided)), code_occluded, code);
+
+        // Nearest 1/w, rounded up and raised by a relative 2^-20.
+        const VD d = hn::Div(one, hn::PromoteTo(dd, w_min));
+        const VF f = hn::DemoteTo(df, d);
+        const VF f_up = hn::BitCast(df, hn::Add(hn::BitCast(du, f), hn::Set(du, 1u)));
+        const VF d_near = hn::Mul(hn::DemoteTo(df, hn::IfThenElse(hn::Lt(hn::PromoteTo(dd, f), d), hn::PromoteTo(dd, f_up), hn::PromoteTo(dd, f))),
+                                  hn::Set(df, 1.0f + 0x1.0p-20f));
+
+        // The coarse check, for the lanes still undecided (the others read cell 0).
+        const auto open = hn::Eq(code, code_undecided);
+        if (hn::AllFalse(di, open)) {
+            hn::Store(code, di, code_out);
+            for (std::size_t k = 0; k < n; ++k) results[base + k] = std::uint8_t(code_out[k]);
+            continue;
+        }
+        const VI tx0 = hn::IfThenElseZero(open, hn::ShiftRight<3>(i0)), tx1 = hn::IfThenElseZero(open, hn::ShiftRight<3>(i1));
+        const VI ty0 = hn::IfThenElseZero(open, hn::ShiftRight<2>(j0)), ty1 = hn::IfThenElseZero(open, hn::ShiftRight<2>(j1));
+        static_assert(kW == 8 && kH == 4, "the shifts above divide by the subtile size");
+        // The level where the subtile range spans at most 2 x 2 cells (monotone in the level).
+        VI level = hn::Zero(di);
+        for (int l = 0; l + 1 < view.levels; ++l) {
+            const auto wider = hn::Or(hn::Gt(hn::Sub(hn::ShiftRightSame(tx1, l), hn::ShiftRightSame(tx0, l)), hn::Set(di, 1)),
+                                      hn::Gt(hn::Sub(hn::ShiftRightSame(ty1, l), hn::ShiftRightSame(ty0, l)), hn::Set(di, 1)));
+            if (hn::AllFalse(di, wider)) break;
+            level = hn::Add(level, hn::IfThenElseZero(wider, hn::Set(di, 1)));
+        }
+        const VI offset = hn::GatherIndex(di, view.level_offset, level), row = hn::GatherIndex(di, view.level_width, level);
+        const VI cx0 = hn::Shr(tx0, level), cx1 = hn::Shr(tx1, level), cy0 = hn::Shr(ty0, level), cy1 = hn::Shr(ty1, level);
+        const VI row0 = hn::Add(offset, hn::Mul(cy0, row)), row1 = hn::Add(offset, hn::Mul(cy1, row));
+        const VF coarse = hn::Min(hn::Min(hn::GatherIndex(df, view.pyramid, hn::Add(row0, cx0)), hn::GatherIndex(df, view.pyramid, hn::Add(row0, cx1))),
+                                  hn::Min(hn::GatherIndex(df, view.pyramid, hn::Add(row1, cx0)), hn::GatherIndex(df, view.pyramid, hn::Add(row1, cx1))));
+        code = hn::IfThenElse(hn::And(open, hn::RebindMask(di, hn::Lt(d_near, coarse))), code_occluded, code);
+        hn::Store(code, di, code_out);
+        hn::Store(i0, di, i0_out), hn::Store(i1, di, i1_out), hn::Store(j0, di, j0_out), hn::Store(j1, di, j1_out);
+        hn::Store(d_near, df, d_near_out);
+        for (std::size_t k = 0; k < n; ++k) {
+            results[base + k] = std::uint8_t(code_out[k]);
+            queries[base + k] = {i0_out[k], i1_out[k], j0_out[k], j1_out[k], d_near_out[k]};
+        }
+    }
+}
+
+// The exact stage: every subtile the rectangle reaches, row by row, a vector of subtiles at a
+// time. A subtile with d0 > d_near hides it whatever its mask; one with d0 <= d_near shows it
+// if it is interior (all its samples in the rectangle, so its bound is d0), and otherwise is
+// decided by subtile_hides. Same answers as test_rect_exhaustive.
+Visibility RectScan(const SubtileView& view, const RectQuery& q, int sample_width) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const hn::CappedTag<float, kMaxScanLanes> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const int lanes = int(hn::Lanes(df));
+    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+    const bool left_full = q.i0 % kW == 0, right_full = q.i1 % kW == kW - 1 && q.i1 < sample_width;
+    const bool top_full = q.j0 % kH == 0, bottom_full = q.j1 % kH == kH - 1;
+    const int ix0 = left_full ? tx0 : tx0 + 1, ix1 = right_full ? tx1 : tx1 - 1;
+    const int iy0 = top_full ? ty0 : ty0 + 1, iy1 = bottom_full ? ty1 : ty1 - 1;
+    const auto d_near = hn::Set(df, q.d_near);
+    for (int ty = ty0; ty <= ty1; ++ty) {
+        const float* row = view.d0 + std::size_t(ty) * view.stride;
+        const bool interior_row = ty >= iy0 && ty <= iy1;
+        for (int tx = tx0; tx <= tx1; tx += lanes) {
+            // Lanes past tx1 read the row's padding or its next subtiles: masked out.
+            const auto reached = hn::FirstN(df, std::size_t(tx1 - tx + 1));
+            const auto shows = hn::And(reached, hn::Not(hn::Lt(d_near, hn::LoadU(df, row + tx))));
+            if (hn::AllFalse(df, shows)) continue;
+            if (interior_row) {
+                const auto column = hn::Iota(di, tx);
+                const auto interior = hn::And(hn::Not(hn::Lt(column, hn::Set(di, ix0))), hn::Not(hn::Gt(column, hn::Set(di, ix1))));
+                if (!hn::AllFalse(df, hn::And(shows, hn::RebindMask(df, interior)))) return Visibility::visible;
+            }
+            HWY_ALIGN std::uint8_t bits[8];
+            hn::StoreMaskBits(df, shows, bits);
+            for (int k = 0; k < lanes; ++k)
+                if ((bits[k / 8] >> (k % 8)) & 1u)
+                    if (!subtile_hides(view, tx + k, ty, q)) return Visibility::visible;
+        }
+    }
+    return Visibility::occluded;
+}
+
+}  // namespace homcull::detail::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace homcull::detail {
+
+HWY_EXPORT(CoarseRectTests);
+HWY_EXPORT(RectScan);
+
+namespace {
+void dispatch_coarse(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, std::uint8_t* results, RectQuery* queries) {
+    HWY_DYNAMIC_DISPATCH(CoarseRectTests)(view, rects, count, results, queries);
+}
+}  // namespace
+
+
+Visibility dispatch_scan(const SubtileView& view, const RectQuery& q, int sample_width) {
+    return HWY_DYNAMIC_DISPATCH(RectScan)(view, q, sample_width);
+}
+
+CoarseRectKernel selected_coarse_rect_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_coarse; }
+RectScanKernel selected_rect_scan_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_scan; }
+
+}  // namespace homcull::detail
+#endif  // HWY_ONCE

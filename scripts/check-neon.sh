@@ -1,0 +1,134 @@
+#!/usr/bin/env bash
+# Checks that homcull::core, the SIMD rasterizer in particular, compiles for ARM NEON (aarch64).
+#
+# Why: the project is built and tested on x86-64 only, but the Highway kernels
+# (lib/raster/rasterize_simd.cpp, compiled once per target with hwy/foreach_target.h) must also
+# compile for NEON, and on aarch64 Highway 1.0.3 also builds its SVE targets (SVE, SVE2,
+# SVE_256, SVE2_128) from the same code. Code that is fine on x86 can fail there (SVE vectors
+# are sizeless: no arrays of vectors, no sizeof, no vectors as struct members).
+#
+# What: compiles (-c, no linking) every source of homcull_core with the aarch64 cross compiler
+# and the core target's flags; then checks that every source using hwy/foreach_target.h
+# defines functions in namespace N_NEON (and lists the other targets built), and that
+# homcull::detail::N_NEON::RasterizeRows exists and uses NEON vector registers. Kernels that
+# are HWY_INLINE (e.g. UpdateSubtileRow) have no symbol of their own; they are compiled, and
+# checked, inside their callers. Nothing is run (no aarch64 machine or emulator is needed).
+#
+# Why not CMake with a toolchain file: lib/CMakeLists.txt defines all the libraries in one
+# file and find_package()s TBB, Embree, assimp, OpenImageIO and nlohmann_json unconditionally,
+# none of which is installed for arm64, so a cross configure fails before homcull_core is
+# reached. The script therefore calls the compiler itself. The source list is read from the
+# add_library(homcull_core ...) call in lib/CMakeLists.txt, so it cannot go stale; the flags
+# below mirror that target (C++17, -ffp-contract=off, include dirs lib/include and lib), the
+# top-level Release flags (-O3 -DNDEBUG) and cmake/HomcullWarnings.cmake.
+#
+# Usage: scripts/check-neon.sh [extra compiler flags, e.g. -Werror]
+#   Installs g++-aarch64-linux-gnu with apt-get when it is missing and the script runs as root.
+#   AARCH64_CXX overrides the compiler (default aarch64-linux-gnu-g++).
+# Exit status: 0 when everything compiled and the NEON symbols are there, 1 otherwise,
+# 2 when the cross compiler or the Highway/GLM headers are missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cxx=${AARCH64_CXX:-aarch64-linux-gnu-g++}
+nm=aarch64-linux-gnu-nm
+objdump=aarch64-linux-gnu-objdump
+
+# --- The cross compiler -------------------------------------------------------------------
+if ! command -v "$cxx" >/dev/null 2>&1 || ! command -v "$nm" >/dev/null 2>&1; then
+  if [ "$(id -u)" -eq 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "check-neon: installing the aarch64 cross compiler (g++-aarch64-linux-gnu)..."
+    if ! DEBIAN_FRONTEND=noninteractive apt-get install -y -qq g++-aarch64-linux-gnu >/dev/null; then
+      apt-get update -qq
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq g++-aarch64-linux-gnu >/dev/null
+    fi
+  else
+    echo "check-neon: $cxx (or $nm) not found. Install the cross compiler first, e.g." >&2
+    echo "  sudo apt-get install g++-aarch64-linux-gnu" >&2
+    exit 2
+  fi
+fi
+for tool in "$cxx" "$nm" "$objdump"; do
+  command -v "$tool" >/dev/null 2>&1 || { echo "check-neon: $tool not found" >&2; exit 2; }
+done
+
+# --- Headers ------------------------------------------------------------------------------
+# Highway and GLM are header-only here (nothing is linked) and their headers do not depend on
+# the architecture, so the host's copies are used. Only those two folders are exposed to the
+# cross compiler: adding -I/usr/include would pull in the host's x86-64 glibc headers.
+for h in /usr/include/hwy/highway.h /usr/include/glm/glm.hpp; do
+  [ -f "$h" ] || { echo "check-neon: $h missing (run scripts/install-deps.sh)" >&2; exit 2; }
+done
+
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/homcull-check-neon.XXXXXX")
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$tmp/include" "$tmp/obj"
+ln -s /usr/include/hwy "$tmp/include/hwy"
+ln -s /usr/include/glm "$tmp/include/glm"
+
+# --- Sources of homcull_core, from lib/CMakeLists.txt ----------------------------------------
+# The words between "add_library(homcull_core" and the first ")" after it.
+mapfile -t sources < <(sed -n '/add_library(homcull_core\b/,/)/p' lib/CMakeLists.txt |
+  sed -e 's/.*add_library(homcull_core//' -e 's/).*//' -e 's/#.*//' | tr -s ' \t' '\n' | grep -v '^$' || true)
+if [ "${#sources[@]}" -eq 0 ]; then
+  echo "check-neon: found no sources in add_library(homcull_core ...) in lib/CMakeLists.txt" >&2
+  exit 1
+fi
+simd_source=raster/rasterize_simd.cpp
+printf '%s\n' "${sources[@]}" | grep -qx "$simd_source" ||
+  { echo "check-neon: $simd_source is no longer a source of homcull_core; update this script" >&2; exit 1; }
+
+# --- Compile ------------------------------------------------------------------------------
+flags=(-std=c++17 -O3 -DNDEBUG -fPIC -ffp-contract=off
+       -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align -Wunused
+       -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
+       -isystem "$tmp/include" -Ilib/include -Ilib "$@")
+hwy_version=$(sed -n 's/^#define HWY_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' /usr/include/hwy/highway.h | paste -sd.)
+echo "check-neon: $("$cxx" --version | head -n 1), Highway headers $hwy_version"
+failed=()
+for src in "${sources[@]}"; do
+  obj="$tmp/obj/${src//\//_}.o"
+  echo "  compiling lib/$src"
+  if ! "$cxx" "${flags[@]}" -c "lib/$src" -o "$obj"; then failed+=("lib/$src"); fi
+done
+if [ "${#failed[@]}" -ne 0 ]; then
+  echo "check-neon: FAILED: ${#failed[@]} of ${#sources[@]} sources do not compile for aarch64:" >&2
+  printf '  %s\n' "${failed[@]}" >&2
+  exit 1
+fi
+
+# --- Check the Highway targets ----------------------------------------------------------------
+# Every source that includes hwy/foreach_target.h must define functions in namespace N_NEON;
+# the other targets found (N_SVE... on Highway 1.0.3) are listed, not required.
+status=0
+for src in "${sources[@]}"; do
+  grep -q 'hwy/foreach_target\.h' "lib/$src" || continue
+  obj="$tmp/obj/${src//\//_}.o"
+  # "homcull::detail::N_NEON::RasterizeRows(...)" -> "N_NEON RasterizeRows"
+  kernels=$("$nm" -C --defined-only "$obj" |
+    sed -n 's/^[0-9a-f]* [TtWw] homcull::\(.*::\)\{0,1\}\(N_[A-Z0-9_]*\)::\([A-Za-z_][A-Za-z0-9_]*\)(.*/\2 \3/p' | sort -u)
+  targets=$(printf '%s\n' "$kernels" | awk 'NF {print $1}' | sort -u | paste -sd' ')
+  neon_functions=$(printf '%s\n' "$kernels" | awk '$1 == "N_NEON" {print $2}' | paste -sd' ')
+  echo "check-neon: lib/$src: targets ${targets:-none}; N_NEON functions: ${neon_functions:-none}"
+  if [ -z "$neon_functions" ]; then
+    echo "check-neon: FAILED: lib/$src defines no function in namespace N_NEON" >&2
+    status=1
+  fi
+done
+[ "$status" -eq 0 ] || exit 1
+
+simd_obj="$tmp/obj/${simd_source//\//_}.o"
+neon_symbol=$("$nm" --defined-only "$simd_obj" | awk '$3 ~ /6N_NEON13RasterizeRows/ {print $3}' | head -n 1)
+if [ -z "$neon_symbol" ]; then
+  echo "check-neon: FAILED: no homcull::detail::N_NEON::RasterizeRows in lib/$simd_source's object" >&2
+  exit 1
+fi
+# The NEON kernel must really be vector code: 4 x 32-bit lanes in v registers (e.g. v3.4s).
+neon_ops=$("$objdump" -d --no-show-raw-insn --disassemble="$neon_symbol" "$simd_obj" |
+  grep -cE '\bv[0-9]+\.4s\b' || true)
+if [ "$neon_ops" -eq 0 ]; then
+  echo "check-neon: FAILED: N_NEON::RasterizeRows has no NEON (vN.4s) instructions" >&2
+  exit 1
+fi
+echo "check-neon: OK: ${#sources[@]} sources of homcull_core compile for aarch64;" \
+  "N_NEON::RasterizeRows has $neon_ops NEON vector instructions"
