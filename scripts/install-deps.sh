@@ -15,6 +15,7 @@ packages=(
   libtinygltf-dev                 # glTF/GLB import and export (keeps node order and extras)
   assimp-testmodels               # test data: the IFC source of fzk_haus.glb, for the IFC import test
   libgtest-dev libgmock-dev libbenchmark-dev
+  g++-aarch64-linux-gnu           # the test that the SIMD kernels compile for Arm NEON/SVE (scripts/check-neon.sh)
 )
 
 sudo_cmd=()

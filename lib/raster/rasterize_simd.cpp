@@ -38,11 +38,12 @@ HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, i
     std::uint32_t replicate = 0;
     for (int j = 0; j < rows; ++j) replicate |= 1u << (j * kW);
 
-    // Per sample row j: its interval as lane-independent values.
-    VI first_v[kH], last_v[kH];
+    // Per sample row j: its interval, broadcast in the row loop below (SVE vectors are sizeless
+    // and cannot be array elements). Local copies: the stores to the planes cannot alias them.
+    std::int32_t first_l[kH], last_l[kH];
     for (int j = 0; j < kH; ++j) {
-        first_v[j] = hn::Set(di, first[j]);
-        last_v[j] = hn::Set(di, last[j]);
+        first_l[j] = first[j];
+        last_l[j] = last[j];
     }
     const VI zero_i = hn::Zero(di), seven = hn::Set(di, kW - 1), eight = hn::Set(di, kW);
     const VU byte = hn::Set(du, 0xFFu);
@@ -58,8 +59,8 @@ HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, i
         VU m = hn::Zero(du);
         VI far_column = tri.far_is_left ? eight : hn::Set(di, -1), far_row = hn::Set(di, kH);
         for (int j = 0; j < kH; ++j) {
-            const VI lo = hn::Max(hn::Sub(first_v[j], column0), zero_i);
-            const VI hi = hn::Min(hn::Sub(last_v[j], column0), seven);
+            const VI lo = hn::Max(hn::Sub(hn::Set(di, first_l[j]), column0), zero_i);
+            const VI hi = hn::Min(hn::Sub(hn::Set(di, last_l[j]), column0), seven);
             const auto empty = hn::Gt(lo, hi);
             // Shift counts clamped to [0, 8]: only lanes with lo <= hi (both in [0, 7]) are kept.
             const VU lo_u = hn::BitCast(du, hn::Min(lo, eight));
@@ -180,7 +181,8 @@ struct NamedTarget {
     const char* name;
     std::int64_t bits;
 };
-const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4}, {"emu128", HWY_EMU128}};
+const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4},     {"sve2", HWY_SVE2},
+                                 {"sve", HWY_SVE},       {"neon", HWY_NEON}, {"emu128", HWY_EMU128}};
 
 }  // namespace
 
