@@ -75,7 +75,6 @@ void OcclusionBuffer::clear() {
     stats_ = RasterStats{};
 }
 
-
 void OcclusionBuffer::build_pyramid() {
     for (int ty = 0; ty < subtiles_y_; ++ty)
         std::copy_n(d0_.begin() + std::ptrdiff_t(at(0, ty)), subtiles_x_, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_);
@@ -153,7 +152,8 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         const Job& j = *static_cast<Job*>(data);
         OcclusionBuffer& b = *j.self;
         const int row_begin = int(band) * kBandSubtileRows;
-        const detail::RasterTarget target{{b.d0_.data(), b.d1_.data(), b.mask_.data(), b.covered_.data(), b.stride_}, b.subtiles_x_, b.subtiles_y_, b.sample_width_, b.sample_height_,
+        const detail::SubtilePlanes planes{b.d0_.data(), b.d1_.data(), b.mask_.data(), b.covered_.data(), b.stride_};
+        const detail::RasterTarget target{planes, b.subtiles_x_, b.subtiles_y_, b.sample_width_, b.sample_height_,
                                           b.config_.edge_margin, row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_),
                                           detail::selected_rows_kernel()};
         std::uint64_t touched = 0;
