@@ -6,8 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <limits>
 
 namespace homcull {
 namespace {
@@ -153,7 +151,7 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         OcclusionBuffer& b = *j.self;
         const int row_begin = int(band) * kBandSubtileRows;
         const detail::SubtilePlanes planes{b.d0_.data(), b.d1_.data(), b.mask_.data(), b.covered_.data(), b.stride_};
-        const detail::RasterTarget target{planes, b.subtiles_x_, b.subtiles_y_, b.sample_width_, b.sample_height_,
+        const detail::RasterTarget target{planes, b.sample_width_, b.sample_height_,
                                           b.config_.edge_margin, row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_),
                                           detail::selected_rows_kernel()};
         std::uint64_t touched = 0;

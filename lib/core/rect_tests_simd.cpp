@@ -20,8 +20,6 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-constexpr int kMaxScanLanes = kMaxSimdLanes;  // rows are padded for this many (rasterize.hpp)
-
 void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, std::uint8_t* results,
                      RectQuery* queries) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
@@ -131,7 +129,7 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
 // decided by subtile_hides. Same answers as test_rect_exhaustive.
 Visibility RectScan(const SubtileView& view, const RectQuery& q, int sample_width) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    const hn::CappedTag<float, kMaxScanLanes> df;
+    const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many (rasterize.hpp)
     const hn::RebindToSigned<decltype(df)> di;
     const int lanes = int(hn::Lanes(df));
     const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;

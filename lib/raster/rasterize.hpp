@@ -43,7 +43,6 @@ struct SubtilePlanes {
 
 struct RasterTarget {
     SubtilePlanes planes;
-    int subtiles_x, subtiles_y;
     int sample_width, sample_height;
     double edge_margin;
     int row_begin, row_end;  // the subtile rows [row_begin, row_end) this call may write
