@@ -137,11 +137,8 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
     return Visibility::occluded;
 }
 
-namespace {
+namespace detail {
 
-// The screen rectangle of a box under a model-to-clip matrix, or the answer when it needs
-// none (non-finite corners: visible; entirely before the near plane: view-culled; crossing
-// it: visible).
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, ScreenRect& rect,
                    Visibility& decided) {
     // Incremental corner transform: the base corner plus the three transformed edge vectors.
@@ -176,12 +173,12 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
     return true;
 }
 
-}  // namespace
+}  // namespace detail
 
 Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) const {
     ScreenRect r;
     Visibility decided;
-    if (!box_rectangle(box_min, box_max, m, config_.near_w, r, decided)) return decided;
+    if (!detail::box_rectangle(box_min, box_max, m, config_.near_w, r, decided)) return decided;
     return test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
 }
 
@@ -216,7 +213,7 @@ void OcclusionBuffer::test_aabbs(const Aabb* boxes, std::size_t count, const std
         const std::size_t n = std::min(kBlock, count - base);
         std::size_t pending = 0;
         for (std::size_t k = 0; k < n; ++k)
-            if (box_rectangle(&boxes[base + k].min.x, &boxes[base + k].max.x, m, config_.near_w, rects[pending], results[base + k]))
+            if (detail::box_rectangle(&boxes[base + k].min.x, &boxes[base + k].max.x, m, config_.near_w, rects[pending], results[base + k]))
                 index[pending++] = base + k;
         test_rects(rects, pending, answers);
         for (std::size_t p = 0; p < pending; ++p) results[index[p]] = answers[p];

@@ -57,6 +57,13 @@ inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery&
 using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q, int sample_width);
 RectScanKernel selected_rect_scan_kernel();
 
+// The screen rectangle of a box under a model-to-clip matrix (incremental corner transform:
+// base corner plus three edge vectors), rounded outwards, with its nearest w rounded down; or,
+// returning false, the answer when it needs none (non-finite corners: visible; entirely
+// before the near plane: view-culled; crossing it: visible).
+bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,
+                   ScreenRect& rect, Visibility& decided);
+
 // results[k] for rectangle k: a Visibility the coarse stage decided, or kUndecided.
 constexpr std::uint8_t kUndecided = 0xFF;
 

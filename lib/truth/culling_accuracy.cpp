@@ -3,27 +3,19 @@
 
 namespace homcull {
 
-void tally_culling(const Scene& scene, const RayScene& rays, const WorldTriangles& occluders, const Camera& camera,
-                   Resolution display, int samples, CullingTally& tally) {
-    if (samples < 1 || display.width % samples != 0 || display.height % samples != 0)
-        throw Error("culling accuracy: the display resolution must be a multiple of the samples per pixel axis");
+void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally) {
     TruthOptions truth_options;
-    truth_options.resolution = display;
+    truth_options.resolution = culler.config().display;
     const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
-    BufferConfig config;
-    config.width = display.width / samples;
-    config.height = display.height / samples;
-    config.samples = samples;
-    config.near_w = float(camera.near_plane);
-    OcclusionBuffer buffer(config);
-    const auto clip = clip_from_world(camera, display.aspect());
-    buffer.render(occluders.input(clip, Backface::none));
+    std::vector<OccludeeAnswer> answers;
+    culler.cull(camera, answers);
     ++tally.views;
+    tally.total_ms.render_ms += culler.timings().render_ms;
+    tally.total_ms.maps_ms += culler.timings().maps_ms;
+    tally.total_ms.test_ms += culler.timings().test_ms;
     for (std::size_t id = 0; id < scene.objects.size(); ++id) {
-        const Aabb& box = scene.objects[id].world_bounds;
-        if (box.empty()) continue;
-        const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
-        const Visibility answer = buffer.test_aabb(lo, hi, clip);
+        if (scene.objects[id].world_bounds.empty()) continue;
+        const Visibility answer = answers[id].visibility;
         const ObjectVisibility& t = truth.objects[id];
         if (t.visible_samples > 0) {
             ++tally.visible;

@@ -4,6 +4,7 @@
 //   --scene F:    every object's AABB test against Embree ground truth at the display's pixel
 //                 centres, from the frames of --path, or of a generated walk or orbit.
 #include "commands.hpp"
+#include "cull_options.hpp"
 #include "options.hpp"
 
 #include <homcull/error.hpp>
@@ -26,7 +27,7 @@ namespace {
 
 template <class Options>
 void run_scene_accuracy(const Options& o) {
-    const Resolution display = parse_resolution(o.resolution);
+    const SceneCullerConfig config = scene_culler_config(o.cull);
     const Scene scene = load_scene(o.scene);
     const RayScene rays(scene);
     CameraPath views;
@@ -42,18 +43,24 @@ void run_scene_accuracy(const Options& o) {
     } else {
         throw Error("accuracy --scene needs views: --path P, --walk N or --orbit N");
     }
-    std::vector<std::uint32_t> ids = objects_with_role(scene, o.occluders == "role" ? "occluder" : "");
-    if (ids.empty()) ids = objects_with_role(scene, "");
-    const WorldTriangles occluders = gather_world_triangles(scene, ids);
+    SceneCuller culler(scene, choose_occluders(scene, o.cull.occluders), config);
+    const Resolution display = config.display;
+    const BufferConfig& buffer = culler.buffer().config();
     CullingTally tally;
     for (std::size_t k = 0; k < views.frames.size(); ++k) {
-        tally_culling(scene, rays, occluders, views.frames[k], display, o.samples, tally);
+        tally_culling(scene, rays, culler, views.frames[k], tally);
         if (!o.json) fmt::print(stderr, "\rview {}/{}", k + 1, views.frames.size());
     }
     if (!o.json) fmt::print(stderr, "\n");
     if (o.json) {
-        fmt::print("{}\n", nlohmann::json{{"scene", scene.source}, {"display", {display.width, display.height}}, {"samples", o.samples},
-                                          {"views", tally.views}, {"occluder_triangles", occluders.triangle_count()},
+        const double views_count = std::max(1, tally.views);
+        fmt::print("{}\n", nlohmann::json{{"scene", scene.source}, {"display", {display.width, display.height}},
+                                          {"buffer", {buffer.width, buffer.height}}, {"samples", buffer.samples},
+                                          {"mode", o.cull.mode}, {"hole", config.maps.hole_pixels}, {"depth", o.cull.depth},
+                                          {"views", tally.views}, {"occluder_triangles", culler.occluder_triangles()},
+                                          {"ms_per_view", {{"render", tally.total_ms.render_ms / views_count},
+                                                           {"maps", tally.total_ms.maps_ms / views_count},
+                                                           {"tests", tally.total_ms.test_ms / views_count}}},
                                           {"visible", tally.visible}, {"hidden_in_frustum", tally.hidden_in_frustum},
                                           {"culled_hidden", tally.culled_hidden}, {"missed_culls", tally.missed_culls()},
                                           {"false_culls", tally.false_culls}, {"robust_false_culls", tally.robust_false_culls},
@@ -61,9 +68,12 @@ void run_scene_accuracy(const Options& o) {
                                 .dump(1));
         return;
     }
-    fmt::print("{}: {} views at {}x{} (buffer {}x{}, {}x{} samples), {} occluder triangles\n", scene.source, tally.views,
-               display.width, display.height, display.width / o.samples, display.height / o.samples, o.samples, o.samples,
-               occluders.triangle_count());
+    fmt::print("{}: {} views at {}x{} (buffer {}x{}, {}x{} samples; {} mode, depth {}), {} occluder triangles\n", scene.source,
+               tally.views, display.width, display.height, buffer.width, buffer.height, buffer.samples, buffer.samples, o.cull.mode,
+               o.cull.depth, culler.occluder_triangles());
+    const double views_count = std::max(1, tally.views);
+    fmt::print("ms per view: render {:.3f}, maps {:.3f}, tests {:.3f}\n", tally.total_ms.render_ms / views_count,
+               tally.total_ms.maps_ms / views_count, tally.total_ms.test_ms / views_count);
     fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %), missed {}\n",
                tally.false_culls, tally.robust_false_culls, tally.culled_hidden, tally.hidden_in_frustum, 100.0 * tally.efficiency(),
                tally.missed_culls());
@@ -75,8 +85,9 @@ void run_scene_accuracy(const Options& o) {
 void register_accuracy(CLI::App& app) {
     struct Options {
         std::string resolution = "1920x1080", s1_folder = "../shared/workloads/s1";
-        std::string scene, path, occluders = "role";
+        std::string scene, path;
         int samples = 1, walk = 0, orbit = 0;
+        CullOptions cull;  // --scene
         bool json = false;
     };
     auto o = std::make_shared<Options>();
@@ -89,11 +100,12 @@ void register_accuracy(CLI::App& app) {
     cmd->add_option("--path", o->path, "--scene: camera path whose frames are the views");
     cmd->add_option("--walk", o->walk, "--scene: views from a generated walk (N views, every 10th frame)");
     cmd->add_option("--orbit", o->orbit, "--scene: N views on an orbit");
-    cmd->add_option("--occluders", o->occluders, "--scene: role (objects with role=occluder, or all if none has a role) or all")
-        ->capture_default_str()->check(CLI::IsMember({"role", "all"}));
+    add_cull_options(*cmd, o->cull, /*with_display=*/false);  // --scene: --buffer, --mode, --hole, --depth, --occluders, ...
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o] {
         if (!o->scene.empty()) {
+            o->cull.resolution = o->resolution;
+            o->cull.samples = o->samples;
             run_scene_accuracy(*o);
             return;
         }

@@ -10,5 +10,6 @@ void register_export(CLI::App& app);
 void register_path(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_accuracy(CLI::App& app);
+void register_cull(CLI::App& app);
 
 }  // namespace homcull::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     homcull::cli::register_path(app);
     homcull::cli::register_bench(app);
     homcull::cli::register_accuracy(app);
+    homcull::cli::register_cull(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

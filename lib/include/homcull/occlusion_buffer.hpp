@@ -27,6 +27,7 @@
 #include <vector>
 
 namespace homcull {
+class OcclusionMaps;
 namespace detail {
 struct RectQuery;
 struct SubtileView;
@@ -162,6 +163,7 @@ public:
     void read_depth(std::vector<float>& w) const;
 
 private:
+    friend class OcclusionMaps;  // reads the subtiles and shares the rectangle preparation
     BufferConfig config_;
     int sample_width_ = 0, sample_height_ = 0;
     int subtiles_x_ = 0, subtiles_y_ = 0;

@@ -3,7 +3,7 @@
 // checked with (DESIGN.md, "false cull", "missed cull", "culling efficiency").
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/truth/ground_truth.hpp>
-#include <homcull/world_triangles.hpp>
+#include <homcull/scene_culler.hpp>
 
 #include <string>
 #include <vector>
@@ -18,15 +18,13 @@ struct CullingTally {
     std::size_t false_culls = 0;        // seen, yet declared occluded or view-culled
     std::size_t robust_false_culls = 0; // of those, seen by at least one robust sample
     std::vector<std::string> false_cull_reports;  // one line each: view, object, samples
+    SceneCullTimings total_ms;                    // the culler's stage times, summed over views
     double efficiency() const { return hidden_in_frustum ? double(culled_hidden) / double(hidden_in_frustum) : 1.0; }
     std::size_t missed_culls() const { return hidden_in_frustum - culled_hidden; }
 };
 
-// Renders `occluders` (no backface culling: back faces are surfaces to ground truth) into a
-// buffer of display / samples pixels with samples x samples samples each, so that its samples
-// are the display's pixel centres; tests every object's world AABB; and tallies the answers
-// against ground truth cast at the display's pixel centres.
-void tally_culling(const Scene& scene, const RayScene& rays, const WorldTriangles& occluders, const Camera& camera,
-                   Resolution display, int samples, CullingTally& tally);
+// Culls the scene from `camera` with `culler` and tallies its answers against ground truth
+// cast at the display's pixel centres (the culler's display resolution).
+void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally);
 
 }  // namespace homcull

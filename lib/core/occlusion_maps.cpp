@@ -1,0 +1,323 @@
+// Hierarchical occlusion maps: the opacity pyramid and the hierarchical overlap test (Zhang
+// 1998, ch. 5), and the answers that combine overlap and depth. The depth maps are in
+// occlusion_maps_depth.cpp.
+//
+// The pyramid stores covered-sample counts, not averaged opacities: level k + 1 sums 2 x 2
+// cells of level k, so a cell's opacity is exactly its covered share (the 2 x 2 average where
+// all four children exist, the area-weighted one at odd borders), and the overlap test can
+// reason with whole samples: a cell with n samples, c covered, of which r lie in the
+// rectangle, leaves between max(0, r - c) and min(r, n - c) uncovered samples in it.
+#include <homcull/error.hpp>
+#include <homcull/occlusion_maps.hpp>
+
+#include "core/rect_tests.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace homcull {
+namespace {
+
+constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+
+// Bit count without a library call (the baseline x86-64 target has no popcnt instruction).
+int popcount(std::uint32_t v) {
+    v = v - ((v >> 1) & 0x55555555u);
+    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+    return int((((v + (v >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24);
+}
+
+}  // namespace
+
+OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config) : config_(config) {
+    const BufferConfig& b = buffer.config();
+    width_ = b.width;
+    height_ = b.height;
+    samples_ = b.samples;
+    near_w_ = b.near_w;
+    if (config.display_width < 1 || config.display_height < 1)
+        throw Error("occlusion maps: the display resolution must be at least 1x1");
+    if (!(config.hole_pixels >= 0.0) || !std::isfinite(config.hole_pixels))
+        throw Error("occlusion maps: the hole size must be a finite number of pixels >= 0");
+    if (!(config.distribution >= 1.0 && config.distribution <= 4.0))
+        throw Error("occlusion maps: the distribution factor D must be in [1, 4]");
+    if (!(config.transparency >= 0.0 && config.transparency < 1.0))
+        throw Error("occlusion maps: the transparency threshold must be in [0, 1)");
+    if (config.min_size < 1) throw Error("occlusion maps: the minimum pyramid size must be at least 1");
+    if (config.deb_width < 1 || config.deb_height < 1 || config.deb_width > 4096 || config.deb_height > 4096)
+        throw Error("occlusion maps: the depth estimation buffer must have 1 to 4096 cells per axis");
+
+    std::size_t size = 0;
+    int w = width_, h = height_;
+    for (;;) {
+        levels_.push_back({w, h, size});
+        size += std::size_t(w) * std::size_t(h);
+        if (w <= config.min_size && h <= config.min_size) break;
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+    const int last = int(levels_.size()) - 1;
+    if (config.finest_level < 0 || config.finest_level > last)
+        throw Error("occlusion maps: finest level " + std::to_string(config.finest_level) + " outside the pyramid's 0.." +
+                    std::to_string(last));
+    start_max_level_ = config.coarsest_level < 0 ? last : config.coarsest_level;
+    if (start_max_level_ < config.finest_level || start_max_level_ > last)
+        throw Error("occlusion maps: coarsest level must be -1 or in [finest level, " + std::to_string(last) + "]");
+    covered_.assign(size, 0u);
+    hzb_.assign(size, 0.0f);
+    nbz_.assign(size, 0.0f);
+    deb_.assign(std::size_t(config.deb_width) * std::size_t(config.deb_height), INFINITY);
+
+    // Display pixels per buffer pixel (m0 x m0) and samples per display pixel (area).
+    const double m0x = double(config.display_width) / double(width_), m0y = double(config.display_height) / double(height_);
+    samples_per_display_pixel_ = double(buffer.sample_width()) * double(buffer.sample_height()) /
+                                 (double(config.display_width) * double(config.display_height));
+    // Zhang 5.4: T0 = 1 - D L / (4 m0^2), T(k+1) = 1 - D (1 - Tk) / 4; transparency
+    // t(k+1) = D tk / 4. With L = 0 every opacity threshold is 1: only full cells are opaque.
+    const bool approximate = config.hole_pixels > 0.0;
+    double opacity = 1.0 - config.distribution * config.hole_pixels / (4.0 * m0x * m0y);
+    double transparency = approximate ? config.transparency : 0.0;
+    for (std::size_t k = 0; k < levels_.size(); ++k) {
+        opacity_threshold_.push_back(std::clamp(opacity, 0.0, 1.0));
+        transparency_threshold_.push_back(transparency);
+        opacity = 1.0 - config.distribution * (1.0 - opacity) / 4.0;
+        transparency = config.distribution * transparency / 4.0;
+    }
+}
+
+std::uint32_t OcclusionMaps::cell_samples(int k, int x, int y) const {
+    const int px0 = x << k, py0 = y << k;
+    const int px1 = std::min((x + 1) << k, width_), py1 = std::min((y + 1) << k, height_);
+    return std::uint32_t(px1 - px0) * std::uint32_t(py1 - py0) * std::uint32_t(samples_ * samples_);
+}
+
+float OcclusionMaps::opacity(int k, int x, int y) const {
+    const Level& l = levels_[std::size_t(k)];
+    return float(covered_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)]) / float(cell_samples(k, x, y));
+}
+
+void OcclusionMaps::build(const OcclusionBuffer& buffer) {
+    if (buffer.config().width != width_ || buffer.config().height != height_ || buffer.config().samples != samples_)
+        throw Error("occlusion maps: build() needs a buffer shaped like the one the maps were made for");
+    // Level 0: per buffer pixel, its covered samples, and the farthest and nearest bound of
+    // those samples (a sample in a subtile's working mask is bounded by max(d0, d1), any
+    // other by d0; see OcclusionBuffer). Pixels without covered samples get +inf ("no
+    // occluder"): the depth maps ignore the background, the overlap test decides coverage.
+    const int s = samples_, pixels_x = kW / s, pixels_y = kH / s;  // pixels per subtile (s is 1, 2 or 4)
+    std::uint32_t pixel_bits[kW * kH];  // each pixel's samples in a subtile, row-major
+    for (int py = 0; py < pixels_y; ++py)
+        for (int px = 0; px < pixels_x; ++px) {
+            std::uint32_t bits = 0;
+            for (int r = 0; r < s; ++r) bits |= ((0xFFu >> (kW - s)) << (px * s)) << ((py * s + r) * kW);
+            pixel_bits[py * pixels_x + px] = bits;
+        }
+    for (int ty = 0; ty < buffer.subtiles_y(); ++ty) {
+        const int rows = std::min(pixels_y, height_ - ty * pixels_y);
+        for (int tx = 0; tx < buffer.subtiles_x(); ++tx) {
+            const std::size_t i = buffer.at(tx, ty);
+            const std::uint32_t cov = buffer.covered_[i], mask = buffer.mask_[i];
+            const float d0 = buffer.d0_[i], layered = std::max(d0, buffer.d1_[i]);
+            const int columns = std::min(pixels_x, width_ - tx * pixels_x);
+            for (int py = 0; py < rows; ++py) {
+                const std::size_t row = std::size_t(ty * pixels_y + py) * std::size_t(width_) + std::size_t(tx * pixels_x);
+                for (int px = 0; px < columns; ++px) {
+                    const std::uint32_t c = cov & pixel_bits[py * pixels_x + px];
+                    const bool outside_mask = (c & ~mask) != 0, inside_mask = (c & mask) != 0;
+                    covered_[row + std::size_t(px)] = std::uint32_t(popcount(c));
+                    hzb_[row + std::size_t(px)] = outside_mask ? d0 : inside_mask ? layered : INFINITY;  // d0 <= layered
+                    nbz_[row + std::size_t(px)] = inside_mask ? layered : outside_mask ? d0 : INFINITY;
+                }
+            }
+        }
+    }
+    // Levels 1..: sums of covered samples, minimum (farthest) of the depth maps.
+    for (std::size_t k = 1; k < levels_.size(); ++k) {
+        const Level& below = levels_[k - 1];
+        const Level& here = levels_[k];
+        for (int y = 0; y < here.height; ++y) {
+            // The two rows of children (the second repeats the first at an odd bottom edge,
+            // and a missing right child repeats the left one: min is unaffected, sums skip it).
+            const int y0 = 2 * y, y1 = std::min(2 * y + 1, below.height - 1);
+            const std::size_t r0 = below.offset + std::size_t(y0) * std::size_t(below.width);
+            const std::size_t r1 = below.offset + std::size_t(y1) * std::size_t(below.width);
+            const std::uint32_t second_row = y1 != y0 ? 1u : 0u;
+            const std::size_t out = here.offset + std::size_t(y) * std::size_t(here.width);
+            for (int x = 0; x < here.width; ++x) {
+                const std::size_t a = std::size_t(2 * x), b = std::size_t(std::min(2 * x + 1, below.width - 1));
+                const std::uint32_t second_column = b != a ? 1u : 0u;
+                covered_[out + std::size_t(x)] = covered_[r0 + a] + second_column * covered_[r0 + b] +
+                                                 second_row * (covered_[r1 + a] + second_column * covered_[r1 + b]);
+                hzb_[out + std::size_t(x)] = std::min(std::min(hzb_[r0 + a], hzb_[r0 + b]), std::min(hzb_[r1 + a], hzb_[r1 + b]));
+                nbz_[out + std::size_t(x)] = std::min(std::min(nbz_[r0 + a], nbz_[r0 + b]), std::min(nbz_[r1 + a], nbz_[r1 + b]));
+            }
+        }
+    }
+    const Level& top = levels_.back();
+    plane_ = *std::min_element(hzb_.begin() + std::ptrdiff_t(top.offset), hzb_.end());
+}
+
+// The overlap test's state: the rectangle in samples, the hole budget left (samples that may
+// stay uncovered), and how the test ended.
+struct OcclusionMaps::OverlapQuery {
+    const OcclusionBuffer* buffer;
+    int i0, i1, j0, j1;
+    double budget;
+    OverlapExit exit = OverlapExit::passed;
+};
+
+namespace {
+
+// Uncovered samples of [i0, i1] x [j0, j1] (exact, from the coverage masks).
+std::uint32_t uncovered_samples(const OcclusionBuffer& b, int i0, int i1, int j0, int j1) {
+    std::uint32_t count = 0;
+    for (int ty = j0 / kH; ty <= j1 / kH; ++ty)
+        for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {
+            const int c0 = std::max(0, i0 - tx * kW), c1 = std::min(kW - 1, i1 - tx * kW);
+            const int r0 = std::max(0, j0 - ty * kH), r1 = std::min(kH - 1, j1 - ty * kH);
+            const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
+            std::uint32_t rect = 0;
+            for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
+            count += std::uint32_t(popcount(rect & ~b.subtile(tx, ty).covered));
+        }
+    return count;
+}
+
+}  // namespace
+
+// One cell of the hierarchical overlap test (Zhang 5.3, Fig. 5.3). Returns false when the
+// rectangle is rejected (not inside the occluders' projection, within the hole budget).
+bool OcclusionMaps::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
+    const int s = samples_;
+    const int sx0 = (x << k) * s, sy0 = (y << k) * s;
+    const int sx1 = std::min((x + 1) << k, width_) * s - 1, sy1 = std::min((y + 1) << k, height_) * s - 1;
+    const int ox0 = std::max(sx0, q.i0), ox1 = std::min(sx1, q.i1), oy0 = std::max(sy0, q.j0), oy1 = std::min(sy1, q.j1);
+    if (ox0 > ox1 || oy0 > oy1) return true;  // the rectangle misses this cell
+    const Level& l = levels_[std::size_t(k)];
+    const double n = double(cell_samples(k, x, y));
+    const double c = double(covered_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)]);
+    const double r = double(ox1 - ox0 + 1) * double(oy1 - oy0 + 1);
+    const double holes = n - c;
+    if (holes == 0.0) return true;  // opaque: nothing to add
+    const double opacity = c / n;
+    // Transparency threshold: a cell this empty counts as empty (approximate mode).
+    if (opacity <= transparency_threshold_[std::size_t(k)]) {  // 0 in conservative mode: an empty cell
+        if (r > q.budget) {
+            q.exit = OverlapExit::transparent_cell;
+            return false;
+        }
+        q.budget -= r;
+        return true;
+    }
+    // At least max(0, r - c) holes lie in the rectangle. The rectangle holding the whole cell
+    // (conservative rejection: at or below the transparency threshold 1 - budget / n) or more
+    // holes than fit outside the rectangle (predictive rejection) is decided here.
+    const double least = std::max(0.0, r - c);
+    if (least > q.budget) {
+        q.exit = r == n ? OverlapExit::conservative_rejection : OverlapExit::predictive_rejection;
+        return false;
+    }
+    const double most = std::min(r, holes);
+    // Opaque enough for this level (Zhang's opacity threshold), and its holes fit the budget.
+    if (opacity >= opacity_threshold_[std::size_t(k)] && most <= q.budget) {
+        q.budget -= most;
+        return true;
+    }
+    if (least == most) {  // the count is known: a transparent cell, or one the rectangle holds
+        q.budget -= least;
+        return true;
+    }
+    if (k == config_.finest_level) {
+        if (k == 0 && s > 1) {  // one pixel: count its samples in the rectangle
+            const double exact = double(uncovered_samples(*q.buffer, ox0, ox1, oy0, oy1));
+            if (exact > q.budget) {
+                q.exit = OverlapExit::samples;
+                return false;
+            }
+            q.budget -= exact;
+            return true;
+        }
+        if (most > q.budget) {  // cannot look closer: charge every hole it may have
+            q.exit = OverlapExit::finest_level;
+            return false;
+        }
+        q.budget -= most;
+        return true;
+    }
+    const Level& below = levels_[std::size_t(k) - 1];
+    for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx) {
+            const int cx = 2 * x + dx, cy = 2 * y + dy;
+            if (cx < below.width && cy < below.height && !overlap_cell(q, k - 1, cx, cy)) return false;
+        }
+    return true;
+}
+
+void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, OccludeeAnswer& answer,
+                            double& uncovered) const {
+    // Start at the finest level whose cells are at least as large as the rectangle's smaller
+    // side, within the active levels.
+    const int smaller_side = std::min(i1 - i0 + 1, j1 - j0 + 1);
+    int k = config_.finest_level;
+    while (k < start_max_level_ && (samples_ << k) < smaller_side) ++k;
+    const Level& l = levels_[std::size_t(k)];
+    const int px0 = i0 / samples_ >> k, px1 = i1 / samples_ >> k, py0 = j0 / samples_ >> k, py1 = j1 / samples_ >> k;
+
+    // Level of visibility estimate at the start level: each cell's uncovered share, spread
+    // evenly over it, times the rectangle's part of it.
+    const double rect_samples = double(i1 - i0 + 1) * double(j1 - j0 + 1);
+    double estimate = 0.0;
+    for (int y = py0; y <= std::min(py1, l.height - 1); ++y)
+        for (int x = px0; x <= std::min(px1, l.width - 1); ++x) {
+            const int s = samples_;
+            const int sx0 = (x << k) * s, sy0 = (y << k) * s;
+            const int sx1 = std::min((x + 1) << k, width_) * s - 1, sy1 = std::min((y + 1) << k, height_) * s - 1;
+            const double r = double(std::min(sx1, i1) - std::max(sx0, i0) + 1) * double(std::min(sy1, j1) - std::max(sy0, j0) + 1);
+            const double n = double(cell_samples(k, x, y));
+            estimate += r * (n - double(covered_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)])) / n;
+        }
+    answer.level_of_visibility = float(std::clamp(estimate / rect_samples, 0.0, 1.0));
+
+    const double budget = std::floor(config_.hole_pixels * samples_per_display_pixel_);
+    OverlapQuery q{&buffer, i0, i1, j0, j1, budget};
+    for (int y = py0; y <= py1 && q.exit == OverlapExit::passed; ++y)
+        for (int x = px0; x <= px1; ++x)
+            if (!overlap_cell(q, k, x, y)) break;
+    answer.overlap_exit = std::uint8_t(q.exit);
+    uncovered = budget - q.budget;
+}
+
+OccludeeAnswer OcclusionMaps::test_rect(const OcclusionBuffer& buffer, const ScreenRect& rect) const {
+    OccludeeAnswer answer;
+    detail::RectQuery q;
+    Visibility decided;
+    if (!buffer.prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided)) {
+        answer.visibility = decided;
+        answer.level_of_visibility = decided == Visibility::visible ? 1.0f : 0.0f;
+        return answer;
+    }
+    double uncovered = 0.0;
+    overlap(buffer, q.i0, q.i1, q.j0, q.j1, answer, uncovered);
+    if (answer.overlap_exit != std::uint8_t(OverlapExit::passed)) return answer;  // visible
+    if (!depth_hidden(buffer, q.i0, q.i1, q.j0, q.j1, q.d_near)) {
+        answer.level_of_visibility = 1.0f;  // in front of the occluders somewhere: no estimate
+        return answer;
+    }
+    answer.visibility = Visibility::occluded;
+    answer.level_of_visibility = float(uncovered / (double(q.i1 - q.i0 + 1) * double(q.j1 - q.j0 + 1)));
+    return answer;
+}
+
+OccludeeAnswer OcclusionMaps::test_aabb(const OcclusionBuffer& buffer, const Aabb& box, const std::array<float, 16>& m) const {
+    ScreenRect r;
+    Visibility decided;
+    if (!detail::box_rectangle(&box.min.x, &box.max.x, m, buffer.config().near_w, r, decided)) {
+        OccludeeAnswer answer;
+        answer.visibility = decided;
+        answer.level_of_visibility = decided == Visibility::visible ? 1.0f : 0.0f;
+        return answer;
+    }
+    return test_rect(buffer, r);
+}
+
+}  // namespace homcull

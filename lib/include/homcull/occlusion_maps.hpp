@@ -1,0 +1,143 @@
+#pragma once
+// Hierarchical occlusion maps (Hansong Zhang, "Effective Occlusion Culling for the Interactive
+// Display of Arbitrary Models", UNC 1998, ch. 4-6; Zhang, Manocha, Hudson, Hoff, "Visibility
+// Culling using Hierarchical Occlusion Maps", SIGGRAPH 1997) on top of the occlusion buffer.
+//
+// An occludee is hidden when two tests pass:
+//   overlap: its screen rectangle lies inside the occluders' cumulative projection, asked of an
+//            opacity pyramid built from the buffer's coverage masks (level 0: one value per
+//            buffer pixel, covered samples / S^2; level k + 1: 2 x 2 cells of level k);
+//   depth:   it lies behind the occluders there, asked of one of several depth
+//            representations (DepthTest).
+// Conservative mode (hole_pixels = 0) never hides an occludee that has a sample of the
+// buffer's grid in its rectangle not covered by an occluder nearer than it. Approximate mode
+// tolerates up to hole_pixels display pixels of holes in the rectangle. See
+// docs/occlusion-maps.md for the thresholds, the early terminations and which overlap x
+// depth combinations are conservative.
+#include <homcull/occlusion_buffer.hpp>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace homcull {
+
+enum class DepthTest : std::uint8_t {
+    masked,  // the buffer's own per-subtile layers, per sample (MOC's test; conservative)
+    hzb,     // per-pixel farthest depth of the covered samples + min pyramid (Greene; conservative)
+    deb,     // depth estimation buffer: far rectangles of occluder boxes (Zhang; conservative)
+    nbz,     // no-background Z-buffer: per-pixel nearest depth of the covered samples (Zhang;
+             // NOT conservative when a pixel's samples lie on occluders at different depths)
+    plane,   // one plane at the farthest covered depth (Zhang's single depth; conservative)
+};
+
+struct OcclusionMapsConfig {
+    // The display the answers must be right for, in pixels. A display pixel is
+    // (buffer samples per axis) / (display pixels per axis) samples wide: the hole size and
+    // the level-0 opacity thresholds are converted with it.
+    int display_width = 0, display_height = 0;
+    // Approximate culling (Zhang 5.4): the largest negligible hole, in display pixels (area).
+    // 0 = conservative.
+    double hole_pixels = 0.0;
+    // Zhang's distribution factor D in [1, 4]: how spread out the holes of a pyramid cell are
+    // assumed to be. It scales the per-level opacity thresholds (see opacity_threshold()).
+    double distribution = 1.0;
+    // Zhang's transparency threshold at level 0, in [0, 1): a cell at or below it counts as
+    // empty (approximate mode only; 0 in conservative mode). Coarser levels use D * t / 4.
+    double transparency = 0.0;
+    // Active levels of the opacity pyramid: the overlap test never starts above
+    // coarsest_level and never descends below finest_level (where it then charges the whole
+    // cell's holes). -1: the pyramid's last level.
+    int finest_level = 0, coarsest_level = -1;
+    // The pyramid stops at the first level with both sides at most this many cells.
+    int min_size = 4;
+    // Depth estimation buffer cells (Zhang 6.2; 64 x 64 by default).
+    int deb_width = 64, deb_height = 64;
+    DepthTest depth = DepthTest::masked;
+};
+
+// What an occludee test answers. level_of_visibility estimates the share of the occludee's
+// rectangle that is not covered by occluders in front of it (0: none, 1: all), from the
+// opacity pyramid: an engine can pick a coarser level of detail for a barely visible object.
+struct OccludeeAnswer {
+    Visibility visibility = Visibility::visible;
+    float level_of_visibility = 1.0f;
+    // Which early termination decided the overlap test (OverlapExit), for statistics and tests.
+    std::uint8_t overlap_exit = 0;
+};
+
+// How the overlap test ended.
+enum class OverlapExit : std::uint8_t {
+    not_run = 0,
+    passed,                  // every cell visited was opaque enough, holes within the budget
+    conservative_rejection,  // a cell the rectangle contains has more holes than the budget
+    predictive_rejection,    // a cell partly in the rectangle has more holes than fit outside it
+    transparent_cell,        // a cell at or below the transparency threshold
+    finest_level,            // the finest active level, still uncertain: its holes charged
+    samples,                 // decided by the coverage masks of one pixel
+};
+
+class OcclusionMaps {
+public:
+    // Allocates the pyramids for buffers shaped like `buffer` (its pixel grid and samples).
+    // Throws homcull::Error on an invalid configuration.
+    OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config);
+
+    // Per frame: clear() forgets the occluder boxes of the depth estimation buffer;
+    // add_occluder_box() enters one (its far rectangle, Zhang 6.2.1); build() derives the
+    // opacity pyramid and the depth maps from a rendered buffer. No allocation.
+    void clear();
+    void add_occluder_box(const Aabb& box, const std::array<float, 16>& model_to_clip);
+    void build(const OcclusionBuffer& buffer);
+
+    // Occludee tests. Thread-safe with each other once build() has returned. The buffer must
+    // be the one given to build(), unchanged since.
+    OccludeeAnswer test_rect(const OcclusionBuffer& buffer, const ScreenRect& rect) const;
+    OccludeeAnswer test_aabb(const OcclusionBuffer& buffer, const Aabb& box, const std::array<float, 16>& model_to_clip) const;
+
+    const OcclusionMapsConfig& config() const { return config_; }
+    // The opacity pyramid, for dumps and tests: level k is level_width(k) x level_height(k)
+    // cells of 2^k x 2^k buffer pixels; covered_samples(k) and cell_samples(k) row-major.
+    int levels() const { return int(levels_.size()); }
+    int level_width(int k) const { return levels_[std::size_t(k)].width; }
+    int level_height(int k) const { return levels_[std::size_t(k)].height; }
+    const std::uint32_t* covered_samples(int k) const { return covered_.data() + levels_[std::size_t(k)].offset; }
+    // Samples in a cell of level k inside the buffer (border cells may have fewer).
+    std::uint32_t cell_samples(int k, int x, int y) const;
+    float opacity(int k, int x, int y) const;
+    // Per-level thresholds in force (Zhang 5.4): a cell with opacity >= opacity_threshold(k)
+    // is opaque enough; one with opacity <= transparency_threshold(k) counts as empty.
+    double opacity_threshold(int k) const { return opacity_threshold_[std::size_t(k)]; }
+    double transparency_threshold(int k) const { return transparency_threshold_[std::size_t(k)]; }
+    // Depth maps as 1/w per cell (larger is nearer; +inf where no occluder covers anything):
+    // the farthest (hzb) and nearest (nbz) depth of the covered samples of each pixel, with
+    // their min pyramids on the opacity pyramid's levels, and the depth estimation buffer.
+    const float* farthest_depth(int k) const { return hzb_.data() + levels_[std::size_t(k)].offset; }
+    const float* nearest_depth(int k) const { return nbz_.data() + levels_[std::size_t(k)].offset; }
+    const std::vector<float>& depth_estimation() const { return deb_; }
+    float plane_depth() const { return plane_; }
+
+private:
+    struct Level {
+        int width, height;
+        std::size_t offset;
+    };
+    OcclusionMapsConfig config_;
+    int width_ = 0, height_ = 0, samples_ = 1;  // buffer pixels and samples per axis
+    float near_w_ = 0.1f;
+    double samples_per_display_pixel_ = 1.0;
+    std::vector<Level> levels_;
+    std::vector<std::uint32_t> covered_;
+    std::vector<float> hzb_, nbz_, deb_;
+    float plane_ = 0.0f;
+    std::vector<double> opacity_threshold_, transparency_threshold_;
+    int start_max_level_ = 0;
+
+    struct OverlapQuery;
+    bool overlap_cell(OverlapQuery& q, int k, int x, int y) const;
+    void overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, OccludeeAnswer& answer, double& uncovered) const;
+    bool depth_hidden(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, float d_near) const;
+    bool min_pyramid_above(const std::vector<float>& pyramid, int k, int x, int y, int x0, int y0, int x1, int y1, float d) const;
+};
+
+}  // namespace homcull

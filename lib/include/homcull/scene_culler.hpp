@@ -1,0 +1,70 @@
+#pragma once
+// Culling a scene's objects from one camera with hierarchical occlusion maps: render the
+// chosen occluders into an occlusion buffer, build the maps, test every object's world box.
+// One SceneCuller is reused frame after frame: the buffer, the maps and the occluder triangles
+// are allocated once.
+#include <homcull/occlusion_maps.hpp>
+#include <homcull/scene.hpp>
+#include <homcull/world_triangles.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace homcull {
+
+struct SceneCullerConfig {
+    Resolution display{1280, 720};
+    // Buffer pixels; 0 x 0 means display / samples, whose samples are the display's pixel
+    // centres. Conservative mode (maps.hole_pixels = 0) requires exactly that: a coverage
+    // sample elsewhere says nothing about the display's pixel centres.
+    Resolution buffer{0, 0};
+    int samples = 1;
+    OcclusionMapsConfig maps;  // display_width/height are taken from `display`
+    // Back faces are surfaces to ground truth and to the eye: none are culled by default.
+    Backface backface = Backface::none;
+};
+
+struct SceneCullTimings {
+    double render_ms = 0.0;  // occluder triangles into the buffer
+    double maps_ms = 0.0;    // opacity pyramid, depth maps, depth estimation buffer
+    double test_ms = 0.0;    // every object's box
+};
+
+// How many objects each overlap-test exit decided (indexed by OverlapExit).
+struct OverlapExitCounts {
+    std::uint64_t count[7] = {};
+};
+
+class SceneCuller {
+public:
+    // `occluders`: object ids whose triangles are rendered (gathered once, here).
+    // Throws homcull::Error on an invalid configuration.
+    SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config);
+
+    // answers[id] for every object of the scene (objects without geometry are view-culled).
+    void cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
+
+    const SceneCullerConfig& config() const { return config_; }
+    const OcclusionBuffer& buffer() const { return buffer_; }
+    const OcclusionMaps& maps() const { return maps_; }
+    const SceneCullTimings& timings() const { return timings_; }
+    const OverlapExitCounts& overlap_exits() const { return exits_; }
+    std::size_t occluder_objects() const { return occluder_ids_.size(); }
+    std::size_t occluder_triangles() const { return occluders_.triangle_count(); }
+
+private:
+    const Scene* scene_;
+    SceneCullerConfig config_;
+    std::vector<std::uint32_t> occluder_ids_;
+    WorldTriangles occluders_;
+    OcclusionBuffer buffer_;
+    OcclusionMaps maps_;
+    SceneCullTimings timings_;
+    OverlapExitCounts exits_;
+};
+
+// The buffer configuration a SceneCullerConfig asks for (resolved buffer size), for callers
+// that want to check it before building a culler. Throws homcull::Error when invalid.
+BufferConfig scene_buffer_config(const SceneCullerConfig& config, float near_w);
+
+}  // namespace homcull

@@ -1,0 +1,325 @@
+// Hierarchical occlusion maps on hand-built buffers: the opacity pyramid, every early
+// termination of the overlap test, approximate culling's hole size, the depth tests (and the
+// one that is not conservative), and a property test of the conservative overlap test against
+// brute-force coverage.
+#include "support.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/occlusion_maps.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace homcull {
+namespace {
+
+// Axis-aligned occluder rectangles given in buffer pixels (fractions reach single samples),
+// each two triangles whose diagonal is flagged as shared, so the pixels it crosses stay covered.
+struct Occluders {
+    int width, height;  // buffer pixels
+    std::vector<float> xyzw;
+    std::vector<std::uint8_t> shared;
+    void add(double x0, double y0, double x1, double y1, float w) {
+        auto vertex = [&](double px, double py) {
+            const float x = float(px / width * 2.0 - 1.0), y = float(1.0 - py / height * 2.0);
+            xyzw.insert(xyzw.end(), {x * w, y * w, 0.0f, w});
+        };
+        vertex(x0, y0), vertex(x1, y0), vertex(x1, y1);  // edge 2 (x1,y1 -> x0,y0) is the diagonal
+        vertex(x0, y0), vertex(x1, y1), vertex(x0, y1);  // edge 0 (x0,y0 -> x1,y1) is the diagonal
+        shared.push_back(4u);
+        shared.push_back(1u);
+    }
+    TriangleInput input() const {
+        TriangleInput in = test::clip_space_input(xyzw);
+        in.shared_edges = shared.data();
+        return in;
+    }
+};
+
+// A screen rectangle over buffer pixels [x0, x1) x [y0, y1) (fractions: samples) at depth w.
+ScreenRect pixel_rect(int width, int height, double x0, double y0, double x1, double y1, float w) {
+    return {float(x0 / width * 2.0 - 1.0), float(1.0 - y1 / height * 2.0), float(x1 / width * 2.0 - 1.0),
+            float(1.0 - y0 / height * 2.0), w};
+}
+
+OcclusionBuffer buffer_of(int width, int height, int samples, const Occluders& occluders) {
+    BufferConfig c;
+    c.width = width;
+    c.height = height;
+    c.samples = samples;
+    c.near_w = 0.5f;
+    OcclusionBuffer buffer(c);
+    if (!occluders.xyzw.empty()) buffer.render(occluders.input());
+    return buffer;
+}
+
+OcclusionMapsConfig maps_config(const OcclusionBuffer& b, DepthTest depth = DepthTest::masked, double hole = 0.0) {
+    OcclusionMapsConfig c;
+    c.display_width = b.sample_width();
+    c.display_height = b.sample_height();
+    c.depth = depth;
+    c.hole_pixels = hole;
+    return c;
+}
+
+// Boxes given in clip space as (x, y, w): (x, y, z) -> (x, y, 0, z), column-major.
+const std::array<float, 16> kXyw = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0};
+
+OverlapExit exit_of(const OccludeeAnswer& a) { return OverlapExit(a.overlap_exit); }
+
+TEST(OcclusionMaps, OpacityPyramidCountsCoveredSamplesOnOddSizes) {
+    for (int s : {1, 2, 4}) {
+        const int width = 37, height = 23;  // odd at every level
+        Occluders o{width, height, {}, {}};
+        o.add(3.25, 2.5, 30.0, 9.75, 5.0f);
+        o.add(10.0, 12.0, 36.5, 22.0, 7.0f);
+        const OcclusionBuffer buffer = buffer_of(width, height, s, o);
+        OcclusionMaps maps(buffer, maps_config(buffer));
+        maps.build(buffer);
+        std::vector<std::uint8_t> covered;
+        buffer.read_coverage(covered);
+        for (int k = 0; k < maps.levels(); ++k)
+            for (int y = 0; y < maps.level_height(k); ++y)
+                for (int x = 0; x < maps.level_width(k); ++x) {
+                    std::uint32_t count = 0, samples = 0;
+                    for (int sy = (y << k) * s; sy < std::min((y + 1) << k, height) * s; ++sy)
+                        for (int sx = (x << k) * s; sx < std::min((x + 1) << k, width) * s; ++sx) {
+                            count += covered[std::size_t(sy) * std::size_t(width * s) + std::size_t(sx)];
+                            ++samples;
+                        }
+                    ASSERT_EQ(maps.covered_samples(k)[y * maps.level_width(k) + x], count) << "S " << s << " level " << k;
+                    ASSERT_EQ(maps.cell_samples(k, x, y), samples);
+                }
+        const int last = maps.levels() - 1;
+        EXPECT_LE(maps.level_width(last), 4);
+        EXPECT_LE(maps.level_height(last), 4);
+    }
+}
+
+TEST(OcclusionMaps, ThresholdsFollowZhang) {
+    const OcclusionBuffer buffer = buffer_of(64, 64, 1, Occluders{64, 64, {}, {}});
+    OcclusionMapsConfig c = maps_config(buffer);
+    const OcclusionMaps conservative(buffer, c);
+    for (int k = 0; k < conservative.levels(); ++k) {
+        EXPECT_EQ(conservative.opacity_threshold(k), 1.0);
+        EXPECT_EQ(conservative.transparency_threshold(k), 0.0);
+    }
+    c.display_width = c.display_height = 128;  // m0 = 2 display pixels per buffer pixel
+    c.hole_pixels = 2.0;
+    c.distribution = 2.0;
+    c.transparency = 0.4;
+    const OcclusionMaps approximate(buffer, c);
+    double t = 1.0 - 2.0 * 2.0 / (4.0 * 4.0), tt = 0.4;  // T0 = 1 - D L / (4 m0^2)
+    for (int k = 0; k < approximate.levels(); ++k) {
+        EXPECT_DOUBLE_EQ(approximate.opacity_threshold(k), t);
+        EXPECT_DOUBLE_EQ(approximate.transparency_threshold(k), tt);
+        t = 1.0 - 2.0 * (1.0 - t) / 4.0;
+        tt = 2.0 * tt / 4.0;
+    }
+}
+
+// 64 x 64 pixels, everything covered at w = 4 except pixel (10, 10).
+TEST(OcclusionMaps, OverlapPassesAndConservativeRejection) {
+    Occluders o{64, 64, {}, {}};
+    o.add(0, 0, 64, 10, 4.0f);
+    o.add(0, 11, 64, 64, 4.0f);
+    o.add(0, 10, 10, 11, 4.0f);
+    o.add(11, 10, 64, 11, 4.0f);
+    const OcclusionBuffer buffer = buffer_of(64, 64, 1, o);
+    OcclusionMaps maps(buffer, maps_config(buffer));
+    maps.build(buffer);
+    // Inside the covered part, behind it: passes, occluded.
+    OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(64, 64, 32, 32, 64, 64, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::passed);
+    EXPECT_EQ(a.visibility, Visibility::occluded);
+    EXPECT_EQ(a.level_of_visibility, 0.0f);
+    // In front of it: the overlap passes, the depth test does not.
+    a = maps.test_rect(buffer, pixel_rect(64, 64, 32, 32, 64, 64, 2.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::passed);
+    EXPECT_EQ(a.visibility, Visibility::visible);
+    // The 32 x 32 cell holding the hole, whole: conservative rejection at the start level.
+    a = maps.test_rect(buffer, pixel_rect(64, 64, 0, 0, 32, 32, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::conservative_rejection);
+    EXPECT_EQ(a.visibility, Visibility::visible);
+    EXPECT_NEAR(a.level_of_visibility, 1.0 / 1024.0, 1e-7);
+    // Partly over the hole's cell but not over the hole: descends and passes.
+    a = maps.test_rect(buffer, pixel_rect(64, 64, 12, 12, 44, 44, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::passed);
+    EXPECT_EQ(a.visibility, Visibility::occluded);
+}
+
+TEST(OcclusionMaps, PredictiveRejectionAndTransparentCells) {
+    Occluders o{64, 64, {}, {}};
+    o.add(0, 0, 10, 10, 4.0f);  // 100 of the 256 pixels of the 16 x 16 cell (0, 0)
+    const OcclusionBuffer buffer = buffer_of(64, 64, 1, o);
+    OcclusionMaps maps(buffer, maps_config(buffer));
+    maps.build(buffer);
+    // 144 pixels of that cell in the rectangle, only 100 covered: some hole must be inside.
+    OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(64, 64, 4, 4, 20, 20, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::predictive_rejection);
+    // Nothing covered at all where the rectangle is.
+    a = maps.test_rect(buffer, pixel_rect(64, 64, 40, 40, 50, 50, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::transparent_cell);
+    EXPECT_EQ(a.level_of_visibility, 1.0f);
+    // Inside the covered square: passes after descending.
+    a = maps.test_rect(buffer, pixel_rect(64, 64, 1, 1, 9, 9, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::passed);
+    EXPECT_EQ(a.visibility, Visibility::occluded);
+}
+
+TEST(OcclusionMaps, SamplesDecideWithinAPixel) {
+    // S = 4: the sample rows above 22 are covered, so pixel row 5 is half covered (its top two
+    // sample rows).
+    Occluders o{16, 16, {}, {}};
+    o.add(0, 0, 16, 5.5, 4.0f);
+    const OcclusionBuffer buffer = buffer_of(16, 16, 4, o);
+    OcclusionMaps maps(buffer, maps_config(buffer));
+    maps.build(buffer);
+    // The covered half of pixel (5, 5): passes by its samples.
+    OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(16, 16, 5.0, 5.0, 6.0, 5.5, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::passed);
+    EXPECT_EQ(a.visibility, Visibility::occluded);
+    // Its left half, rows of both halves: 8 samples as many as are covered, 4 of them not.
+    a = maps.test_rect(buffer, pixel_rect(16, 16, 5.0, 5.0, 5.5, 6.0, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::samples);
+    EXPECT_EQ(a.visibility, Visibility::visible);
+}
+
+TEST(OcclusionMaps, FinestActiveLevelChargesItsHoles) {
+    Occluders o{64, 64, {}, {}};
+    o.add(0, 0, 10, 64, 4.0f);  // columns 0..9 covered
+    const OcclusionBuffer buffer = buffer_of(64, 64, 1, o);
+    OcclusionMapsConfig c = maps_config(buffer);
+    c.finest_level = 3;  // cells of 8 x 8 pixels: column 8..15 is a half-covered cell
+    OcclusionMaps maps(buffer, c);
+    maps.build(buffer);
+    const OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(64, 64, 0, 0, 10, 8, 8.0f));
+    EXPECT_EQ(exit_of(a), OverlapExit::finest_level);
+    EXPECT_EQ(a.visibility, Visibility::visible);
+    // With every level active the same rectangle is found covered.
+    OcclusionMaps all(buffer, maps_config(buffer));
+    all.build(buffer);
+    EXPECT_EQ(all.test_rect(buffer, pixel_rect(64, 64, 0, 0, 10, 8, 8.0f)).visibility, Visibility::occluded);
+}
+
+// A wall at w = 4 with a square hole of side `hole` pixels, and an occludee at w = 8 whose
+// rectangle holds the hole: approximate culling with L = 16 pixels hides it behind a hole of
+// 16 pixels and keeps it behind one of 25; conservative mode keeps it behind any hole.
+TEST(OcclusionMaps, ApproximateCullingToleratesHolesUpToL) {
+    for (DepthTest depth : {DepthTest::masked, DepthTest::hzb, DepthTest::nbz, DepthTest::plane, DepthTest::deb})
+        for (int hole : {0, 1, 4, 5, 8}) {
+            Occluders o{128, 128, {}, {}};
+            const int h0 = 50, h1 = 50 + hole;
+            o.add(0, 0, 128, h0, 4.0f);
+            o.add(0, h1, 128, 128, 4.0f);
+            o.add(0, h0, h0, h1, 4.0f);
+            o.add(h1, h0, 128, h1, 4.0f);
+            const OcclusionBuffer buffer = buffer_of(128, 128, 1, o);
+            const ScreenRect behind = pixel_rect(128, 128, 30, 30, 90, 90, 8.0f);
+            for (double L : {0.0, 16.0}) {
+                OcclusionMaps maps(buffer, maps_config(buffer, depth, L));
+                maps.clear();
+                maps.add_occluder_box({glm::vec3(-4.0f, -4.0f, 4.0f), glm::vec3(4.0f, 4.0f, 4.0f)}, kXyw);  // the wall's box
+                maps.build(buffer);
+                const OccludeeAnswer a = maps.test_rect(buffer, behind);
+                const bool hidden = hole == 0 || (L > 0.0 && hole * hole <= L);
+                EXPECT_EQ(a.visibility, hidden ? Visibility::occluded : Visibility::visible)
+                    << "depth " << int(depth) << ", hole " << hole << "x" << hole << ", L " << L;
+                if (hidden) {
+                    EXPECT_NEAR(a.level_of_visibility, double(hole * hole) / 3600.0, 1e-6);
+                }
+                // In front of the wall nothing is hidden, holes or not.
+                EXPECT_EQ(maps.test_rect(buffer, pixel_rect(128, 128, 30, 30, 90, 90, 3.0f)).visibility, Visibility::visible);
+            }
+        }
+}
+
+// Two occluders share each pixel of a column: a wall at w = 10 behind everything, and in front
+// of it, at w = 2, a panel over the left half of the column's samples. An occludee at w = 5
+// over that column is visible through the right halves. The no-background Z-buffer keeps each
+// pixel's nearest depth and hides it: it is not conservative. Every other depth test keeps it
+// visible.
+TEST(OcclusionMaps, NearestDepthZBufferIsNotConservativeWithPartialCoverage) {
+    Occluders o{16, 16, {}, {}};
+    o.add(0, 0, 16, 16, 10.0f);
+    o.add(0, 0, 8.5, 16, 2.0f);
+    const OcclusionBuffer buffer = buffer_of(16, 16, 4, o);
+    const ScreenRect column = pixel_rect(16, 16, 8, 0, 9, 16, 5.0f);
+    for (DepthTest depth : {DepthTest::masked, DepthTest::hzb, DepthTest::nbz, DepthTest::plane, DepthTest::deb}) {
+        OcclusionMaps maps(buffer, maps_config(buffer, depth));
+        maps.clear();
+        maps.add_occluder_box({glm::vec3(-2.0f, -2.0f, 2.0f), glm::vec3(2.0f * (8.5f / 8.0f - 1.0f), 2.0f, 2.0f)}, kXyw);
+        maps.add_occluder_box({glm::vec3(-10.0f, -10.0f, 10.0f), glm::vec3(10.0f, 10.0f, 10.0f)}, kXyw);
+        maps.build(buffer);
+        const OccludeeAnswer a = maps.test_rect(buffer, column);
+        EXPECT_EQ(exit_of(a), OverlapExit::passed);
+        EXPECT_EQ(a.visibility, depth == DepthTest::nbz ? Visibility::occluded : Visibility::visible) << "depth " << int(depth);
+    }
+}
+
+// Conservative mode: the overlap test passes exactly when every sample in the rectangle is
+// covered, on random triangles, rectangles and sample counts.
+TEST(OcclusionMaps, ConservativeOverlapIsExactOnRandomInput) {
+    std::mt19937 rng(11);
+    for (int s : {1, 2, 4}) {
+        const int width = 97, height = 61;
+        BufferConfig c;
+        c.width = width;
+        c.height = height;
+        c.samples = s;
+        c.near_w = 0.5f;
+        OcclusionBuffer buffer(c);
+        const std::vector<float> tris = test::random_clip_triangles(std::uint64_t(s), 600, 0.5f);
+        buffer.render(test::clip_space_input(tris));
+        OcclusionMaps maps(buffer, maps_config(buffer));
+        maps.build(buffer);
+        std::vector<std::uint8_t> covered;
+        buffer.read_coverage(covered);
+        const int sw = buffer.sample_width(), sh = buffer.sample_height();
+        std::uniform_int_distribution<int> x_of(0, sw - 1), y_of(0, sh - 1), size_of(0, 40);
+        int passed = 0;
+        for (int t = 0; t < 3000; ++t) {
+            const int i0 = x_of(rng), j0 = y_of(rng), i1 = std::min(sw - 1, i0 + size_of(rng)), j1 = std::min(sh - 1, j0 + size_of(rng));
+            bool all = true;
+            for (int j = j0; j <= j1 && all; ++j)
+                for (int i = i0; i <= i1 && all; ++i) all = covered[std::size_t(j) * std::size_t(sw) + std::size_t(i)] != 0;
+            // The rectangle through the samples' centres, well inside their cells.
+            const ScreenRect r = pixel_rect(sw, sh, i0 + 0.25, j0 + 0.25, i1 + 0.75, j1 + 0.75, 1000.0f);
+            const OccludeeAnswer a = maps.test_rect(buffer, r);
+            ASSERT_EQ(exit_of(a) == OverlapExit::passed, all) << "S " << s << " samples [" << i0 << ", " << i1 << "] x [" << j0 << ", " << j1 << "]";
+            passed += all;
+        }
+        EXPECT_GT(passed, 100) << "too few covered rectangles to mean anything";
+    }
+}
+
+TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
+    const OcclusionBuffer buffer = buffer_of(32, 32, 1, Occluders{32, 32, {}, {}});
+    auto make = [&](auto change) {
+        OcclusionMapsConfig c = maps_config(buffer);
+        change(c);
+        OcclusionMaps maps(buffer, c);
+    };
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.display_width = 0; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.hole_pixels = -1.0; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.hole_pixels = NAN; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.distribution = 5.0; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.transparency = 1.0; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.finest_level = 40; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.coarsest_level = 40; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.deb_width = 0; }), Error);
+    EXPECT_NO_THROW(make([](OcclusionMapsConfig&) {}));
+    // A 1 x 1 buffer is a one-level pyramid.
+    const OcclusionBuffer tiny = buffer_of(1, 1, 4, Occluders{1, 1, {}, {}});
+    OcclusionMaps maps(tiny, maps_config(tiny));
+    maps.build(tiny);
+    EXPECT_EQ(maps.levels(), 1);
+    EXPECT_EQ(maps.test_rect(tiny, {-1, -1, 1, 1, 5.0f}).visibility, Visibility::visible);
+    // NaN rectangles are visible, off-screen ones view-culled.
+    EXPECT_EQ(maps.test_rect(tiny, {NAN, -1, 1, 1, 5.0f}).visibility, Visibility::visible);
+    EXPECT_EQ(maps.test_rect(tiny, {2, 2, 3, 3, 5.0f}).visibility, Visibility::view_culled);
+}
+
+}  // namespace
+}  // namespace homcull

@@ -1,0 +1,163 @@
+// homcull cull: per-object answers of the hierarchical occlusion maps from one camera.
+#include "commands.hpp"
+#include "cull_options.hpp"
+#include "options.hpp"
+
+#include <homcull/io/scene_io.hpp>
+#include <homcull/tbb_parallel_for.hpp>
+#include <homcull/truth/ground_truth.hpp>
+#include <homcull/truth/ray_scene.hpp>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <memory>
+
+namespace homcull::cli {
+namespace {
+
+struct CullCommandOptions {
+    std::string scene;
+    CameraOptions camera;
+    CullOptions cull;
+    bool json = false, truth = false;
+    int threads = 1, repeat = 1;
+};
+
+nlohmann::json stats_json(const RasterStats& s) {
+    return {{"triangles_in", s.triangles_in}, {"invalid", s.invalid},   {"outside", s.outside},
+            {"near_clipped", s.near_clipped}, {"too_large", s.too_large}, {"backface_culled", s.backface_culled},
+            {"degenerate", s.degenerate},     {"rasterized", s.rasterized}, {"subtiles_touched", s.subtiles_touched}};
+}
+
+void run_cull(const CullCommandOptions& o) {
+    const Camera camera = resolve_camera(o.camera);
+    const SceneCullerConfig config = scene_culler_config(o.cull);
+    long long start = now_ns();
+    const Scene scene = load_scene(o.scene);
+    const double load_ms = elapsed_ms(start);
+    start = now_ns();
+    const std::vector<std::uint32_t> occluders = choose_occluders(scene, o.cull.occluders);
+    SceneCuller culler(scene, occluders, config);
+    const double setup_ms = elapsed_ms(start);
+    std::vector<OccludeeAnswer> answers;
+    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+    // The first call also allocates the render scratch; repeats show the per-frame cost.
+    SceneCullTimings best;
+    for (int r = 0; r < o.repeat; ++r) {
+        culler.cull(camera, answers, parallel);
+        const SceneCullTimings& t = culler.timings();
+        best = r == 0 ? t : SceneCullTimings{std::min(best.render_ms, t.render_ms), std::min(best.maps_ms, t.maps_ms),
+                                             std::min(best.test_ms, t.test_ms)};
+    }
+
+    // Optional ground truth at the display's pixel centres.
+    TruthResult truth;
+    double truth_ms = 0.0;
+    if (o.truth) {
+        start = now_ns();
+        const RayScene rays(scene);
+        TruthOptions truth_options;
+        truth_options.resolution = config.display;
+        truth = compute_ground_truth(rays, scene, camera, truth_options);
+        truth_ms = elapsed_ms(start);
+    }
+
+    std::size_t counts[3] = {}, false_culls = 0, hidden = 0, culled_hidden = 0;
+    std::uint64_t triangles = 0, after_frustum = 0, after_occlusion = 0;
+    nlohmann::json objects = nlohmann::json::array();
+    for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+        const OccludeeAnswer& a = answers[id];
+        const std::uint64_t n = scene.triangle_count(scene.objects[id]);
+        ++counts[int(a.visibility)];
+        triangles += n;
+        after_frustum += a.visibility != Visibility::view_culled ? n : 0;
+        after_occlusion += a.visibility == Visibility::visible ? n : 0;
+        nlohmann::json item = {{"id", id},
+                               {"name", scene.objects[id].name},
+                               {"triangles", n},
+                               {"result", visibility_name(a.visibility)},
+                               {"level_of_visibility", a.level_of_visibility}};
+        if (a.overlap_exit) item["overlap"] = overlap_exit_name(OverlapExit(a.overlap_exit));
+        if (o.truth) {
+            const ObjectVisibility& t = truth.objects[id];
+            item["truth"] = t.visible_samples > 0 ? "visible" : t.in_frustum ? "occluded" : "view_culled";
+            item["visible_samples"] = t.visible_samples;
+            if (t.visible_samples > 0 && a.visibility != Visibility::visible) ++false_culls;
+            if (t.visible_samples == 0 && t.in_frustum && !scene.objects[id].world_bounds.empty()) {
+                ++hidden;
+                culled_hidden += a.visibility != Visibility::visible;
+            }
+        }
+        objects.push_back(std::move(item));
+    }
+    const SceneCullTimings& ms = best;
+    if (o.json) {
+        nlohmann::json exits;
+        for (int e = 1; e < 7; ++e) exits[overlap_exit_name(OverlapExit(e))] = culler.overlap_exits().count[e];
+        nlohmann::json out = {
+            {"scene", scene.source},
+            {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}},
+                        {"target", {camera.target.x, camera.target.y, camera.target.z}},
+                        {"up", {camera.up.x, camera.up.y, camera.up.z}},
+                        {"fov_y", camera.fov_y_degrees}, {"near", camera.near_plane}, {"far", camera.far_plane}}},
+            {"display", {config.display.width, config.display.height}},
+            {"buffer", {culler.buffer().config().width, culler.buffer().config().height}},
+            {"samples", config.samples},
+            {"mode", o.cull.mode},
+            {"hole", config.maps.hole_pixels},
+            {"depth", o.cull.depth},
+            {"occluders", {{"choice", o.cull.occluders}, {"objects", culler.occluder_objects()},
+                           {"triangles", culler.occluder_triangles()}}},
+            {"objects", objects},
+            {"summary", {{"objects", scene.objects.size()}, {"visible", counts[0]}, {"occluded", counts[1]}, {"view_culled", counts[2]},
+                         {"triangles", triangles}, {"triangles_after_frustum", after_frustum},
+                         {"triangles_after_occlusion", after_occlusion}}},
+            {"timings_ms", {{"load", load_ms}, {"setup", setup_ms}, {"render", ms.render_ms}, {"maps", ms.maps_ms},
+                            {"tests", ms.test_ms}}},
+            {"stats", stats_json(culler.buffer().stats())},
+            {"overlap_exits", exits}};
+        if (o.truth) {
+            out["truth"] = {{"false_culls", false_culls}, {"hidden_in_frustum", hidden}, {"culled_hidden", culled_hidden},
+                            {"missed_culls", hidden - culled_hidden},
+                            {"efficiency", hidden ? double(culled_hidden) / double(hidden) : 1.0}, {"trace_ms", truth_ms}};
+        }
+        fmt::print("{}\n", out.dump(1));
+        return;
+    }
+    fmt::print("scene      {} ({} objects)\n", scene.source, scene.objects.size());
+    fmt::print("display    {}x{}, buffer {}x{} with {}x{} samples, {} mode{}, depth {}\n", config.display.width,
+               config.display.height, culler.buffer().config().width, culler.buffer().config().height, config.samples,
+               config.samples, o.cull.mode, o.cull.mode == "approximate" ? fmt::format(" (hole {} px)", o.cull.hole) : "",
+               o.cull.depth);
+    fmt::print("occluders  {} objects, {} triangles ({})\n", culler.occluder_objects(), culler.occluder_triangles(), o.cull.occluders);
+    fmt::print("answers    {} visible, {} occluded, {} view-culled\n", counts[0], counts[1], counts[2]);
+    fmt::print("triangles  {} in all, {} after frustum culling, {} after occlusion culling\n", triangles, after_frustum,
+               after_occlusion);
+    fmt::print("time       load {:.1f} ms, setup {:.1f} ms; render {:.3f} ms, maps {:.3f} ms, tests {:.3f} ms\n", load_ms, setup_ms,
+               ms.render_ms, ms.maps_ms, ms.test_ms);
+    if (o.truth)
+        fmt::print("truth      {} false culls; culled {} of {} hidden objects ({:.1f} %); trace {:.0f} ms\n", false_culls,
+                   culled_hidden, hidden, hidden ? 100.0 * double(culled_hidden) / double(hidden) : 100.0, truth_ms);
+    fmt::print("(--json lists every object)\n");
+}
+
+}  // namespace
+
+void register_cull(CLI::App& app) {
+    auto o = std::make_shared<CullCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("cull", "Occlusion culling of a scene's objects from one camera (hierarchical occlusion maps)");
+    add_scene_option(*cmd, o->scene);
+    add_camera_options(*cmd, o->camera);
+    add_cull_options(*cmd, o->cull);
+    cmd->add_option("--threads", o->threads, "Render with this many threads (TBB); 1 = the calling thread")
+        ->capture_default_str()->check(CLI::Range(1, 256));
+    cmd->add_option("--repeat", o->repeat, "Cull this many times and report each stage's fastest time")
+        ->capture_default_str()->check(CLI::Range(1, 1000));
+    cmd->add_flag("--truth", o->truth, "Also cast Embree ground truth at the display's pixel centres and count false culls");
+    cmd->add_flag("--json", o->json, "Print JSON on stdout");
+    cmd->callback([o] { run_cull(*o); });
+}
+
+}  // namespace homcull::cli

@@ -1,0 +1,84 @@
+#include "cull_options.hpp"
+
+#include "options.hpp"
+
+#include <homcull/error.hpp>
+
+#include <glm/glm.hpp>
+
+namespace homcull::cli {
+
+void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
+    if (with_display) {
+        app.add_option("--resolution", o.resolution, "Display resolution WxH: the answers are right for its pixel centres")
+            ->capture_default_str();
+        app.add_option("--samples", o.samples, "S x S coverage samples per buffer pixel (1, 2 or 4)")
+            ->capture_default_str()->check(CLI::IsMember({1, 2, 4}));
+    }
+    app.add_option("--buffer", o.buffer, "Occlusion buffer WxH (default: display / samples, the display's own pixel centres)");
+    app.add_option("--mode", o.mode, "conservative (never hides a visible object) or approximate (tolerates --hole)")
+        ->capture_default_str()->check(CLI::IsMember({"conservative", "approximate"}));
+    app.add_option("--hole", o.hole, "approximate: largest negligible hole L, in display pixels")->capture_default_str();
+    app.add_option("--distribution", o.distribution, "approximate: Zhang's distribution factor D in [1, 4]")->capture_default_str();
+    app.add_option("--transparency", o.transparency, "approximate: level-0 transparency threshold in [0, 1)")->capture_default_str();
+    app.add_option("--depth", o.depth, "Depth test: masked, hzb, deb, nbz (not conservative) or plane")
+        ->capture_default_str()->check(CLI::IsMember({"masked", "hzb", "deb", "nbz", "plane"}));
+    app.add_option("--deb", o.deb, "Depth estimation buffer cells WxH")->capture_default_str();
+    app.add_option("--finest-level", o.finest_level, "Finest active level of the opacity pyramid")->capture_default_str();
+    app.add_option("--coarsest-level", o.coarsest_level, "Coarsest active level (-1: the pyramid's last)")->capture_default_str();
+    app.add_option("--occluders", o.occluders, "role, all, or auto (role when marked, else objects by size)")
+        ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
+}
+
+SceneCullerConfig scene_culler_config(const CullOptions& o) {
+    SceneCullerConfig c;
+    c.display = parse_resolution(o.resolution);
+    if (!o.buffer.empty()) c.buffer = parse_resolution(o.buffer);
+    c.samples = o.samples;
+    if (o.mode == "conservative" && o.hole != 0.0) throw Error("--hole needs --mode approximate (conservative mode tolerates no hole)");
+    if (o.mode == "approximate" && !(o.hole > 0.0)) throw Error("--mode approximate needs --hole L with L > 0 display pixels");
+    c.maps.hole_pixels = o.mode == "approximate" ? o.hole : 0.0;
+    c.maps.distribution = o.distribution;
+    c.maps.transparency = o.transparency;
+    c.maps.finest_level = o.finest_level;
+    c.maps.coarsest_level = o.coarsest_level;
+    const Resolution deb = parse_resolution(o.deb);
+    c.maps.deb_width = deb.width;
+    c.maps.deb_height = deb.height;
+    c.maps.depth = o.depth == "hzb" ? DepthTest::hzb : o.depth == "deb" ? DepthTest::deb : o.depth == "nbz" ? DepthTest::nbz
+                 : o.depth == "plane" ? DepthTest::plane : DepthTest::masked;
+    return c;
+}
+
+std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice) {
+    if (choice == "all") return objects_with_role(scene, "");
+    std::vector<std::uint32_t> ids = objects_with_role(scene, "occluder");
+    if (!ids.empty()) return ids;
+    if (choice == "role") return objects_with_role(scene, "");
+    const Aabb bounds = scene.bounds();
+    const float min_diagonal = 0.02f * glm::length(bounds.extent());
+    for (std::uint32_t id = 0; id < scene.objects.size(); ++id) {
+        const Aabb& b = scene.objects[id].world_bounds;
+        if (!b.empty() && glm::length(b.extent()) >= min_diagonal) ids.push_back(id);
+    }
+    return ids;
+}
+
+const char* visibility_name(Visibility v) {
+    return v == Visibility::visible ? "visible" : v == Visibility::occluded ? "occluded" : "view_culled";
+}
+
+const char* overlap_exit_name(OverlapExit e) {
+    switch (e) {
+    case OverlapExit::not_run: return "not_run";
+    case OverlapExit::passed: return "passed";
+    case OverlapExit::conservative_rejection: return "conservative_rejection";
+    case OverlapExit::predictive_rejection: return "predictive_rejection";
+    case OverlapExit::transparent_cell: return "transparent_cell";
+    case OverlapExit::finest_level: return "finest_level";
+    case OverlapExit::samples: return "samples";
+    }
+    return "unknown";
+}
+
+}  // namespace homcull::cli

@@ -1,0 +1,35 @@
+#pragma once
+// The culling options `cull` and `accuracy` share: display, buffer, mode, depth test,
+// occluder choice.
+#include <homcull/scene.hpp>
+#include <homcull/scene_culler.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+namespace homcull::cli {
+
+struct CullOptions {
+    std::string resolution = "1280x720", buffer, mode = "conservative", depth = "masked", occluders = "role";
+    int samples = 1;
+    double hole = 0.0, distribution = 1.0, transparency = 0.0;
+    int finest_level = 0, coarsest_level = -1;
+    std::string deb = "64x64";
+};
+
+// with_display: also --resolution and --samples (commands that define their own leave them out
+// and fill CullOptions::resolution and samples themselves).
+void add_cull_options(CLI::App& app, CullOptions& options, bool with_display = true);
+// Throws homcull::Error on inconsistent options (a hole size in conservative mode, ...).
+SceneCullerConfig scene_culler_config(const CullOptions& options);
+// role: objects with role=occluder (all when none has a role); all; auto: role when the scene
+// marks occluders, otherwise objects whose box diagonal is at least 2 % of the scene's
+// (Zhang's static size filter).
+std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice);
+
+const char* visibility_name(Visibility v);
+const char* overlap_exit_name(OverlapExit e);
+
+}  // namespace homcull::cli
