@@ -1,7 +1,9 @@
 #include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 
 namespace homcull {
@@ -16,6 +18,16 @@ OcclusionMapsConfig maps_config(const SceneCullerConfig& c) {
     m.display_width = c.display.width;
     m.display_height = c.display.height;
     return m;
+}
+
+// float(v) rounded towards -infinity / +infinity.
+float down(double v) {
+    const float f = float(v);
+    return double(f) > v ? std::nextafter(f, -INFINITY) : f;
+}
+float up(double v) {
+    const float f = float(v);
+    return double(f) < v ? std::nextafter(f, INFINITY) : f;
 }
 
 }  // namespace
@@ -62,6 +74,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
         maps_ = OcclusionMaps(buffer_, maps_config(config_));
     }
     const auto clip = clip_from_world(camera, config_.display.aspect());
+    const glm::dmat4 clip_double = projection_matrix(camera, config_.display.aspect()) * view_matrix(camera);
     auto start = std::chrono::steady_clock::now();
     buffer_.clear();
     buffer_.render(occluders_.input(clip, config_.backface), parallel);
@@ -85,8 +98,58 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
         }
         answers[id] = maps_.test_aabb(buffer_, box, clip);
         ++exits_.count[answers[id].overlap_exit];
+        const Object& object = scene_->objects[id];
+        if (answers[id].visibility == Visibility::visible && config_.test_triangles &&
+            scene_->triangle_count(object) <= config_.triangle_test_limit && triangles_hidden(object, clip_double))
+            answers[id].visibility = Visibility::occluded;
     }
     timings_.test_ms = ms_since(start);
+}
+
+namespace {
+
+// Whether a triangle given by its clip-space corners is hidden at every sample: its screen
+// rectangle at its nearest w (w is affine on the triangle, so its nearest point is a corner)
+// tested against the maps; when that rectangle is not hidden, the four halves-of-edges
+// sub-triangles (clip space is linear on the triangle, so they tile it exactly) are tried, down
+// to `depth` more levels. A corner before the near plane makes it visible.
+bool triangle_hidden(const OcclusionMaps& maps, const OcclusionBuffer& buffer, const glm::dvec4 c[3], int depth) {
+    double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, min_w = HUGE_VAL;
+    for (int k = 0; k < 3; ++k) {
+        if (!std::isfinite(c[k].x) || !std::isfinite(c[k].y) || !std::isfinite(c[k].w) || c[k].w < double(buffer.config().near_w))
+            return false;
+        min_x = std::min(min_x, c[k].x / c[k].w), max_x = std::max(max_x, c[k].x / c[k].w);
+        min_y = std::min(min_y, c[k].y / c[k].w), max_y = std::max(max_y, c[k].y / c[k].w);
+        min_w = std::min(min_w, c[k].w);
+    }
+    // Widened by 2^-20 of the magnitudes: world_bounds and ground truth round the world
+    // transform to float, this does not.
+    const double slack_x = 0x1.0p-20 * (1.0 + std::abs(min_x) + std::abs(max_x));
+    const double slack_y = 0x1.0p-20 * (1.0 + std::abs(min_y) + std::abs(max_y));
+    const ScreenRect r{down(min_x - slack_x), down(min_y - slack_y), up(max_x + slack_x), up(max_y + slack_y),
+                       down(min_w * (1.0 - 0x1.0p-20))};
+    if (maps.test_rect(buffer, r).visibility != Visibility::visible) return true;
+    if (depth == 0) return false;
+    const glm::dvec4 m01 = (c[0] + c[1]) * 0.5, m12 = (c[1] + c[2]) * 0.5, m20 = (c[2] + c[0]) * 0.5;
+    const glm::dvec4 parts[4][3] = {{c[0], m01, m20}, {m01, c[1], m12}, {m20, m12, c[2]}, {m01, m12, m20}};
+    for (const auto& part : parts)
+        if (!triangle_hidden(maps, buffer, part, depth - 1)) return false;
+    return true;
+}
+
+}  // namespace
+
+// Every triangle hidden (see triangle_hidden), corners transformed in double as ground truth
+// transforms them.
+bool SceneCuller::triangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
+    const Mesh& mesh = scene_->meshes[object.mesh];
+    const glm::dmat4 m = clip_from_world * object.world;
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        glm::dvec4 c[3];
+        for (int k = 0; k < 3; ++k) c[k] = m * glm::dvec4(glm::dvec3(mesh.positions[mesh.indices[3 * t + std::size_t(k)]]), 1.0);
+        if (!triangle_hidden(maps_, buffer_, c, 3)) return false;
+    }
+    return true;
 }
 
 }  // namespace homcull

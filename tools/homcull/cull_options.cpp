@@ -26,6 +26,9 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--deb", o.deb, "Depth estimation buffer cells WxH")->capture_default_str();
     app.add_option("--finest-level", o.finest_level, "Finest active level of the opacity pyramid")->capture_default_str();
     app.add_option("--coarsest-level", o.coarsest_level, "Coarsest active level (-1: the pyramid's last)")->capture_default_str();
+    app.add_option("--occludees", o.occludees,
+                   "box: test each object's world box; triangles: where the box is visible, also its triangles' rectangles")
+        ->capture_default_str()->check(CLI::IsMember({"box", "triangles"}));
     app.add_option("--occluders", o.occluders, "role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
 }
@@ -47,6 +50,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.maps.deb_height = deb.height;
     c.maps.depth = o.depth == "hzb" ? DepthTest::hzb : o.depth == "deb" ? DepthTest::deb : o.depth == "nbz" ? DepthTest::nbz
                  : o.depth == "plane" ? DepthTest::plane : DepthTest::masked;
+    c.test_triangles = o.occludees == "triangles";
     return c;
 }
 

@@ -22,12 +22,18 @@ struct SceneCullerConfig {
     OcclusionMapsConfig maps;  // display_width/height are taken from `display`
     // Back faces are surfaces to ground truth and to the eye: none are culled by default.
     Backface backface = Backface::none;
+    // Occludee shape: the world box alone, or, where the box is found visible, the screen
+    // rectangles of the object's triangles (hidden when every one is): much tighter for
+    // objects whose box reaches past what hides them, at the cost of transforming their
+    // vertices. Objects with more than triangle_test_limit triangles keep the box's answer.
+    bool test_triangles = true;
+    std::size_t triangle_test_limit = 20000;
 };
 
 struct SceneCullTimings {
     double render_ms = 0.0;  // occluder triangles into the buffer
     double maps_ms = 0.0;    // opacity pyramid, depth maps, depth estimation buffer
-    double test_ms = 0.0;    // every object's box
+    double test_ms = 0.0;    // every object's box (and triangles)
 };
 
 // How many objects each overlap-test exit decided (indexed by OverlapExit).
@@ -61,6 +67,7 @@ private:
     OcclusionMaps maps_;
     SceneCullTimings timings_;
     OverlapExitCounts exits_;
+    bool triangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const;
 };
 
 // The buffer configuration a SceneCullerConfig asks for (resolved buffer size), for callers
