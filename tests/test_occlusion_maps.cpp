@@ -97,6 +97,43 @@ TEST(OcclusionMaps, OpacityPyramidCountsCoveredSamplesOnOddSizes) {
     }
 }
 
+// The pyramid reduction runs in SIMD: every instruction set builds the scalar reference's bits.
+TEST(OcclusionMaps, EveryIsaBuildsTheSamePyramids) {
+    const std::vector<float> tris = test::random_clip_triangles(5, 800, 0.4f);
+    for (int s : {1, 4}) {
+        std::vector<std::uint32_t> reference_covered;
+        std::vector<float> reference_far, reference_near;
+        for (const std::string& isa : available_isas()) {
+            select_isa(isa);
+            BufferConfig c;
+            c.width = 203;  // odd widths at several levels, and rows longer than a vector
+            c.height = 77;
+            c.samples = s;
+            c.near_w = 0.5f;
+            OcclusionBuffer buffer(c);
+            buffer.render(test::clip_space_input(tris));
+            OcclusionMaps maps(buffer, maps_config(buffer));
+            maps.build(buffer);
+            std::vector<std::uint32_t> covered;
+            std::vector<float> far, near;
+            for (int k = 0; k < maps.levels(); ++k) {
+                const std::size_t n = std::size_t(maps.level_width(k)) * std::size_t(maps.level_height(k));
+                covered.insert(covered.end(), maps.covered_samples(k), maps.covered_samples(k) + n);
+                far.insert(far.end(), maps.farthest_depth(k), maps.farthest_depth(k) + n);
+                near.insert(near.end(), maps.nearest_depth(k), maps.nearest_depth(k) + n);
+            }
+            if (isa == "scalar") {
+                reference_covered = covered, reference_far = far, reference_near = near;
+                continue;
+            }
+            EXPECT_EQ(covered, reference_covered) << isa << " S " << s;
+            EXPECT_EQ(far, reference_far) << isa << " S " << s;
+            EXPECT_EQ(near, reference_near) << isa << " S " << s;
+        }
+        select_isa("best");
+    }
+}
+
 TEST(OcclusionMaps, ThresholdsFollowZhang) {
     const OcclusionBuffer buffer = buffer_of(64, 64, 1, Occluders{64, 64, {}, {}});
     OcclusionMapsConfig c = maps_config(buffer);

@@ -10,6 +10,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_maps.hpp>
 
+#include "core/opacity_pyramid.hpp"
 #include "core/rect_tests.hpp"
 
 #include <algorithm>
@@ -132,25 +133,23 @@ void OcclusionMaps::build(const OcclusionBuffer& buffer) {
         }
     }
     // Levels 1..: sums of covered samples, minimum (farthest) of the depth maps.
+    const detail::PyramidRowKernel reduce = detail::selected_pyramid_row_kernel();
     for (std::size_t k = 1; k < levels_.size(); ++k) {
         const Level& below = levels_[k - 1];
         const Level& here = levels_[k];
         for (int y = 0; y < here.height; ++y) {
-            // The two rows of children (the second repeats the first at an odd bottom edge,
-            // and a missing right child repeats the left one: min is unaffected, sums skip it).
+            // The two rows of children; at an odd bottom edge the second repeats the first
+            // (minima unaffected, counted once).
             const int y0 = 2 * y, y1 = std::min(2 * y + 1, below.height - 1);
             const std::size_t r0 = below.offset + std::size_t(y0) * std::size_t(below.width);
             const std::size_t r1 = below.offset + std::size_t(y1) * std::size_t(below.width);
-            const std::uint32_t second_row = y1 != y0 ? 1u : 0u;
             const std::size_t out = here.offset + std::size_t(y) * std::size_t(here.width);
-            for (int x = 0; x < here.width; ++x) {
-                const std::size_t a = std::size_t(2 * x), b = std::size_t(std::min(2 * x + 1, below.width - 1));
-                const std::uint32_t second_column = b != a ? 1u : 0u;
-                covered_[out + std::size_t(x)] = covered_[r0 + a] + second_column * covered_[r0 + b] +
-                                                 second_row * (covered_[r1 + a] + second_column * covered_[r1 + b]);
-                hzb_[out + std::size_t(x)] = std::min(std::min(hzb_[r0 + a], hzb_[r0 + b]), std::min(hzb_[r1 + a], hzb_[r1 + b]));
-                nbz_[out + std::size_t(x)] = std::min(std::min(nbz_[r0 + a], nbz_[r0 + b]), std::min(nbz_[r1 + a], nbz_[r1 + b]));
-            }
+            const detail::PyramidRows rows{covered_.data() + r0, covered_.data() + r1, hzb_.data() + r0, hzb_.data() + r1,
+                                           nbz_.data() + r0,     nbz_.data() + r1,     y1 != y0,          covered_.data() + out,
+                                           hzb_.data() + out,    nbz_.data() + out};
+            const int pairs = below.width / 2;  // output cells with both children columns
+            const int done = reduce ? reduce(rows, pairs) : 0;
+            detail::reduce_pyramid_row_reference(rows, done, here.width, below.width);
         }
     }
     const Level& top = levels_.back();
