@@ -22,13 +22,6 @@ namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 
-// Bit count without a library call (the baseline x86-64 target has no popcnt instruction).
-int popcount(std::uint32_t v) {
-    v = v - ((v >> 1) & 0x55555555u);
-    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
-    return int((((v + (v >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24);
-}
-
 }  // namespace
 
 OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config) : config_(config) {
@@ -105,33 +98,12 @@ void OcclusionMaps::build(const OcclusionBuffer& buffer) {
     // those samples (a sample in a subtile's working mask is bounded by max(d0, d1), any
     // other by d0; see OcclusionBuffer). Pixels without covered samples get +inf ("no
     // occluder"): the depth maps ignore the background, the overlap test decides coverage.
-    const int s = samples_, pixels_x = kW / s, pixels_y = kH / s;  // pixels per subtile (s is 1, 2 or 4)
-    std::uint32_t pixel_bits[kW * kH];  // each pixel's samples in a subtile, row-major
-    for (int py = 0; py < pixels_y; ++py)
-        for (int px = 0; px < pixels_x; ++px) {
-            std::uint32_t bits = 0;
-            for (int r = 0; r < s; ++r) bits |= ((0xFFu >> (kW - s)) << (px * s)) << ((py * s + r) * kW);
-            pixel_bits[py * pixels_x + px] = bits;
-        }
-    for (int ty = 0; ty < buffer.subtiles_y(); ++ty) {
-        const int rows = std::min(pixels_y, height_ - ty * pixels_y);
-        for (int tx = 0; tx < buffer.subtiles_x(); ++tx) {
-            const std::size_t i = buffer.at(tx, ty);
-            const std::uint32_t cov = buffer.covered_[i], mask = buffer.mask_[i];
-            const float d0 = buffer.d0_[i], layered = std::max(d0, buffer.d1_[i]);
-            const int columns = std::min(pixels_x, width_ - tx * pixels_x);
-            for (int py = 0; py < rows; ++py) {
-                const std::size_t row = std::size_t(ty * pixels_y + py) * std::size_t(width_) + std::size_t(tx * pixels_x);
-                for (int px = 0; px < columns; ++px) {
-                    const std::uint32_t c = cov & pixel_bits[py * pixels_x + px];
-                    const bool outside_mask = (c & ~mask) != 0, inside_mask = (c & mask) != 0;
-                    covered_[row + std::size_t(px)] = std::uint32_t(popcount(c));
-                    hzb_[row + std::size_t(px)] = outside_mask ? d0 : inside_mask ? layered : INFINITY;  // d0 <= layered
-                    nbz_[row + std::size_t(px)] = inside_mask ? layered : outside_mask ? d0 : INFINITY;
-                }
-            }
-        }
-    }
+    const detail::Level0Maps level0{buffer.covered_.data(), buffer.mask_.data(), buffer.d0_.data(), buffer.d1_.data(),
+                                    buffer.stride_,         buffer.subtiles_x(), buffer.subtiles_y(), width_,
+                                    height_,                samples_,            covered_.data(),      hzb_.data(),
+                                    nbz_.data()};
+    const detail::Level0Kernel level0_kernel = detail::selected_level0_kernel();
+    detail::level0_reference(level0, level0_kernel ? level0_kernel(level0) : 0);
     // Levels 1..: sums of covered samples, minimum (farthest) of the depth maps.
     const detail::PyramidRowKernel reduce = detail::selected_pyramid_row_kernel();
     for (std::size_t k = 1; k < levels_.size(); ++k) {
@@ -177,7 +149,7 @@ std::uint32_t uncovered_samples(const OcclusionBuffer& b, int i0, int i1, int j0
             const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
             std::uint32_t rect = 0;
             for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
-            count += std::uint32_t(popcount(rect & ~b.subtile(tx, ty).covered));
+            count += detail::bit_count(rect & ~b.subtile(tx, ty).covered);
         }
     return count;
 }

@@ -1,11 +1,42 @@
 #pragma once
-// One level of the occlusion maps' pyramids from the level below: covered-sample counts summed
+// Level 0 of the occlusion maps from the buffer's subtiles (per pixel: covered samples, the
+// farthest and the nearest bound of the covered samples), and one level of the pyramids from
+// the level below: covered-sample counts summed
 // over 2 x 2 cells, the two depth maps' minimum. A plain reference for one output row, and a
 // SIMD kernel (opacity_pyramid_simd.cpp) for the cells with four children; sums and minima are
 // exact, so every instruction set gives the reference's bits.
+#include <cstddef>
 #include <cstdint>
 
 namespace homcull::detail {
+
+// Bit count without a library call (the baseline x86-64 target has no popcnt instruction).
+inline std::uint32_t bit_count(std::uint32_t v) {
+    v = v - ((v >> 1) & 0x55555555u);
+    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+    return (((v + (v >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24;
+}
+
+// The buffer's subtile planes (OcclusionBuffer's layout) and the level-0 maps to fill.
+struct Level0Maps {
+    const std::uint32_t *covered, *mask;
+    const float *d0, *d1;
+    std::size_t stride;
+    int subtiles_x, subtiles_y;
+    int width, height, samples;  // buffer pixels and samples per axis (1, 2 or 4)
+    std::uint32_t* covered_out;  // width x height, row-major
+    float *far_out, *near_out;
+};
+
+// Level 0 for the subtile columns [tx_begin, subtiles_x) of every subtile row: a pixel's
+// covered samples; its farthest covered bound (d0 for samples outside the subtile's working
+// mask, max(d0, d1) inside it) and its nearest; +inf for both when nothing covers it.
+void level0_reference(const Level0Maps& maps, int tx_begin);
+// The SIMD kernel for the selected instruction set (S = 1: a subtile row's 8 pixels as
+// lanes): does the subtile columns [0, returned) whose pixels all exist. Null when the
+// scalar reference is selected.
+using Level0Kernel = int (*)(const Level0Maps& maps);
+Level0Kernel selected_level0_kernel();
 
 // One row of the level above, from the rows r0 and r1 of the level below (r1 = r0 at an odd
 // bottom edge, counted once). The reduce kernels do the output cells [0, pairs), whose two

@@ -1,5 +1,5 @@
-// The pyramid reduction of the occlusion maps in SIMD (opacity_pyramid.hpp): a vector of
-// output cells at a time, their children's even and odd columns separated with
+// The occlusion maps' level 0 at one sample per pixel, and the pyramid reduction, in SIMD
+// (opacity_pyramid.hpp). Reduction: a vector of output cells at a time, their children's even and odd columns separated with
 // ConcatEven/ConcatOdd. Integer sums and float minima are exact: the reference's bits.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "core/opacity_pyramid_simd.cpp"
@@ -9,6 +9,9 @@
 
 #include "core/opacity_pyramid.hpp"
 #include "raster/rasterize.hpp"
+
+#include <algorithm>
+#include <cmath>
 
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
@@ -44,34 +47,57 @@ int ReducePyramidRow(const PyramidRows& r, int pairs) {
 #endif
 }
 
+// S = 1: per subtile row, its 8 pixels as lanes (two halves of 4 on SSE4): covered bit, and
+// which layer bounds it.
+int Level0SingleSample(const Level0Maps& m) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    if (m.samples != 1) return 0;
+    const hn::CappedTag<std::uint32_t, kW> du;
+    const hn::Rebind<float, decltype(du)> df;
+    const int lanes = int(hn::Lanes(du));
+    const int full_columns = m.width / kW;
+    const auto one = hn::Set(du, 1u);
+    const auto infinity = hn::Set(df, HUGE_VALF);
+    for (int ty = 0; ty < m.subtiles_y; ++ty) {
+        const int rows = std::min(kH, m.height - ty * kH);
+        for (int tx = 0; tx < full_columns; ++tx) {
+            const std::size_t i = std::size_t(ty) * m.stride + std::size_t(tx);
+            const auto covered = hn::Set(du, m.covered[i]), mask = hn::Set(du, m.mask[i]);
+            const auto d0 = hn::Set(df, m.d0[i]), layered = hn::Set(df, std::max(m.d0[i], m.d1[i]));
+            for (int r = 0; r < rows; ++r) {
+                const std::size_t out = std::size_t(ty * kH + r) * std::size_t(m.width) + std::size_t(tx * kW);
+                for (int h = 0; h < kW; h += lanes) {
+                    const auto shift = hn::Iota(du, std::uint32_t(r * kW + h));
+                    const auto bit = hn::And(hn::Shr(covered, shift), one);
+                    const auto in_mask = hn::And(hn::Shr(mask, shift), one);
+                    const auto outside = hn::RebindMask(df, hn::Ne(hn::AndNot(in_mask, bit), hn::Zero(du)));
+                    const auto inside = hn::RebindMask(df, hn::Ne(hn::And(in_mask, bit), hn::Zero(du)));
+                    hn::StoreU(bit, du, m.covered_out + out + std::size_t(h));
+                    hn::StoreU(hn::IfThenElse(outside, d0, hn::IfThenElse(inside, layered, infinity)), df, m.far_out + out + std::size_t(h));
+                    hn::StoreU(hn::IfThenElse(inside, layered, hn::IfThenElse(outside, d0, infinity)), df, m.near_out + out + std::size_t(h));
+                }
+            }
+        }
+    }
+    return full_columns;
+}
+
 }  // namespace homcull::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include <algorithm>
-
 namespace homcull::detail {
 
 HWY_EXPORT(ReducePyramidRow);
+HWY_EXPORT(Level0SingleSample);
 
 namespace {
 int dispatch_reduce(const PyramidRows& rows, int pairs) { return HWY_DYNAMIC_DISPATCH(ReducePyramidRow)(rows, pairs); }
+int dispatch_level0(const Level0Maps& maps) { return HWY_DYNAMIC_DISPATCH(Level0SingleSample)(maps); }
 }  // namespace
 
 PyramidRowKernel selected_pyramid_row_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_reduce; }
-
-void reduce_pyramid_row_reference(const PyramidRows& r, int begin, int end, int below_width) {
-    for (int x = begin; x < end; ++x) {
-        // A missing right child repeats the left one: the minimum is unaffected, the sum skips it.
-        const std::size_t a = std::size_t(2 * x), b = std::size_t(std::min(2 * x + 1, below_width - 1));
-        const std::uint32_t second_column = b != a ? 1u : 0u;
-        std::uint32_t covered = r.covered0[a] + second_column * r.covered0[b];
-        if (r.second_row) covered += r.covered1[a] + second_column * r.covered1[b];
-        r.covered_out[x] = covered;
-        r.far_out[x] = std::min(std::min(r.far0[a], r.far0[b]), std::min(r.far1[a], r.far1[b]));
-        r.near_out[x] = std::min(std::min(r.near0[a], r.near0[b]), std::min(r.near1[a], r.near1[b]));
-    }
-}
+Level0Kernel selected_level0_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_level0; }
 
 }  // namespace homcull::detail
 #endif  // HWY_ONCE
