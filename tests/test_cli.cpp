@@ -56,6 +56,49 @@ TEST(Cli, TruthJsonHasEveryObjectInTheDesignFormat) {
     EXPECT_EQ(j["resolution"], nlohmann::json({96, 54}));
 }
 
+TEST(Cli, CullJsonHasEveryObjectStagesAndTruth) {
+    const CliRun r = run_cli("cull " + kCityCamera + " --samples 2 --depth hzb --truth --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(j["objects"].is_array());
+    std::size_t occluded = 0;
+    for (std::size_t i = 0; i < j["objects"].size(); ++i) {
+        const auto& o = j["objects"][i];
+        EXPECT_EQ(o["id"], i);
+        for (const char* key : {"name", "triangles", "result", "level_of_visibility", "truth"}) EXPECT_TRUE(o.contains(key)) << key;
+        occluded += o["result"] == "occluded";
+    }
+    EXPECT_GT(occluded, 0u);
+    EXPECT_EQ(j["summary"]["occluded"], occluded);
+    EXPECT_EQ(j["buffer"], nlohmann::json({48, 27}));
+    EXPECT_EQ(j["truth"]["false_culls"], 0);
+    for (const char* stage : {"render", "maps", "tests"}) EXPECT_TRUE(j["timings_ms"].contains(stage)) << stage;
+    EXPECT_TRUE(j["stats"].contains("triangles_in"));
+    EXPECT_TRUE(j["overlap_exits"].contains("predictive_rejection"));
+}
+
+TEST(Cli, CullRejectsInconsistentOptions) {
+    CliRun r = run_cli("cull " + kCityCamera + " --buffer 40x20");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "conservative culling needs");
+    r = run_cli("cull " + kCityCamera + " --mode approximate");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--hole");
+    r = run_cli("cull " + kCityCamera + " --hole 4");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--mode approximate");
+    r = run_cli("cull " + kCityCamera + " --mode approximate --hole 4 --distribution 9");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "distribution");
+    r = run_cli("cull --scene /nonexistent.glb --eye 0,0,0 --target 1,0,0");
+    EXPECT_EQ(r.exit_code, 1);
+    r = run_cli("cull " + kCityCamera + " --depth zbuffer");
+    EXPECT_NE(r.exit_code, 0);
+    // Approximate mode takes any buffer.
+    r = run_cli("cull " + kCityCamera + " --buffer 40x20 --samples 4 --mode approximate --hole 2 --json");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 TEST(Cli, PathFileFramesDriveTheCamera) {
     const std::string dir = test::temp_dir("cli_path");
     CliRun r = run_cli("path --scene gen:city:blocks=3 --kind walk --frames 20 --out " + dir + "/walk.json");
