@@ -272,6 +272,30 @@ TEST(OcclusionMaps, ApproximateCullingToleratesHolesUpToL) {
         }
 }
 
+// One occludee tested as several rectangles (SceneCuller tests an object's triangles) shares one
+// hole budget: two holes of 16 pixels hide it with L = 32, not with L = 16, however it is cut.
+TEST(OcclusionMaps, RectanglesOfOneOccludeeShareTheHoleBudget) {
+    Occluders o{128, 128, {}, {}};
+    o.add(0, 0, 128, 40, 4.0f);  // a wall at w = 4 with 4 x 4 holes at (40, 40) and (80, 40)
+    o.add(0, 44, 128, 128, 4.0f);
+    o.add(0, 40, 40, 44, 4.0f);
+    o.add(44, 40, 80, 44, 4.0f);
+    o.add(84, 40, 128, 44, 4.0f);
+    const OcclusionBuffer buffer = buffer_of(128, 128, 1, o);
+    const ScreenRect left = pixel_rect(128, 128, 20, 20, 60, 60, 8.0f), right = pixel_rect(128, 128, 64, 20, 100, 60, 8.0f);
+    for (double L : {16.0, 32.0}) {
+        OcclusionMaps maps(buffer, maps_config(buffer, DepthTest::masked, L));
+        maps.build(buffer);
+        EXPECT_EQ(maps.test_rect(buffer, left).visibility, Visibility::occluded);  // alone, each is within L
+        EXPECT_EQ(maps.test_rect(buffer, right).visibility, Visibility::occluded);
+        double budget = maps.hole_budget();
+        EXPECT_EQ(budget, L);
+        EXPECT_EQ(maps.test_rect_within(buffer, left, budget).visibility, Visibility::occluded);
+        EXPECT_EQ(budget, L - 16.0);
+        EXPECT_EQ(maps.test_rect_within(buffer, right, budget).visibility, L == 32.0 ? Visibility::occluded : Visibility::visible);
+    }
+}
+
 // Two occluders share each pixel of a column: a wall at w = 10 behind everything, and in front
 // of it, at w = 2, a panel over the left half of the column's samples. An occludee at w = 5
 // over that column is visible through the right halves. The no-background Z-buffer keeps each

@@ -224,7 +224,7 @@ bool OcclusionMaps::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
     return true;
 }
 
-void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, OccludeeAnswer& answer,
+void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer,
                             double& uncovered) const {
     // Start at the finest level whose cells are at least as large as the rectangle's smaller
     // side, within the active levels.
@@ -249,7 +249,6 @@ void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j
         }
     answer.level_of_visibility = float(std::clamp(estimate / rect_samples, 0.0, 1.0));
 
-    const double budget = std::floor(config_.hole_pixels * samples_per_display_pixel_);
     OverlapQuery q{&buffer, i0, i1, j0, j1, budget};
     for (int y = py0; y <= py1 && q.exit == OverlapExit::passed; ++y)
         for (int x = px0; x <= px1; ++x)
@@ -258,7 +257,14 @@ void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j
     uncovered = budget - q.budget;
 }
 
+double OcclusionMaps::hole_budget() const { return std::floor(config_.hole_pixels * samples_per_display_pixel_); }
+
 OccludeeAnswer OcclusionMaps::test_rect(const OcclusionBuffer& buffer, const ScreenRect& rect) const {
+    double budget = hole_budget();
+    return test_rect_within(buffer, rect, budget);
+}
+
+OccludeeAnswer OcclusionMaps::test_rect_within(const OcclusionBuffer& buffer, const ScreenRect& rect, double& budget) const {
     OccludeeAnswer answer;
     detail::RectQuery q;
     Visibility decided;
@@ -268,13 +274,14 @@ OccludeeAnswer OcclusionMaps::test_rect(const OcclusionBuffer& buffer, const Scr
         return answer;
     }
     double uncovered = 0.0;
-    overlap(buffer, q.i0, q.i1, q.j0, q.j1, answer, uncovered);
+    overlap(buffer, q.i0, q.i1, q.j0, q.j1, budget, answer, uncovered);
     if (answer.overlap_exit != std::uint8_t(OverlapExit::passed)) return answer;  // visible
     if (!depth_hidden(buffer, q.i0, q.i1, q.j0, q.j1, q.d_near)) {
         answer.level_of_visibility = 1.0f;  // in front of the occluders somewhere: no estimate
         return answer;
     }
     answer.visibility = Visibility::occluded;
+    budget -= uncovered;  // the holes this answer tolerated are spent
     answer.level_of_visibility = float(uncovered / (double(q.i1 - q.i0 + 1) * double(q.j1 - q.j0 + 1)));
     return answer;
 }

@@ -112,8 +112,9 @@ namespace {
 // rectangle at its nearest w (w is affine on the triangle, so its nearest point is a corner)
 // tested against the maps; when that rectangle is not hidden, the four halves-of-edges
 // sub-triangles (clip space is linear on the triangle, so they tile it exactly) are tried, down
-// to `depth` more levels. A corner before the near plane makes it visible.
-bool triangle_hidden(const OcclusionMaps& maps, const OcclusionBuffer& buffer, const glm::dvec4 c[3], int depth) {
+// to `depth` more levels. A corner before the near plane makes it visible. The rectangles
+// share the object's hole budget (approximate mode).
+bool triangle_hidden(const OcclusionMaps& maps, const OcclusionBuffer& buffer, const glm::dvec4 c[3], int depth, double& budget) {
     double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, min_w = HUGE_VAL;
     for (int k = 0; k < 3; ++k) {
         if (!std::isfinite(c[k].x) || !std::isfinite(c[k].y) || !std::isfinite(c[k].w) || c[k].w < double(buffer.config().near_w))
@@ -128,12 +129,12 @@ bool triangle_hidden(const OcclusionMaps& maps, const OcclusionBuffer& buffer, c
     const double slack_y = 0x1.0p-20 * (1.0 + std::abs(min_y) + std::abs(max_y));
     const ScreenRect r{down(min_x - slack_x), down(min_y - slack_y), up(max_x + slack_x), up(max_y + slack_y),
                        down(min_w * (1.0 - 0x1.0p-20))};
-    if (maps.test_rect(buffer, r).visibility != Visibility::visible) return true;
+    if (maps.test_rect_within(buffer, r, budget).visibility != Visibility::visible) return true;
     if (depth == 0) return false;
     const glm::dvec4 m01 = (c[0] + c[1]) * 0.5, m12 = (c[1] + c[2]) * 0.5, m20 = (c[2] + c[0]) * 0.5;
     const glm::dvec4 parts[4][3] = {{c[0], m01, m20}, {m01, c[1], m12}, {m20, m12, c[2]}, {m01, m12, m20}};
     for (const auto& part : parts)
-        if (!triangle_hidden(maps, buffer, part, depth - 1)) return false;
+        if (!triangle_hidden(maps, buffer, part, depth - 1, budget)) return false;
     return true;
 }
 
@@ -144,10 +145,11 @@ bool triangle_hidden(const OcclusionMaps& maps, const OcclusionBuffer& buffer, c
 bool SceneCuller::triangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
     const Mesh& mesh = scene_->meshes[object.mesh];
     const glm::dmat4 m = clip_from_world * object.world;
+    double budget = maps_.hole_budget();  // approximate mode: L pixels of holes for the whole object
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
         glm::dvec4 c[3];
         for (int k = 0; k < 3; ++k) c[k] = m * glm::dvec4(glm::dvec3(mesh.positions[mesh.indices[3 * t + std::size_t(k)]]), 1.0);
-        if (!triangle_hidden(maps_, buffer_, c, 3)) return false;
+        if (!triangle_hidden(maps_, buffer_, c, 3, budget)) return false;
     }
     return true;
 }

@@ -1,6 +1,8 @@
 #include <homcull/error.hpp>
 #include <homcull/truth/culling_accuracy.hpp>
 
+#include <algorithm>
+
 namespace homcull {
 
 void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally) {
@@ -22,6 +24,7 @@ void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler
             if (answer != Visibility::visible) {
                 ++tally.false_culls;
                 tally.robust_false_culls += t.robust_samples > 0;
+                tally.most_samples_falsely_culled = std::max(tally.most_samples_falsely_culled, t.visible_samples);
                 tally.false_cull_reports.push_back(scene.source + ": object " + std::to_string(id) + " (" + scene.objects[id].name +
                                                    ") seen by " + std::to_string(t.visible_samples) + " samples (" +
                                                    std::to_string(t.robust_samples) + " robust) from eye " + format_vec3(camera.eye) +

@@ -94,6 +94,12 @@ public:
     // be the one given to build(), unchanged since.
     OccludeeAnswer test_rect(const OcclusionBuffer& buffer, const ScreenRect& rect) const;
     OccludeeAnswer test_aabb(const OcclusionBuffer& buffer, const Aabb& box, const std::array<float, 16>& model_to_clip) const;
+    // One occludee tested as several rectangles (its triangles, say) must share one hole
+    // budget, or each rectangle would tolerate L pixels of holes: test_rect_within starts from
+    // `budget` (samples; hole_budget() for a fresh occludee) and, when it answers occluded,
+    // subtracts the holes it tolerated. Conservative mode: the budget is 0 and stays 0.
+    double hole_budget() const;
+    OccludeeAnswer test_rect_within(const OcclusionBuffer& buffer, const ScreenRect& rect, double& budget) const;
 
     const OcclusionMapsConfig& config() const { return config_; }
     // The opacity pyramid, for dumps and tests: level k is level_width(k) x level_height(k)
@@ -135,7 +141,8 @@ private:
 
     struct OverlapQuery;
     bool overlap_cell(OverlapQuery& q, int k, int x, int y) const;
-    void overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, OccludeeAnswer& answer, double& uncovered) const;
+    void overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer,
+                 double& uncovered) const;
     bool depth_hidden(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, float d_near) const;
     bool min_pyramid_above(const std::vector<float>& pyramid, int k, int x, int y, int x0, int y0, int x1, int y1, float d) const;
 };

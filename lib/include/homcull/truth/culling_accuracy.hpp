@@ -17,6 +17,7 @@ struct CullingTally {
     std::size_t culled_hidden = 0;      // of those, declared occluded or view-culled
     std::size_t false_culls = 0;        // seen, yet declared occluded or view-culled
     std::size_t robust_false_culls = 0; // of those, seen by at least one robust sample
+    std::uint64_t most_samples_falsely_culled = 0;  // the largest visible_samples among them
     std::vector<std::string> false_cull_reports;  // one line each: view, object, samples
     SceneCullTimings total_ms;                    // the culler's stage times, summed over views
     double efficiency() const { return hidden_in_frustum ? double(culled_hidden) / double(hidden_in_frustum) : 1.0; }
