@@ -33,11 +33,17 @@ echo "== frame 60 in detail"
   | head -16
 
 echo
-echo "== occlusion culling along the walk: the occlusion buffer's answers for every object's box"
+echo "== occlusion culling along the walk: hierarchical occlusion maps' answers for every object"
 echo "   against the exact visibility above (1280x720 display, 320x180 buffer with 4x4 samples)"
 "$homcull" accuracy --scene "$out/city.glb" --path "$out/city_walk.json" --resolution 1280x720 --samples 4 2>/dev/null
 "$homcull" accuracy --scene "$out/city.glb" --path "$out/city_walk.json" --resolution 1280x720 --samples 4 --json \
   > "$out/culling_accuracy.json" 2>/dev/null
+
+echo
+echo "== frame 60 culled on its own, with Embree's answer beside each object's"
+"$homcull" cull --scene "$out/city.glb" --path "$out/city_walk.json" --frame 60 --resolution 1280x720 --samples 4 --truth
+"$homcull" cull --scene "$out/city.glb" --path "$out/city_walk.json" --frame 60 --resolution 1280x720 --samples 4 --truth --json \
+  > "$out/frame60_cull.json"
 
 echo
 echo "== output in $out/"
@@ -46,3 +52,4 @@ echo "   city_walk.json          the camera path (DESIGN.md path format)"
 echo "   frame*_ids.png          the object seen by every sample, one colour per object"
 echo "   frame60_truth.json      per-object results for frame 60 (homcull truth --json)"
 echo "   culling_accuracy.json   false culls, missed culls and culling efficiency along the walk"
+echo "   frame60_cull.json       per-object culling answers, levels of visibility and stage times for frame 60"
