@@ -167,9 +167,7 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
         return false;
     }
     // Round the rectangle outwards and the depth towards the eye when going to float.
-    const auto down = [](double v) { float f = float(v); return double(f) > v ? std::nextafter(f, -INFINITY) : f; };
-    const auto up = [](double v) { float f = float(v); return double(f) < v ? std::nextafter(f, INFINITY) : f; };
-    rect = {down(min_x), down(min_y), up(max_x), up(max_y), down(min_w)};
+    rect = {float_down(min_x), float_down(min_y), float_up(max_x), float_up(max_y), float_down(min_w)};
     return true;
 }
 

@@ -12,6 +12,7 @@
 
 #include "core/opacity_pyramid.hpp"
 #include "core/rect_tests.hpp"
+#include "raster/rasterize.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -144,12 +145,7 @@ std::uint32_t uncovered_samples(const OcclusionBuffer& b, int i0, int i1, int j0
     std::uint32_t count = 0;
     for (int ty = j0 / kH; ty <= j1 / kH; ++ty)
         for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {
-            const int c0 = std::max(0, i0 - tx * kW), c1 = std::min(kW - 1, i1 - tx * kW);
-            const int r0 = std::max(0, j0 - ty * kH), r1 = std::min(kH - 1, j1 - ty * kH);
-            const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
-            std::uint32_t rect = 0;
-            for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
-            count += detail::bit_count(rect & ~b.subtile(tx, ty).covered);
+            count += detail::bit_count(detail::subtile_rect_bits(tx, ty, i0, i1, j0, j1) & ~b.subtile(tx, ty).covered);
         }
     return count;
 }

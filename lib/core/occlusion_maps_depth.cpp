@@ -28,12 +28,6 @@ namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 
-// float(v) rounded towards -infinity (v >= 0).
-float float_down(double v) {
-    const float f = float(v);
-    return double(f) > v ? std::nextafter(f, -INFINITY) : f;
-}
-
 // The depth estimation buffer cell of sample i on a grid of `samples` samples and `cells` cells.
 int deb_cell(int i, int samples, int cells) { return int(std::int64_t(i) * cells / samples); }
 
@@ -69,7 +63,7 @@ void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16
     int cx0 = 0, cx1 = gw - 1, cy0 = 0, cy1 = gh - 1;
     float depth = 0.0f;  // no bound
     if (finite) {
-        depth = float_down(1.0 / max_w);
+        depth = detail::float_down(1.0 / max_w);
         if (!crosses_near) {  // its projection lies in the corners' rectangle (slightly widened)
             const double slack = 1.0 / 256.0;
             int i0, i1, j0, j1;
@@ -116,13 +110,8 @@ bool OcclusionMaps::depth_hidden(const OcclusionBuffer& buffer, int i0, int i1, 
         // Holes tolerated: every covered sample of the rectangle must be behind its bound.
         for (int ty = j0 / kH; ty <= j1 / kH; ++ty)
             for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {
-                const int c0 = std::max(0, i0 - tx * kW), c1 = std::min(kW - 1, i1 - tx * kW);
-                const int r0 = std::max(0, j0 - ty * kH), r1 = std::min(kH - 1, j1 - ty * kH);
-                const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
-                std::uint32_t rect = 0;
-                for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
                 const OcclusionBuffer::Subtile t = buffer.subtile(tx, ty);
-                const std::uint32_t bits = rect & t.covered;
+                const std::uint32_t bits = detail::subtile_rect_bits(tx, ty, i0, i1, j0, j1) & t.covered;
                 if ((bits & ~t.mask) && !(t.d0 > d_near)) return false;
                 if ((bits & t.mask) && !(std::max(t.d0, t.d1) > d_near)) return false;
             }

@@ -5,6 +5,8 @@
 // at that stage, with the same answers.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "raster/rasterize.hpp"
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -40,12 +42,7 @@ struct SubtileView {
 // Whether subtile (tx, ty) hides the rectangle's samples in it: its bound there is d0, or
 // max(d0, d1) when they all lie in the working layer's mask.
 inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery& q) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    const int c0 = std::max(0, q.i0 - tx * kW), c1 = std::min(kW - 1, q.i1 - tx * kW);
-    const int r0 = std::max(0, q.j0 - ty * kH), r1 = std::min(kH - 1, q.j1 - ty * kH);
-    const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
-    std::uint32_t rect = 0;
-    for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
+    const std::uint32_t rect = subtile_rect_bits(tx, ty, q.i0, q.i1, q.j0, q.j1);
     const std::size_t i = std::size_t(ty) * v.stride + std::size_t(tx);
     const float bound = (v.mask[i] != 0 && (rect & ~v.mask[i]) == 0) ? std::max(v.d0[i], v.d1[i]) : v.d0[i];
     return q.d_near < bound;

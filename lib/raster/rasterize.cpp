@@ -32,16 +32,6 @@ inline int ceil_int(double x) {
     return i + (double(i) < x);
 }
 
-// float(v) rounded towards -infinity / +infinity.
-float float_down(double v) {
-    const float f = float(v);
-    return double(f) > v ? std::nextafter(f, -INFINITY) : f;
-}
-float float_up(double v) {
-    const float f = float(v);
-    return double(f) < v ? std::nextafter(f, INFINITY) : f;
-}
-
 }  // namespace
 
 std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_height) {

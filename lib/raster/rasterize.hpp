@@ -92,6 +92,29 @@ std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangl
 std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                            const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height);
 
+// float(v) rounded towards -infinity / +infinity: bounds that must stay on one side of a double
+// (rectangles rounded outwards, depths towards the eye).
+inline float float_down(double v) {
+    const float f = float(v);
+    return double(f) > v ? std::nextafter(f, -INFINITY) : f;
+}
+inline float float_up(double v) {
+    const float f = float(v);
+    return double(f) < v ? std::nextafter(f, INFINITY) : f;
+}
+
+// The mask of subtile (tx, ty)'s samples that lie in the sample range [i0, i1] x [j0, j1].
+inline std::uint32_t subtile_rect_bits(int tx, int ty, int i0, int i1, int j0, int j1) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const int c0 = std::max(0, i0 - tx * kW), c1 = std::min(kW - 1, i1 - tx * kW);
+    const int r0 = std::max(0, j0 - ty * kH), r1 = std::min(kH - 1, j1 - ty * kH);
+    if (c0 > c1 || r0 > r1) return 0;
+    const std::uint32_t columns = (0xFFu >> (kW - 1 - c1)) & (0xFFu << c0);
+    std::uint32_t rect = 0;
+    for (int j = r0; j <= r1; ++j) rect |= columns << (j * kW);
+    return rect;
+}
+
 // The samples of a grid of `count` whose centres (i + 0.5) lie in [lo, hi]: [first, last],
 // empty when first > last. The one rule for what a span of the screen covers, used by the
 // triangle bounding box, the binning and the rectangle tests.

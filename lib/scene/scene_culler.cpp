@@ -1,6 +1,8 @@
 #include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 
+#include "raster/rasterize.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,16 +20,6 @@ OcclusionMapsConfig maps_config(const SceneCullerConfig& c) {
     m.display_width = c.display.width;
     m.display_height = c.display.height;
     return m;
-}
-
-// float(v) rounded towards -infinity / +infinity.
-float down(double v) {
-    const float f = float(v);
-    return double(f) > v ? std::nextafter(f, -INFINITY) : f;
-}
-float up(double v) {
-    const float f = float(v);
-    return double(f) < v ? std::nextafter(f, INFINITY) : f;
 }
 
 }  // namespace
@@ -127,8 +119,8 @@ bool triangle_hidden(const OcclusionMaps& maps, const OcclusionBuffer& buffer, c
     // transform to float, this does not.
     const double slack_x = 0x1.0p-20 * (1.0 + std::abs(min_x) + std::abs(max_x));
     const double slack_y = 0x1.0p-20 * (1.0 + std::abs(min_y) + std::abs(max_y));
-    const ScreenRect r{down(min_x - slack_x), down(min_y - slack_y), up(max_x + slack_x), up(max_y + slack_y),
-                       down(min_w * (1.0 - 0x1.0p-20))};
+    const ScreenRect r{detail::float_down(min_x - slack_x), detail::float_down(min_y - slack_y), detail::float_up(max_x + slack_x),
+                       detail::float_up(max_y + slack_y), detail::float_down(min_w * (1.0 - 0x1.0p-20))};
     if (maps.test_rect_within(buffer, r, budget).visibility != Visibility::visible) return true;
     if (depth == 0) return false;
     const glm::dvec4 m01 = (c[0] + c[1]) * 0.5, m12 = (c[1] + c[2]) * 0.5, m20 = (c[2] + c[0]) * 0.5;

@@ -98,10 +98,7 @@ void run_cull(const CullCommandOptions& o) {
         for (int e = 1; e < 7; ++e) exits[overlap_exit_name(OverlapExit(e))] = culler.overlap_exits().count[e];
         nlohmann::json out = {
             {"scene", scene.source},
-            {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}},
-                        {"target", {camera.target.x, camera.target.y, camera.target.z}},
-                        {"up", {camera.up.x, camera.up.y, camera.up.z}},
-                        {"fov_y", camera.fov_y_degrees}, {"near", camera.near_plane}, {"far", camera.far_plane}}},
+            {"camera", camera_json(camera)},
             {"display", {config.display.width, config.display.height}},
             {"buffer", {culler.buffer().config().width, culler.buffer().config().height}},
             {"samples", config.samples},

@@ -63,10 +63,7 @@ void run_truth(const TruthCommandOptions& o) {
         }
         nlohmann::json out = {
             {"scene", scene.source},
-            {"camera", {{"eye", {camera.eye.x, camera.eye.y, camera.eye.z}},
-                        {"target", {camera.target.x, camera.target.y, camera.target.z}},
-                        {"up", {camera.up.x, camera.up.y, camera.up.z}},
-                        {"fov_y", camera.fov_y_degrees}, {"near", camera.near_plane}, {"far", camera.far_plane}}},
+            {"camera", camera_json(camera)},
             {"resolution", {options.resolution.width, options.resolution.height}},
             {"samples", options.samples},
             {"objects", objects},

@@ -64,6 +64,15 @@ glm::dvec3 parse_vec3(const std::string& text, const char* what) {
     return v;
 }
 
+nlohmann::json camera_json(const Camera& c) {
+    return {{"eye", {c.eye.x, c.eye.y, c.eye.z}},
+            {"target", {c.target.x, c.target.y, c.target.z}},
+            {"up", {c.up.x, c.up.y, c.up.z}},
+            {"fov_y", c.fov_y_degrees},
+            {"near", c.near_plane},
+            {"far", c.far_plane}};
+}
+
 Resolution parse_resolution(const std::string& text) {
     Resolution r;
     char* end = nullptr;

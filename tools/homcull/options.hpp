@@ -3,6 +3,7 @@
 #include <homcull/camera.hpp>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <string>
 
@@ -25,6 +26,9 @@ Camera resolve_camera(const CameraOptions& options);
 glm::dvec3 parse_vec3(const std::string& text, const char* what);
 // "WxH" (also "W,H").
 Resolution parse_resolution(const std::string& text);
+
+// {"eye","target","up","fov_y","near","far"}: a camera as commands print it (the path format's fields).
+nlohmann::json camera_json(const Camera& camera);
 
 // Milliseconds since `start` (std::chrono::steady_clock).
 double elapsed_ms(long long start_ns);
