@@ -167,21 +167,21 @@ TEST(OcclusionMaps, OverlapPassesAndConservativeRejection) {
     OcclusionMaps maps(buffer, maps_config(buffer));
     maps.build(buffer);
     // Inside the covered part, behind it: passes, occluded.
-    OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(64, 64, 32, 32, 64, 64, 8.0f));
+    OccludeeAnswer a = maps.test_rect(pixel_rect(64, 64, 32, 32, 64, 64, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::passed);
     EXPECT_EQ(a.visibility, Visibility::occluded);
     EXPECT_EQ(a.level_of_visibility, 0.0f);
     // In front of it: the overlap passes, the depth test does not.
-    a = maps.test_rect(buffer, pixel_rect(64, 64, 32, 32, 64, 64, 2.0f));
+    a = maps.test_rect(pixel_rect(64, 64, 32, 32, 64, 64, 2.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::passed);
     EXPECT_EQ(a.visibility, Visibility::visible);
     // The 32 x 32 cell holding the hole, whole: conservative rejection at the start level.
-    a = maps.test_rect(buffer, pixel_rect(64, 64, 0, 0, 32, 32, 8.0f));
+    a = maps.test_rect(pixel_rect(64, 64, 0, 0, 32, 32, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::conservative_rejection);
     EXPECT_EQ(a.visibility, Visibility::visible);
     EXPECT_NEAR(a.level_of_visibility, 1.0 / 1024.0, 1e-7);
     // Partly over the hole's cell but not over the hole: descends and passes.
-    a = maps.test_rect(buffer, pixel_rect(64, 64, 12, 12, 44, 44, 8.0f));
+    a = maps.test_rect(pixel_rect(64, 64, 12, 12, 44, 44, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::passed);
     EXPECT_EQ(a.visibility, Visibility::occluded);
 }
@@ -193,14 +193,14 @@ TEST(OcclusionMaps, PredictiveRejectionAndTransparentCells) {
     OcclusionMaps maps(buffer, maps_config(buffer));
     maps.build(buffer);
     // 144 pixels of that cell in the rectangle, only 100 covered: some hole must be inside.
-    OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(64, 64, 4, 4, 20, 20, 8.0f));
+    OccludeeAnswer a = maps.test_rect(pixel_rect(64, 64, 4, 4, 20, 20, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::predictive_rejection);
     // Nothing covered at all where the rectangle is.
-    a = maps.test_rect(buffer, pixel_rect(64, 64, 40, 40, 50, 50, 8.0f));
+    a = maps.test_rect(pixel_rect(64, 64, 40, 40, 50, 50, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::transparent_cell);
     EXPECT_EQ(a.level_of_visibility, 1.0f);
     // Inside the covered square: passes after descending.
-    a = maps.test_rect(buffer, pixel_rect(64, 64, 1, 1, 9, 9, 8.0f));
+    a = maps.test_rect(pixel_rect(64, 64, 1, 1, 9, 9, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::passed);
     EXPECT_EQ(a.visibility, Visibility::occluded);
 }
@@ -214,11 +214,11 @@ TEST(OcclusionMaps, SamplesDecideWithinAPixel) {
     OcclusionMaps maps(buffer, maps_config(buffer));
     maps.build(buffer);
     // The covered half of pixel (5, 5): passes by its samples.
-    OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(16, 16, 5.0, 5.0, 6.0, 5.5, 8.0f));
+    OccludeeAnswer a = maps.test_rect(pixel_rect(16, 16, 5.0, 5.0, 6.0, 5.5, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::passed);
     EXPECT_EQ(a.visibility, Visibility::occluded);
     // Its left half, rows of both halves: 8 samples as many as are covered, 4 of them not.
-    a = maps.test_rect(buffer, pixel_rect(16, 16, 5.0, 5.0, 5.5, 6.0, 8.0f));
+    a = maps.test_rect(pixel_rect(16, 16, 5.0, 5.0, 5.5, 6.0, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::samples);
     EXPECT_EQ(a.visibility, Visibility::visible);
 }
@@ -231,13 +231,13 @@ TEST(OcclusionMaps, FinestActiveLevelChargesItsHoles) {
     c.finest_level = 3;  // cells of 8 x 8 pixels: column 8..15 is a half-covered cell
     OcclusionMaps maps(buffer, c);
     maps.build(buffer);
-    const OccludeeAnswer a = maps.test_rect(buffer, pixel_rect(64, 64, 0, 0, 10, 8, 8.0f));
+    const OccludeeAnswer a = maps.test_rect(pixel_rect(64, 64, 0, 0, 10, 8, 8.0f));
     EXPECT_EQ(exit_of(a), OverlapExit::finest_level);
     EXPECT_EQ(a.visibility, Visibility::visible);
     // With every level active the same rectangle is found covered.
     OcclusionMaps all(buffer, maps_config(buffer));
     all.build(buffer);
-    EXPECT_EQ(all.test_rect(buffer, pixel_rect(64, 64, 0, 0, 10, 8, 8.0f)).visibility, Visibility::occluded);
+    EXPECT_EQ(all.test_rect(pixel_rect(64, 64, 0, 0, 10, 8, 8.0f)).visibility, Visibility::occluded);
 }
 
 // A wall at w = 4 with a square hole of side `hole` pixels, and an occludee at w = 8 whose
@@ -259,7 +259,7 @@ TEST(OcclusionMaps, ApproximateCullingToleratesHolesUpToL) {
                 maps.clear();
                 maps.add_occluder_box({glm::vec3(-4.0f, -4.0f, 4.0f), glm::vec3(4.0f, 4.0f, 4.0f)}, kXyw);  // the wall's box
                 maps.build(buffer);
-                const OccludeeAnswer a = maps.test_rect(buffer, behind);
+                const OccludeeAnswer a = maps.test_rect(behind);
                 const bool hidden = hole == 0 || (L > 0.0 && hole * hole <= L);
                 EXPECT_EQ(a.visibility, hidden ? Visibility::occluded : Visibility::visible)
                     << "depth " << int(depth) << ", hole " << hole << "x" << hole << ", L " << L;
@@ -267,7 +267,7 @@ TEST(OcclusionMaps, ApproximateCullingToleratesHolesUpToL) {
                     EXPECT_NEAR(a.level_of_visibility, double(hole * hole) / 3600.0, 1e-6);
                 }
                 // In front of the wall nothing is hidden, holes or not.
-                EXPECT_EQ(maps.test_rect(buffer, pixel_rect(128, 128, 30, 30, 90, 90, 3.0f)).visibility, Visibility::visible);
+                EXPECT_EQ(maps.test_rect(pixel_rect(128, 128, 30, 30, 90, 90, 3.0f)).visibility, Visibility::visible);
             }
         }
 }
@@ -286,13 +286,13 @@ TEST(OcclusionMaps, RectanglesOfOneOccludeeShareTheHoleBudget) {
     for (double L : {16.0, 32.0}) {
         OcclusionMaps maps(buffer, maps_config(buffer, DepthTest::masked, L));
         maps.build(buffer);
-        EXPECT_EQ(maps.test_rect(buffer, left).visibility, Visibility::occluded);  // alone, each is within L
-        EXPECT_EQ(maps.test_rect(buffer, right).visibility, Visibility::occluded);
+        EXPECT_EQ(maps.test_rect(left).visibility, Visibility::occluded);  // alone, each is within L
+        EXPECT_EQ(maps.test_rect(right).visibility, Visibility::occluded);
         double budget = maps.hole_budget();
         EXPECT_EQ(budget, L);
-        EXPECT_EQ(maps.test_rect_within(buffer, left, budget).visibility, Visibility::occluded);
+        EXPECT_EQ(maps.test_rect_within(left, budget).visibility, Visibility::occluded);
         EXPECT_EQ(budget, L - 16.0);
-        EXPECT_EQ(maps.test_rect_within(buffer, right, budget).visibility, L == 32.0 ? Visibility::occluded : Visibility::visible);
+        EXPECT_EQ(maps.test_rect_within(right, budget).visibility, L == 32.0 ? Visibility::occluded : Visibility::visible);
     }
 }
 
@@ -313,7 +313,7 @@ TEST(OcclusionMaps, NearestDepthZBufferIsNotConservativeWithPartialCoverage) {
         maps.add_occluder_box({glm::vec3(-2.0f, -2.0f, 2.0f), glm::vec3(2.0f * (8.5f / 8.0f - 1.0f), 2.0f, 2.0f)}, kXyw);
         maps.add_occluder_box({glm::vec3(-10.0f, -10.0f, 10.0f), glm::vec3(10.0f, 10.0f, 10.0f)}, kXyw);
         maps.build(buffer);
-        const OccludeeAnswer a = maps.test_rect(buffer, column);
+        const OccludeeAnswer a = maps.test_rect(column);
         EXPECT_EQ(exit_of(a), OverlapExit::passed);
         EXPECT_EQ(a.visibility, depth == DepthTest::nbz ? Visibility::occluded : Visibility::visible) << "depth " << int(depth);
     }
@@ -347,7 +347,7 @@ TEST(OcclusionMaps, ConservativeOverlapIsExactOnRandomInput) {
                 for (int i = i0; i <= i1 && all; ++i) all = covered[std::size_t(j) * std::size_t(sw) + std::size_t(i)] != 0;
             // The rectangle through the samples' centres, well inside their cells.
             const ScreenRect r = pixel_rect(sw, sh, i0 + 0.25, j0 + 0.25, i1 + 0.75, j1 + 0.75, 1000.0f);
-            const OccludeeAnswer a = maps.test_rect(buffer, r);
+            const OccludeeAnswer a = maps.test_rect(r);
             ASSERT_EQ(exit_of(a) == OverlapExit::passed, all) << "S " << s << " samples [" << i0 << ", " << i1 << "] x [" << j0 << ", " << j1 << "]";
             passed += all;
         }
@@ -371,15 +371,20 @@ TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.coarsest_level = 40; }), Error);
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.deb_width = 0; }), Error);
     EXPECT_NO_THROW(make([](OcclusionMapsConfig&) {}));
+    // Tests need a built map.
+    {
+        const OcclusionMaps unbuilt(buffer, maps_config(buffer));
+        EXPECT_THROW(unbuilt.test_rect({-1, -1, 1, 1, 5.0f}), Error);
+    }
     // A 1 x 1 buffer is a one-level pyramid.
     const OcclusionBuffer tiny = buffer_of(1, 1, 4, Occluders{1, 1, {}, {}});
     OcclusionMaps maps(tiny, maps_config(tiny));
     maps.build(tiny);
     EXPECT_EQ(maps.levels(), 1);
-    EXPECT_EQ(maps.test_rect(tiny, {-1, -1, 1, 1, 5.0f}).visibility, Visibility::visible);
+    EXPECT_EQ(maps.test_rect({-1, -1, 1, 1, 5.0f}).visibility, Visibility::visible);
     // NaN rectangles are visible, off-screen ones view-culled.
-    EXPECT_EQ(maps.test_rect(tiny, {NAN, -1, 1, 1, 5.0f}).visibility, Visibility::visible);
-    EXPECT_EQ(maps.test_rect(tiny, {2, 2, 3, 3, 5.0f}).visibility, Visibility::view_culled);
+    EXPECT_EQ(maps.test_rect({NAN, -1, 1, 1, 5.0f}).visibility, Visibility::visible);
+    EXPECT_EQ(maps.test_rect({2, 2, 3, 3, 5.0f}).visibility, Visibility::view_culled);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // whose first, coarse stage runs in SIMD lanes: rect_tests_simd.cpp) and world boxes.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/min_pyramid.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_setup.hpp"
@@ -72,22 +73,6 @@ Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_
     return Visibility::occluded;
 }
 
-// Is there a subtile in [x0, x1] x [y0, y1] (subtile units) within the pyramid cell whose d0
-// is at or below d_near? Cells whose minimum is above d_near are pruned.
-bool OcclusionBuffer::any_farther_or_equal(int level, int x, int y, int x0, int y0, int x1, int y1, float d_near) const {
-    const int cx0 = x << level, cy0 = y << level, cx1 = ((x + 1) << level) - 1, cy1 = ((y + 1) << level) - 1;
-    if (cx1 < x0 || cx0 > x1 || cy1 < y0 || cy0 > y1) return false;
-    if (d_near < min_d0(level, x, y)) return false;
-    if (level == 0 || (cx0 >= x0 && cx1 <= x1 && cy0 >= y0 && cy1 <= y1)) return true;
-    const Level& below = levels_[std::size_t(level) - 1];
-    for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx)
-            if (2 * x + dx < below.width && 2 * y + dy < below.height &&
-                any_farther_or_equal(level - 1, 2 * x + dx, 2 * y + dy, x0, y0, x1, y1, d_near))
-                return true;
-    return false;
-}
-
 Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
     detail::RectQuery q;
     Visibility decided;
@@ -100,8 +85,7 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
 
     // Coarse check: the level where the subtile range spans at most 2 x 2 cells. Their minimum
     // d0 is at most any covered subtile's bound, so d_near below it hides the rectangle.
-    int level = 0;
-    while ((tx1 >> level) - (tx0 >> level) > 1 || (ty1 >> level) - (ty0 >> level) > 1) ++level;
+    const int level = detail::coarse_level(tx0, tx1, ty0, ty1, int(levels_.size()));
     float coarse = INFINITY;
     for (int y = ty0 >> level; y <= ty1 >> level; ++y)
         for (int x = tx0 >> level; x <= tx1 >> level; ++x) coarse = std::min(coarse, min_d0(level, x, y));
@@ -109,11 +93,9 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
     if (const detail::RectScanKernel scan = detail::selected_rect_scan_kernel()) return scan(subtile_view(), q, sample_width_);
     // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound
     // (>= d0) is above d_near and the rectangle is hidden. Most hidden rectangles end here.
-    bool any_at_or_behind = false;
-    for (int y = ty0 >> level; y <= ty1 >> level && !any_at_or_behind; ++y)
-        for (int x = tx0 >> level; x <= tx1 >> level && !any_at_or_behind; ++x)
-            any_at_or_behind = any_farther_or_equal(level, x, y, tx0, ty0, tx1, ty1, q.d_near);
-    if (!any_at_or_behind) return Visibility::occluded;
+    const int level_count = int(levels_.size());
+    if (detail::min_pyramid_range_above(pyramid_.data(), levels_.data(), level_count, tx0, ty0, tx1, ty1, q.d_near))
+        return Visibility::occluded;
 
     const detail::SubtileView view = subtile_view();
     // Interior subtiles (all their samples in the rectangle): their bound is d0, so the
@@ -130,44 +112,54 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
             }
             if (!detail::subtile_hides(view, tx, ty, q)) return Visibility::visible;
         }
-    if (ix0 <= ix1 && iy0 <= iy1)
-        for (int y = ty0 >> level; y <= ty1 >> level; ++y)
-            for (int x = tx0 >> level; x <= tx1 >> level; ++x)
-                if (any_farther_or_equal(level, x, y, ix0, iy0, ix1, iy1, q.d_near)) return Visibility::visible;
+    if (ix0 <= ix1 && iy0 <= iy1 &&
+        !detail::min_pyramid_range_above(pyramid_.data(), levels_.data(), level_count, ix0, iy0, ix1, iy1, q.d_near))
+        return Visibility::visible;
     return Visibility::occluded;
 }
 
 namespace detail {
 
-bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, ScreenRect& rect,
-                   Visibility& decided) {
-    // Incremental corner transform: the base corner plus the three transformed edge vectors.
-    const glm::dvec4 base = detail::transform_to_clip(m, box_min[0], box_min[1], box_min[2], 1.0);
-    const glm::dvec4 ex = detail::transform_to_clip(m, double(box_max[0]) - double(box_min[0]), 0, 0, 0);
-    const glm::dvec4 ey = detail::transform_to_clip(m, 0, double(box_max[1]) - double(box_min[1]), 0, 0);
-    const glm::dvec4 ez = detail::transform_to_clip(m, 0, 0, double(box_max[2]) - double(box_min[2]), 0);
-    double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, min_w = HUGE_VAL;
-    int behind = 0;
-    for (int k = 0; k < 8; ++k) {
-        const glm::dvec4 c = base + ((k & 1) ? ex : glm::dvec4(0)) + ((k & 2) ? ey : glm::dvec4(0)) + ((k & 4) ? ez : glm::dvec4(0));
-        if (!detail::finite_clip(c)) {
-            decided = Visibility::visible;
-            return false;
+void box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, glm::dvec4 corners[8]) {
+    const glm::dvec4 base = transform_to_clip(m, box_min[0], box_min[1], box_min[2], 1.0);
+    const glm::dvec4 ex = transform_to_clip(m, double(box_max[0]) - double(box_min[0]), 0, 0, 0);
+    const glm::dvec4 ey = transform_to_clip(m, 0, double(box_max[1]) - double(box_min[1]), 0, 0);
+    const glm::dvec4 ez = transform_to_clip(m, 0, 0, double(box_max[2]) - double(box_min[2]), 0);
+    for (int k = 0; k < 8; ++k)
+        corners[k] = base + ((k & 1) ? ex : glm::dvec4(0)) + ((k & 2) ? ey : glm::dvec4(0)) + ((k & 4) ? ez : glm::dvec4(0));
+}
+
+ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w) {
+    ClipBounds b;
+    for (int k = 0; k < count; ++k) {
+        const glm::dvec4& c = points[k];
+        if (!finite_clip(c)) {
+            b.finite = false;
+            return b;
         }
-        if (c.w < double(near_w)) {
-            ++behind;
+        b.max_w = std::max(b.max_w, c.w);
+        if (c.w < near_w) {
+            ++b.behind;
             continue;
         }
-        min_x = std::min(min_x, c.x / c.w), max_x = std::max(max_x, c.x / c.w);
-        min_y = std::min(min_y, c.y / c.w), max_y = std::max(max_y, c.y / c.w);
-        min_w = std::min(min_w, c.w);
+        b.min_x = std::min(b.min_x, c.x / c.w), b.max_x = std::max(b.max_x, c.x / c.w);
+        b.min_y = std::min(b.min_y, c.y / c.w), b.max_y = std::max(b.max_y, c.y / c.w);
+        b.min_w = std::min(b.min_w, c.w);
     }
-    if (behind > 0) {
-        decided = behind == 8 ? Visibility::view_culled : Visibility::visible;
+    return b;
+}
+
+bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, ScreenRect& rect,
+                   Visibility& decided) {
+    glm::dvec4 corners[8];
+    box_corners(box_min, box_max, m, corners);
+    const ClipBounds b = clip_bounds(corners, 8, double(near_w));
+    if (!b.finite || b.behind > 0) {  // nothing to reason with, or crossing the near plane: visible
+        decided = b.finite && b.behind == 8 ? Visibility::view_culled : Visibility::visible;
         return false;
     }
     // Round the rectangle outwards and the depth towards the eye when going to float.
-    rect = {float_down(min_x), float_down(min_y), float_up(max_x), float_up(max_y), float_down(min_w)};
+    rect = {float_down(b.min_x), float_down(b.min_y), float_up(b.max_x), float_up(b.max_y), float_down(b.min_w)};
     return true;
 }
 

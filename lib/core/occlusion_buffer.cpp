@@ -53,12 +53,12 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
     std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
     while (levels_.back().width > 1 || levels_.back().height > 1) {
-        const Level& below = levels_.back();
+        const detail::PyramidLevel& below = levels_.back();
         levels_.push_back({(below.width + 1) / 2, (below.height + 1) / 2, size});
         size += std::size_t(levels_.back().width) * std::size_t(levels_.back().height);
     }
     pyramid_.assign(size, 0.0f);
-    for (const Level& l : levels_) {
+    for (const detail::PyramidLevel& l : levels_) {
         level_offset_.push_back(std::int32_t(l.offset));
         level_width_.push_back(l.width);
     }
@@ -77,8 +77,8 @@ void OcclusionBuffer::build_pyramid() {
     for (int ty = 0; ty < subtiles_y_; ++ty)
         std::copy_n(d0_.begin() + std::ptrdiff_t(at(0, ty)), subtiles_x_, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_);
     for (std::size_t level = 1; level < levels_.size(); ++level) {
-        const Level& below = levels_[level - 1];
-        const Level& here = levels_[level];
+        const detail::PyramidLevel& below = levels_[level - 1];
+        const detail::PyramidLevel& here = levels_[level];
         for (int y = 0; y < here.height; ++y)
             for (int x = 0; x < here.width; ++x) {
                 float m = min_d0(int(level) - 1, 2 * x, 2 * y);

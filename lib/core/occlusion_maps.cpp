@@ -81,10 +81,14 @@ OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsC
     }
 }
 
+OcclusionMaps::CellSpan OcclusionMaps::cell_span(int k, int x, int y) const {
+    return {(x << k) * samples_, std::min((x + 1) << k, width_) * samples_ - 1, (y << k) * samples_,
+            std::min((y + 1) << k, height_) * samples_ - 1};
+}
+
 std::uint32_t OcclusionMaps::cell_samples(int k, int x, int y) const {
-    const int px0 = x << k, py0 = y << k;
-    const int px1 = std::min((x + 1) << k, width_), py1 = std::min((y + 1) << k, height_);
-    return std::uint32_t(px1 - px0) * std::uint32_t(py1 - py0) * std::uint32_t(samples_ * samples_);
+    const CellSpan c = cell_span(k, x, y);
+    return std::uint32_t(c.x1 - c.x0 + 1) * std::uint32_t(c.y1 - c.y0 + 1);
 }
 
 float OcclusionMaps::opacity(int k, int x, int y) const {
@@ -127,12 +131,17 @@ void OcclusionMaps::build(const OcclusionBuffer& buffer) {
     }
     const Level& top = levels_.back();
     plane_ = *std::min_element(hzb_.begin() + std::ptrdiff_t(top.offset), hzb_.end());
+    built_ = &buffer;
+}
+
+const OcclusionBuffer& OcclusionMaps::built() const {
+    if (!built_) throw Error("occlusion maps: test before build()");
+    return *built_;
 }
 
 // The overlap test's state: the rectangle in samples, the hole budget left (samples that may
 // stay uncovered), and how the test ended.
 struct OcclusionMaps::OverlapQuery {
-    const OcclusionBuffer* buffer;
     int i0, i1, j0, j1;
     double budget;
     OverlapExit exit = OverlapExit::passed;
@@ -155,10 +164,8 @@ std::uint32_t uncovered_samples(const OcclusionBuffer& b, int i0, int i1, int j0
 // One cell of the hierarchical overlap test (Zhang 5.3, Fig. 5.3). Returns false when the
 // rectangle is rejected (not inside the occluders' projection, within the hole budget).
 bool OcclusionMaps::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
-    const int s = samples_;
-    const int sx0 = (x << k) * s, sy0 = (y << k) * s;
-    const int sx1 = std::min((x + 1) << k, width_) * s - 1, sy1 = std::min((y + 1) << k, height_) * s - 1;
-    const int ox0 = std::max(sx0, q.i0), ox1 = std::min(sx1, q.i1), oy0 = std::max(sy0, q.j0), oy1 = std::min(sy1, q.j1);
+    const CellSpan cell = cell_span(k, x, y);
+    const int ox0 = std::max(cell.x0, q.i0), ox1 = std::min(cell.x1, q.i1), oy0 = std::max(cell.y0, q.j0), oy1 = std::min(cell.y1, q.j1);
     if (ox0 > ox1 || oy0 > oy1) return true;  // the rectangle misses this cell
     const Level& l = levels_[std::size_t(k)];
     const double n = double(cell_samples(k, x, y));
@@ -195,8 +202,8 @@ bool OcclusionMaps::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
         return true;
     }
     if (k == config_.finest_level) {
-        if (k == 0 && s > 1) {  // one pixel: count its samples in the rectangle
-            const double exact = double(uncovered_samples(*q.buffer, ox0, ox1, oy0, oy1));
+        if (k == 0 && samples_ > 1) {  // one pixel: count its samples in the rectangle
+            const double exact = double(uncovered_samples(*built_, ox0, ox1, oy0, oy1));
             if (exact > q.budget) {
                 q.exit = OverlapExit::samples;
                 return false;
@@ -220,8 +227,7 @@ bool OcclusionMaps::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
     return true;
 }
 
-void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer,
-                            double& uncovered) const {
+void OcclusionMaps::overlap(int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer, double& uncovered) const {
     // Start at the finest level whose cells are at least as large as the rectangle's smaller
     // side, within the active levels.
     const int smaller_side = std::min(i1 - i0 + 1, j1 - j0 + 1);
@@ -234,18 +240,17 @@ void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j
     // evenly over it, times the rectangle's part of it.
     const double rect_samples = double(i1 - i0 + 1) * double(j1 - j0 + 1);
     double estimate = 0.0;
-    for (int y = py0; y <= std::min(py1, l.height - 1); ++y)
-        for (int x = px0; x <= std::min(px1, l.width - 1); ++x) {
-            const int s = samples_;
-            const int sx0 = (x << k) * s, sy0 = (y << k) * s;
-            const int sx1 = std::min((x + 1) << k, width_) * s - 1, sy1 = std::min((y + 1) << k, height_) * s - 1;
-            const double r = double(std::min(sx1, i1) - std::max(sx0, i0) + 1) * double(std::min(sy1, j1) - std::max(sy0, j0) + 1);
+    for (int y = py0; y <= py1; ++y)
+        for (int x = px0; x <= px1; ++x) {
+            const CellSpan cell = cell_span(k, x, y);  // holds part of the rectangle
+            const double r =
+                double(std::min(cell.x1, i1) - std::max(cell.x0, i0) + 1) * double(std::min(cell.y1, j1) - std::max(cell.y0, j0) + 1);
             const double n = double(cell_samples(k, x, y));
             estimate += r * (n - double(covered_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)])) / n;
         }
     answer.level_of_visibility = float(std::clamp(estimate / rect_samples, 0.0, 1.0));
 
-    OverlapQuery q{&buffer, i0, i1, j0, j1, budget};
+    OverlapQuery q{i0, i1, j0, j1, budget};
     for (int y = py0; y <= py1 && q.exit == OverlapExit::passed; ++y)
         for (int x = px0; x <= px1; ++x)
             if (!overlap_cell(q, k, x, y)) break;
@@ -255,24 +260,33 @@ void OcclusionMaps::overlap(const OcclusionBuffer& buffer, int i0, int i1, int j
 
 double OcclusionMaps::hole_budget() const { return std::floor(config_.hole_pixels * samples_per_display_pixel_); }
 
-OccludeeAnswer OcclusionMaps::test_rect(const OcclusionBuffer& buffer, const ScreenRect& rect) const {
-    double budget = hole_budget();
-    return test_rect_within(buffer, rect, budget);
+namespace {
+
+// The answer for an occludee decided before any map is asked (see OcclusionBuffer::prepare).
+OccludeeAnswer decided_answer(Visibility v) {
+    OccludeeAnswer answer;
+    answer.visibility = v;
+    answer.level_of_visibility = v == Visibility::visible ? 1.0f : 0.0f;
+    return answer;
 }
 
-OccludeeAnswer OcclusionMaps::test_rect_within(const OcclusionBuffer& buffer, const ScreenRect& rect, double& budget) const {
-    OccludeeAnswer answer;
+}  // namespace
+
+OccludeeAnswer OcclusionMaps::test_rect(const ScreenRect& rect) const {
+    double budget = hole_budget();
+    return test_rect_within(rect, budget);
+}
+
+OccludeeAnswer OcclusionMaps::test_rect_within(const ScreenRect& rect, double& budget) const {
     detail::RectQuery q;
     Visibility decided;
-    if (!buffer.prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided)) {
-        answer.visibility = decided;
-        answer.level_of_visibility = decided == Visibility::visible ? 1.0f : 0.0f;
-        return answer;
-    }
+    if (!built().prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
+        return decided_answer(decided);
+    OccludeeAnswer answer;
     double uncovered = 0.0;
-    overlap(buffer, q.i0, q.i1, q.j0, q.j1, budget, answer, uncovered);
+    overlap(q.i0, q.i1, q.j0, q.j1, budget, answer, uncovered);
     if (answer.overlap_exit != std::uint8_t(OverlapExit::passed)) return answer;  // visible
-    if (!depth_hidden(buffer, q.i0, q.i1, q.j0, q.j1, q.d_near)) {
+    if (!depth_hidden(q.i0, q.i1, q.j0, q.j1, q.d_near)) {
         answer.level_of_visibility = 1.0f;  // in front of the occluders somewhere: no estimate
         return answer;
     }
@@ -282,16 +296,11 @@ OccludeeAnswer OcclusionMaps::test_rect_within(const OcclusionBuffer& buffer, co
     return answer;
 }
 
-OccludeeAnswer OcclusionMaps::test_aabb(const OcclusionBuffer& buffer, const Aabb& box, const std::array<float, 16>& m) const {
+OccludeeAnswer OcclusionMaps::test_aabb(const Aabb& box, const std::array<float, 16>& m) const {
     ScreenRect r;
     Visibility decided;
-    if (!detail::box_rectangle(&box.min.x, &box.max.x, m, buffer.config().near_w, r, decided)) {
-        OccludeeAnswer answer;
-        answer.visibility = decided;
-        answer.level_of_visibility = decided == Visibility::visible ? 1.0f : 0.0f;
-        return answer;
-    }
-    return test_rect(buffer, r);
+    if (!detail::box_rectangle(&box.min.x, &box.max.x, m, built().config().near_w, r, decided)) return decided_answer(decided);
+    return test_rect(r);
 }
 
 }  // namespace homcull

@@ -16,9 +16,9 @@
 // In approximate mode holes are tolerated, and the depth maps ignore uncovered samples.
 #include <homcull/occlusion_maps.hpp>
 
+#include "core/min_pyramid.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
-#include "raster/triangle_setup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -40,37 +40,21 @@ void OcclusionMaps::clear() { std::fill(deb_.begin(), deb_.end(), INFINITY); }
 void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16>& m) {
     const int gw = config_.deb_width, gh = config_.deb_height;
     const int sample_width = width_ * samples_, sample_height = height_ * samples_;
-    double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, max_w = -HUGE_VAL;
-    bool finite = true, crosses_near = false;
-    int in_front = 0;
-    for (int k = 0; k < 8; ++k) {
-        const glm::dvec4 c = detail::transform_to_clip(m, (k & 1) ? box.max.x : box.min.x, (k & 2) ? box.max.y : box.min.y,
-                                                       (k & 4) ? box.max.z : box.min.z, 1.0);
-        if (!detail::finite_clip(c)) {
-            finite = false;
-            break;
-        }
-        max_w = std::max(max_w, c.w);
-        if (c.w < double(near_w_)) {
-            crosses_near = true;
-            continue;
-        }
-        ++in_front;
-        min_x = std::min(min_x, c.x / c.w), max_x = std::max(max_x, c.x / c.w);
-        min_y = std::min(min_y, c.y / c.w), max_y = std::max(max_y, c.y / c.w);
-    }
-    if (finite && in_front == 0) return;  // entirely before the near plane: draws nothing
+    glm::dvec4 corners[8];
+    detail::box_corners(&box.min.x, &box.max.x, m, corners);
+    const detail::ClipBounds b = detail::clip_bounds(corners, 8, double(near_w_));
+    if (b.finite && b.behind == 8) return;  // entirely before the near plane: draws nothing
     int cx0 = 0, cx1 = gw - 1, cy0 = 0, cy1 = gh - 1;
     float depth = 0.0f;  // no bound
-    if (finite) {
-        depth = detail::float_down(1.0 / max_w);
-        if (!crosses_near) {  // its projection lies in the corners' rectangle (slightly widened)
+    if (b.finite) {
+        depth = detail::float_down(1.0 / b.max_w);
+        if (b.behind == 0) {  // its projection lies in the corners' rectangle (slightly widened)
             const double slack = 1.0 / 256.0;
             int i0, i1, j0, j1;
-            detail::sample_span((min_x + 1.0) * 0.5 * sample_width - slack, (max_x + 1.0) * 0.5 * sample_width + slack, sample_width, i0,
-                                i1);
-            detail::sample_span((1.0 - max_y) * 0.5 * sample_height - slack, (1.0 - min_y) * 0.5 * sample_height + slack, sample_height,
-                                j0, j1);
+            detail::sample_span((b.min_x + 1.0) * 0.5 * sample_width - slack, (b.max_x + 1.0) * 0.5 * sample_width + slack, sample_width,
+                                i0, i1);
+            detail::sample_span((1.0 - b.max_y) * 0.5 * sample_height - slack, (1.0 - b.min_y) * 0.5 * sample_height + slack,
+                                sample_height, j0, j1);
             if (i0 > i1 || j0 > j1) return;  // covers no sample
             cx0 = deb_cell(i0, sample_width, gw), cx1 = deb_cell(i1, sample_width, gw);
             cy0 = deb_cell(j0, sample_height, gh), cy1 = deb_cell(j1, sample_height, gh);
@@ -83,26 +67,8 @@ void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16
         }
 }
 
-// Whether every cell of level k's pyramid within cell (x, y) and the pixel range
-// [x0, x1] x [y0, y1] (level-0 units) holds more than d: a cell whose minimum is above d is
-// done, one inside the range whose minimum is not above d has such a pixel.
-bool OcclusionMaps::min_pyramid_above(const std::vector<float>& pyramid, int k, int x, int y, int x0, int y0, int x1, int y1,
-                                      float d) const {
-    const int cx0 = x << k, cy0 = y << k, cx1 = ((x + 1) << k) - 1, cy1 = ((y + 1) << k) - 1;
-    if (cx1 < x0 || cx0 > x1 || cy1 < y0 || cy0 > y1) return true;
-    const Level& l = levels_[std::size_t(k)];
-    if (pyramid[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)] > d) return true;
-    if (k == 0 || (cx0 >= x0 && cx1 <= x1 && cy0 >= y0 && cy1 <= y1)) return false;
-    const Level& below = levels_[std::size_t(k) - 1];
-    for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx)
-            if (2 * x + dx < below.width && 2 * y + dy < below.height &&
-                !min_pyramid_above(pyramid, k - 1, 2 * x + dx, 2 * y + dy, x0, y0, x1, y1, d))
-                return false;
-    return true;
-}
-
-bool OcclusionMaps::depth_hidden(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, float d_near) const {
+bool OcclusionMaps::depth_hidden(int i0, int i1, int j0, int j1, float d_near) const {
+    const OcclusionBuffer& buffer = *built_;
     const bool approximate = config_.hole_pixels > 0.0;
     switch (config_.depth) {
     case DepthTest::masked: {
@@ -120,13 +86,8 @@ bool OcclusionMaps::depth_hidden(const OcclusionBuffer& buffer, int i0, int i1, 
     case DepthTest::hzb:
     case DepthTest::nbz: {
         const std::vector<float>& pyramid = config_.depth == DepthTest::hzb ? hzb_ : nbz_;
-        const int x0 = i0 / samples_, x1 = i1 / samples_, y0 = j0 / samples_, y1 = j1 / samples_;
-        int k = 0;  // the level where the pixel range spans at most 2 x 2 cells
-        while (k + 1 < int(levels_.size()) && ((x1 >> k) - (x0 >> k) > 1 || (y1 >> k) - (y0 >> k) > 1)) ++k;
-        for (int y = y0 >> k; y <= y1 >> k; ++y)
-            for (int x = x0 >> k; x <= x1 >> k; ++x)
-                if (!min_pyramid_above(pyramid, k, x, y, x0, y0, x1, y1, d_near)) return false;
-        return true;
+        return detail::min_pyramid_range_above(pyramid.data(), levels_.data(), int(levels_.size()), i0 / samples_, j0 / samples_,
+                                               i1 / samples_, j1 / samples_, d_near);
     }
     case DepthTest::plane:
         return plane_ != INFINITY && plane_ > d_near;

@@ -8,6 +8,8 @@
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -53,6 +55,20 @@ inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery&
 // (test_rect then searches the pyramid; the answers are the same).
 using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q, int sample_width);
 RectScanKernel selected_rect_scan_kernel();
+
+// The eight corners of a box under a model-to-clip matrix, by the incremental corner transform
+// (Zhang: the base corner plus the three transformed edge vectors), in double.
+void box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, glm::dvec4 corners[8]);
+
+// What an occludee test needs of clip-space points: their NDC bounds and nearest w over the
+// points at or beyond near_w, their farthest w over all, how many lie before near_w, and
+// whether every coordinate is finite (the rest is meaningless when not).
+struct ClipBounds {
+    bool finite = true;
+    int behind = 0;
+    double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, min_w = HUGE_VAL, max_w = -HUGE_VAL;
+};
+ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w);
 
 // The screen rectangle of a box under a model-to-clip matrix (incremental corner transform:
 // base corner plus three edge vectors), rounded outwards, with its nearest w rounded down; or,

@@ -1,6 +1,7 @@
 #include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 
+#include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -88,7 +89,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
             answers[id] = {Visibility::view_culled, 0.0f, 0};
             continue;
         }
-        answers[id] = maps_.test_aabb(buffer_, box, clip);
+        answers[id] = maps_.test_aabb(box, clip);
         ++exits_.count[answers[id].overlap_exit];
         const Object& object = scene_->objects[id];
         if (answers[id].visibility == Visibility::visible && config_.test_triangles &&
@@ -106,27 +107,21 @@ namespace {
 // sub-triangles (clip space is linear on the triangle, so they tile it exactly) are tried, down
 // to `depth` more levels. A corner before the near plane makes it visible. The rectangles
 // share the object's hole budget (approximate mode).
-bool triangle_hidden(const OcclusionMaps& maps, const OcclusionBuffer& buffer, const glm::dvec4 c[3], int depth, double& budget) {
-    double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, min_w = HUGE_VAL;
-    for (int k = 0; k < 3; ++k) {
-        if (!std::isfinite(c[k].x) || !std::isfinite(c[k].y) || !std::isfinite(c[k].w) || c[k].w < double(buffer.config().near_w))
-            return false;
-        min_x = std::min(min_x, c[k].x / c[k].w), max_x = std::max(max_x, c[k].x / c[k].w);
-        min_y = std::min(min_y, c[k].y / c[k].w), max_y = std::max(max_y, c[k].y / c[k].w);
-        min_w = std::min(min_w, c[k].w);
-    }
+bool triangle_hidden(const OcclusionMaps& maps, float near_w, const glm::dvec4 c[3], int depth, double& budget) {
+    const detail::ClipBounds b = detail::clip_bounds(c, 3, double(near_w));
+    if (!b.finite || b.behind > 0) return false;
     // Widened by 2^-20 of the magnitudes: world_bounds and ground truth round the world
     // transform to float, this does not.
-    const double slack_x = 0x1.0p-20 * (1.0 + std::abs(min_x) + std::abs(max_x));
-    const double slack_y = 0x1.0p-20 * (1.0 + std::abs(min_y) + std::abs(max_y));
-    const ScreenRect r{detail::float_down(min_x - slack_x), detail::float_down(min_y - slack_y), detail::float_up(max_x + slack_x),
-                       detail::float_up(max_y + slack_y), detail::float_down(min_w * (1.0 - 0x1.0p-20))};
-    if (maps.test_rect_within(buffer, r, budget).visibility != Visibility::visible) return true;
+    const double slack_x = 0x1.0p-20 * (1.0 + std::abs(b.min_x) + std::abs(b.max_x));
+    const double slack_y = 0x1.0p-20 * (1.0 + std::abs(b.min_y) + std::abs(b.max_y));
+    const ScreenRect r{detail::float_down(b.min_x - slack_x), detail::float_down(b.min_y - slack_y), detail::float_up(b.max_x + slack_x),
+                       detail::float_up(b.max_y + slack_y), detail::float_down(b.min_w * (1.0 - 0x1.0p-20))};
+    if (maps.test_rect_within(r, budget).visibility != Visibility::visible) return true;
     if (depth == 0) return false;
     const glm::dvec4 m01 = (c[0] + c[1]) * 0.5, m12 = (c[1] + c[2]) * 0.5, m20 = (c[2] + c[0]) * 0.5;
     const glm::dvec4 parts[4][3] = {{c[0], m01, m20}, {m01, c[1], m12}, {m20, m12, c[2]}, {m01, m12, m20}};
     for (const auto& part : parts)
-        if (!triangle_hidden(maps, buffer, part, depth - 1, budget)) return false;
+        if (!triangle_hidden(maps, near_w, part, depth - 1, budget)) return false;
     return true;
 }
 
@@ -141,7 +136,7 @@ bool SceneCuller::triangles_hidden(const Object& object, const glm::dmat4& clip_
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
         glm::dvec4 c[3];
         for (int k = 0; k < 3; ++k) c[k] = m * glm::dvec4(glm::dvec3(mesh.positions[mesh.indices[3 * t + std::size_t(k)]]), 1.0);
-        if (!triangle_hidden(maps_, buffer_, c, 3, budget)) return false;
+        if (!triangle_hidden(maps_, buffer_.config().near_w, c, 3, budget)) return false;
     }
     return true;
 }

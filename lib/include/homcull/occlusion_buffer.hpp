@@ -29,6 +29,12 @@
 namespace homcull {
 class OcclusionMaps;
 namespace detail {
+// One level of a pyramid stored level after level in one array: width x height cells from
+// `offset` on, row-major.
+struct PyramidLevel {
+    int width, height;
+    std::size_t offset;
+};
 struct RectQuery;
 struct SubtileView;
 }  // namespace detail
@@ -178,19 +184,14 @@ private:
 
     // Farthest-depth pyramid: level l >= 1 holds, per cell of 2^l x 2^l subtiles, the minimum
     // d0; rebuilt at the end of render().
-    struct Level {
-        int width, height;
-        std::size_t offset;
-    };
-    std::vector<Level> levels_;
+    std::vector<detail::PyramidLevel> levels_;
     std::vector<float> pyramid_;
     std::vector<std::int32_t> level_offset_, level_width_;  // levels_ as arrays, for SIMD gathers
     void build_pyramid();
     float min_d0(int level, int x, int y) const {
-        const Level& l = levels_[std::size_t(level)];
+        const detail::PyramidLevel& l = levels_[std::size_t(level)];
         return pyramid_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)];
     }
-    bool any_farther_or_equal(int level, int x, int y, int x0, int y0, int x1, int y1, float d_near) const;
     // Shared by the rectangle tests: the sample range and nearest 1/w, or a decided answer.
     bool prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, detail::RectQuery& q,
                  Visibility& decided) const;

@@ -90,16 +90,17 @@ public:
     void add_occluder_box(const Aabb& box, const std::array<float, 16>& model_to_clip);
     void build(const OcclusionBuffer& buffer);
 
-    // Occludee tests. Thread-safe with each other once build() has returned. The buffer must
-    // be the one given to build(), unchanged since.
-    OccludeeAnswer test_rect(const OcclusionBuffer& buffer, const ScreenRect& rect) const;
-    OccludeeAnswer test_aabb(const OcclusionBuffer& buffer, const Aabb& box, const std::array<float, 16>& model_to_clip) const;
+    // Occludee tests, against the maps and the buffer of the last build(): the buffer must
+    // outlive them and stay unchanged (render or clear it, then build() again). Thread-safe
+    // with each other. Throws homcull::Error before the first build().
+    OccludeeAnswer test_rect(const ScreenRect& rect) const;
+    OccludeeAnswer test_aabb(const Aabb& box, const std::array<float, 16>& model_to_clip) const;
     // One occludee tested as several rectangles (its triangles, say) must share one hole
     // budget, or each rectangle would tolerate L pixels of holes: test_rect_within starts from
     // `budget` (samples; hole_budget() for a fresh occludee) and, when it answers occluded,
     // subtracts the holes it tolerated. Conservative mode: the budget is 0 and stays 0.
     double hole_budget() const;
-    OccludeeAnswer test_rect_within(const OcclusionBuffer& buffer, const ScreenRect& rect, double& budget) const;
+    OccludeeAnswer test_rect_within(const ScreenRect& rect, double& budget) const;
 
     const OcclusionMapsConfig& config() const { return config_; }
     // The opacity pyramid, for dumps and tests: level k is level_width(k) x level_height(k)
@@ -124,11 +125,9 @@ public:
     float plane_depth() const { return plane_; }
 
 private:
-    struct Level {
-        int width, height;
-        std::size_t offset;
-    };
+    using Level = detail::PyramidLevel;
     OcclusionMapsConfig config_;
+    const OcclusionBuffer* built_ = nullptr;     // the buffer of the last build()
     int width_ = 0, height_ = 0, samples_ = 1;  // buffer pixels and samples per axis
     float near_w_ = 0.1f;
     double samples_per_display_pixel_ = 1.0;
@@ -139,12 +138,16 @@ private:
     std::vector<double> opacity_threshold_, transparency_threshold_;
     int start_max_level_ = 0;
 
+    // The samples of cell (x, y) of level k, clipped to the buffer: [x0, x1] x [y0, y1].
+    struct CellSpan {
+        int x0, x1, y0, y1;
+    };
+    CellSpan cell_span(int k, int x, int y) const;
     struct OverlapQuery;
     bool overlap_cell(OverlapQuery& q, int k, int x, int y) const;
-    void overlap(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer,
-                 double& uncovered) const;
-    bool depth_hidden(const OcclusionBuffer& buffer, int i0, int i1, int j0, int j1, float d_near) const;
-    bool min_pyramid_above(const std::vector<float>& pyramid, int k, int x, int y, int x0, int y0, int x1, int y1, float d) const;
+    void overlap(int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer, double& uncovered) const;
+    bool depth_hidden(int i0, int i1, int j0, int j1, float d_near) const;
+    const OcclusionBuffer& built() const;
 };
 
 }  // namespace homcull

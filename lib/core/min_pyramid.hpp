@@ -1,0 +1,47 @@
+#pragma once
+// Min pyramids stored level after level in one array (the buffer's farthest-d0 pyramid over
+// subtiles, the occlusion maps' hzb and nbz over pixels): level k + 1 holds the minimum of
+// 2 x 2 cells of level k. The pruned range search of Greene, Kass, Miller, "Hierarchical
+// Z-buffer visibility" (SIGGRAPH 1993), shared by both.
+#include <homcull/occlusion_buffer.hpp>
+
+namespace homcull::detail {
+
+// Whether every level-0 cell of [x0, x1] x [y0, y1] under cell (x, y) of level k holds more
+// than d: a cell whose minimum is above d is done; one inside the range whose minimum is not
+// above d contains such a cell.
+inline bool min_pyramid_above(const float* data, const PyramidLevel* levels, int k, int x, int y, int x0, int y0, int x1, int y1,
+                              float d) {
+    const int cx0 = x << k, cy0 = y << k, cx1 = ((x + 1) << k) - 1, cy1 = ((y + 1) << k) - 1;
+    if (cx1 < x0 || cx0 > x1 || cy1 < y0 || cy0 > y1) return true;
+    const PyramidLevel& l = levels[k];
+    if (data[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)] > d) return true;
+    if (k == 0 || (cx0 >= x0 && cx1 <= x1 && cy0 >= y0 && cy1 <= y1)) return false;
+    const PyramidLevel& below = levels[k - 1];
+    for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx)
+            if (2 * x + dx < below.width && 2 * y + dy < below.height &&
+                !min_pyramid_above(data, levels, k - 1, 2 * x + dx, 2 * y + dy, x0, y0, x1, y1, d))
+                return false;
+    return true;
+}
+
+// The level (below `level_count`) where [x0, x1] x [y0, y1] spans at most 2 x 2 cells.
+inline int coarse_level(int x0, int x1, int y0, int y1, int level_count) {
+    int k = 0;
+    while (k + 1 < level_count && ((x1 >> k) - (x0 >> k) > 1 || (y1 >> k) - (y0 >> k) > 1)) ++k;
+    return k;
+}
+
+// Whether every level-0 cell of [x0, x1] x [y0, y1] holds more than d, searched from the
+// coarse level down.
+inline bool min_pyramid_range_above(const float* data, const PyramidLevel* levels, int level_count, int x0, int y0, int x1, int y1,
+                                    float d) {
+    const int k = coarse_level(x0, x1, y0, y1, level_count);
+    for (int y = y0 >> k; y <= y1 >> k; ++y)
+        for (int x = x0 >> k; x <= x1 >> k; ++x)
+            if (!min_pyramid_above(data, levels, k, x, y, x0, y0, x1, y1, d)) return false;
+    return true;
+}
+
+}  // namespace homcull::detail
