@@ -93,8 +93,10 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
         ++exits_.count[answers[id].overlap_exit];
         const Object& object = scene_->objects[id];
         if (answers[id].visibility == Visibility::visible && config_.test_triangles &&
-            scene_->triangle_count(object) <= config_.triangle_test_limit && triangles_hidden(object, clip_double))
+            scene_->triangle_count(object) <= config_.triangle_test_limit && triangles_hidden(object, clip_double)) {
             answers[id].visibility = Visibility::occluded;
+            answers[id].level_of_visibility = 0.0f;  // the holes its triangles tolerated are not estimated
+        }
     }
     timings_.test_ms = ms_since(start);
 }

@@ -11,10 +11,15 @@ void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler
     const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
     std::vector<OccludeeAnswer> answers;
     culler.cull(camera, answers);
-    ++tally.views;
     tally.total_ms.render_ms += culler.timings().render_ms;
     tally.total_ms.maps_ms += culler.timings().maps_ms;
     tally.total_ms.test_ms += culler.timings().test_ms;
+    tally_answers(scene, truth, answers, camera, tally);
+}
+
+void tally_answers(const Scene& scene, const TruthResult& truth, const std::vector<OccludeeAnswer>& answers, const Camera& camera,
+                   CullingTally& tally) {
+    ++tally.views;
     for (std::size_t id = 0; id < scene.objects.size(); ++id) {
         if (scene.objects[id].world_bounds.empty()) continue;
         const Visibility answer = answers[id].visibility;

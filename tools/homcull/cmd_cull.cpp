@@ -5,6 +5,7 @@
 
 #include <homcull/io/scene_io.hpp>
 #include <homcull/tbb_parallel_for.hpp>
+#include <homcull/truth/culling_accuracy.hpp>
 #include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/ray_scene.hpp>
 
@@ -64,7 +65,9 @@ void run_cull(const CullCommandOptions& o) {
         truth_ms = elapsed_ms(start);
     }
 
-    std::size_t counts[3] = {}, false_culls = 0, hidden = 0, culled_hidden = 0;
+    CullingTally tally;
+    if (o.truth) tally_answers(scene, truth, answers, camera, tally);
+    std::size_t counts[3] = {};
     std::uint64_t triangles = 0, after_frustum = 0, after_occlusion = 0;
     nlohmann::json objects = nlohmann::json::array();
     for (std::size_t id = 0; id < scene.objects.size(); ++id) {
@@ -82,13 +85,8 @@ void run_cull(const CullCommandOptions& o) {
         if (a.overlap_exit) item["overlap"] = overlap_exit_name(OverlapExit(a.overlap_exit));
         if (o.truth) {
             const ObjectVisibility& t = truth.objects[id];
-            item["truth"] = t.visible_samples > 0 ? "visible" : t.in_frustum ? "occluded" : "view_culled";
+            item["truth"] = truth_result_name(t);
             item["visible_samples"] = t.visible_samples;
-            if (t.visible_samples > 0 && a.visibility != Visibility::visible) ++false_culls;
-            if (t.visible_samples == 0 && t.in_frustum && !scene.objects[id].world_bounds.empty()) {
-                ++hidden;
-                culled_hidden += a.visibility != Visibility::visible;
-            }
         }
         objects.push_back(std::move(item));
     }
@@ -116,9 +114,10 @@ void run_cull(const CullCommandOptions& o) {
             {"stats", stats_json(culler.buffer().stats())},
             {"overlap_exits", exits}};
         if (o.truth) {
-            out["truth"] = {{"false_culls", false_culls}, {"hidden_in_frustum", hidden}, {"culled_hidden", culled_hidden},
-                            {"missed_culls", hidden - culled_hidden},
-                            {"efficiency", hidden ? double(culled_hidden) / double(hidden) : 1.0}, {"trace_ms", truth_ms}};
+            out["truth"] = {{"false_culls", tally.false_culls},   {"robust_false_culls", tally.robust_false_culls},
+                            {"hidden_in_frustum", tally.hidden_in_frustum}, {"culled_hidden", tally.culled_hidden},
+                            {"missed_culls", tally.missed_culls()}, {"efficiency", tally.efficiency()},
+                            {"false_cull_reports", tally.false_cull_reports}, {"trace_ms", truth_ms}};
         }
         fmt::print("{}\n", out.dump(1));
         return;
@@ -134,9 +133,11 @@ void run_cull(const CullCommandOptions& o) {
                after_occlusion);
     fmt::print("time       load {:.1f} ms, setup {:.1f} ms; render {:.3f} ms, maps {:.3f} ms, tests {:.3f} ms\n", load_ms, setup_ms,
                ms.render_ms, ms.maps_ms, ms.test_ms);
-    if (o.truth)
-        fmt::print("truth      {} false culls; culled {} of {} hidden objects ({:.1f} %); trace {:.0f} ms\n", false_culls,
-                   culled_hidden, hidden, hidden ? 100.0 * double(culled_hidden) / double(hidden) : 100.0, truth_ms);
+    if (o.truth) {
+        fmt::print("truth      {} false culls; culled {} of {} hidden objects ({:.1f} %); trace {:.0f} ms\n", tally.false_culls,
+                   tally.culled_hidden, tally.hidden_in_frustum, 100.0 * tally.efficiency(), truth_ms);
+        for (const std::string& line : tally.false_cull_reports) fmt::print("false cull: {}\n", line);
+    }
     fmt::print("(--json lists every object)\n");
 }
 

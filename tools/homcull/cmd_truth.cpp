@@ -24,10 +24,6 @@ struct TruthCommandOptions {
     std::string id_image;
 };
 
-const char* result_name(const ObjectVisibility& v) {
-    return v.visible_samples > 0 ? "visible" : v.in_frustum ? "occluded" : "view_culled";
-}
-
 void run_truth(const TruthCommandOptions& o) {
     const Camera camera = resolve_camera(o.camera);
     TruthOptions options;
@@ -59,7 +55,7 @@ void run_truth(const TruthCommandOptions& o) {
             const ObjectVisibility& v = truth.objects[id];
             objects.push_back({{"id", id}, {"name", scene.objects[id].name}, {"triangles", scene.triangle_count(scene.objects[id])},
                                {"in_frustum", v.in_frustum}, {"visible_samples", v.visible_samples},
-                               {"robust_samples", v.robust_samples}, {"result", result_name(v)}});
+                               {"robust_samples", v.robust_samples}, {"result", truth_result_name(v)}});
         }
         nlohmann::json out = {
             {"scene", scene.source},

@@ -48,6 +48,8 @@ public:
     SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config);
 
     // answers[id] for every object of the scene (objects without geometry are view-culled).
+    // overlap_exit is the box test's; an object its triangles found hidden reports level of
+    // visibility 0.
     void cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
 
     const SceneCullerConfig& config() const { return config_; }

@@ -24,6 +24,10 @@ struct CullingTally {
     std::size_t missed_culls() const { return hidden_in_frustum - culled_hidden; }
 };
 
+// Tallies one view's answers (answers[id] per object) against its ground truth.
+void tally_answers(const Scene& scene, const TruthResult& truth, const std::vector<OccludeeAnswer>& answers, const Camera& camera,
+                   CullingTally& tally);
+
 // Culls the scene from `camera` with `culler` and tallies its answers against ground truth
 // cast at the display's pixel centres (the culler's display resolution).
 void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally);

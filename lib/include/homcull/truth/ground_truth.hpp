@@ -27,6 +27,12 @@ struct ObjectVisibility {
     std::uint64_t robust_samples = 0;
 };
 
+// "visible" (some sample sees it), "occluded" (in the frustum, no sample sees it) or
+// "view_culled": the per-object result of DESIGN.md's format.
+inline const char* truth_result_name(const ObjectVisibility& v) {
+    return v.visible_samples > 0 ? "visible" : v.in_frustum ? "occluded" : "view_culled";
+}
+
 struct TruthResult {
     std::vector<ObjectVisibility> objects;  // indexed by object id
     int sample_width = 0, sample_height = 0;  // resolution * samples
