@@ -22,6 +22,7 @@ struct CullCommandOptions {
     std::string scene;
     CameraOptions camera;
     CullOptions cull;
+    std::string isa = "best";
     bool json = false, truth = false;
     int threads = 1, repeat = 1;
 };
@@ -33,6 +34,7 @@ nlohmann::json stats_json(const RasterStats& s) {
 }
 
 void run_cull(const CullCommandOptions& o) {
+    select_isa(o.isa);
     const Camera camera = resolve_camera(o.camera);
     const SceneCullerConfig config = scene_culler_config(o.cull);
     long long start = now_ns();
@@ -100,6 +102,7 @@ void run_cull(const CullCommandOptions& o) {
             {"display", {config.display.width, config.display.height}},
             {"buffer", {culler.buffer().config().width, culler.buffer().config().height}},
             {"samples", config.samples},
+            {"isa", selected_isa()},
             {"mode", o.cull.mode},
             {"hole", config.maps.hole_pixels},
             {"depth", o.cull.depth},
@@ -151,6 +154,8 @@ void register_cull(CLI::App& app) {
     add_cull_options(*cmd, o->cull);
     cmd->add_option("--threads", o->threads, "Render with this many threads (TBB); 1 = the calling thread")
         ->capture_default_str()->check(CLI::Range(1, 256));
+    cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
+        ->capture_default_str();
     cmd->add_option("--repeat", o->repeat, "Cull this many times and report each stage's fastest time")
         ->capture_default_str()->check(CLI::Range(1, 1000));
     cmd->add_flag("--truth", o->truth, "Also cast Embree ground truth at the display's pixel centres and count false culls");
