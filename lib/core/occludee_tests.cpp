@@ -9,21 +9,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 namespace homcull {
 namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-
-// std::nextafter(f, +infinity) for a non-negative finite float, without a libm call.
-float next_float_up(float f) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &f, sizeof bits);
-    ++bits;
-    std::memcpy(&f, &bits, sizeof bits);
-    return f;
-}
 
 }  // namespace
 
@@ -52,10 +42,7 @@ bool OcclusionBuffer::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x,
         return false;
     }
     // Nearest 1/w of the occludee, rounded up and raised by a relative 2^-20.
-    const double d = 1.0 / double(w_min);
-    q.d_near = float(d);
-    if (double(q.d_near) < d) q.d_near = next_float_up(q.d_near);
-    q.d_near *= 1.0f + 0x1.0p-20f;
+    q.d_near = detail::float_up(1.0 / double(w_min)) * (1.0f + 0x1.0p-20f);
     return true;
 }
 
@@ -90,7 +77,7 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
     for (int y = ty0 >> level; y <= ty1 >> level; ++y)
         for (int x = tx0 >> level; x <= tx1 >> level; ++x) coarse = std::min(coarse, min_d0(level, x, y));
     if (q.d_near < coarse) return Visibility::occluded;
-    if (const detail::RectScanKernel scan = detail::selected_rect_scan_kernel()) return scan(subtile_view(), q, sample_width_);
+    if (const detail::RectScanKernel scan = detail::selected_rect_scan_kernel()) return scan(subtile_view(), q);
     // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound
     // (>= d0) is above d_near and the rectangle is hidden. Most hidden rectangles end here.
     const int level_count = int(levels_.size());
@@ -100,10 +87,7 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
     const detail::SubtileView view = subtile_view();
     // Interior subtiles (all their samples in the rectangle): their bound is d0, so the
     // rectangle is visible there iff some d0 <= d_near. Border subtiles: the exact test.
-    const bool left_full = q.i0 % kW == 0, right_full = q.i1 % kW == kW - 1 && q.i1 < sample_width_;
-    const bool top_full = q.j0 % kH == 0, bottom_full = q.j1 % kH == kH - 1;
-    const int ix0 = left_full ? tx0 : tx0 + 1, ix1 = right_full ? tx1 : tx1 - 1;
-    const int iy0 = top_full ? ty0 : ty0 + 1, iy1 = bottom_full ? ty1 : ty1 - 1;
+    const auto [ix0, ix1, iy0, iy1] = detail::interior_subtiles(q);
     for (int ty = ty0; ty <= ty1; ++ty)
         for (int tx = tx0; tx <= tx1; ++tx) {
             if (ty >= iy0 && ty <= iy1 && tx >= ix0 && tx <= ix1) {  // skip the interior run
@@ -190,7 +174,7 @@ void OcclusionBuffer::test_rects(const ScreenRect* rects, std::size_t count, Vis
         const std::size_t n = std::min(kBlock, count - base);
         coarse(view, rects + base, n, codes, queries);
         for (std::size_t k = 0; k < n; ++k)
-            results[base + k] = codes[k] != detail::kUndecided ? Visibility(codes[k]) : scan(subtiles, queries[k], sample_width_);
+            results[base + k] = codes[k] != detail::kUndecided ? Visibility(codes[k]) : scan(subtiles, queries[k]);
     }
 }
 

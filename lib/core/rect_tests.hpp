@@ -50,10 +50,22 @@ inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery&
     return q.d_near < bound;
 }
 
+// The rectangle's interior subtiles [ix0, ix1] x [iy0, iy1] (all their samples in it, so their
+// bound is d0); empty ranges when it has none.
+struct InteriorSubtiles {
+    int ix0, ix1, iy0, iy1;
+};
+inline InteriorSubtiles interior_subtiles(const RectQuery& q) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+    return {q.i0 % kW == 0 ? tx0 : tx0 + 1, q.i1 % kW == kW - 1 ? tx1 : tx1 - 1, q.j0 % kH == 0 ? ty0 : ty0 + 1,
+            q.j1 % kH == kH - 1 ? ty1 : ty1 - 1};
+}
+
 // The exact stage after the coarse check, scanning the subtile rows in SIMD: occluded when
 // every subtile the rectangle reaches hides it. Null when the scalar reference is selected
 // (test_rect then searches the pyramid; the answers are the same).
-using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q, int sample_width);
+using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q);
 RectScanKernel selected_rect_scan_kernel();
 
 // The eight corners of a box under a model-to-clip matrix, by the incremental corner transform

@@ -127,16 +127,13 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
 // time. A subtile with d0 > d_near hides it whatever its mask; one with d0 <= d_near shows it
 // if it is interior (all its samples in the rectangle, so its bound is d0), and otherwise is
 // decided by subtile_hides. Same answers as test_rect_exhaustive.
-Visibility RectScan(const SubtileView& view, const RectQuery& q, int sample_width) {
+Visibility RectScan(const SubtileView& view, const RectQuery& q) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many (rasterize.hpp)
     const hn::RebindToSigned<decltype(df)> di;
     const int lanes = int(hn::Lanes(df));
     const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
-    const bool left_full = q.i0 % kW == 0, right_full = q.i1 % kW == kW - 1 && q.i1 < sample_width;
-    const bool top_full = q.j0 % kH == 0, bottom_full = q.j1 % kH == kH - 1;
-    const int ix0 = left_full ? tx0 : tx0 + 1, ix1 = right_full ? tx1 : tx1 - 1;
-    const int iy0 = top_full ? ty0 : ty0 + 1, iy1 = bottom_full ? ty1 : ty1 - 1;
+    const auto [ix0, ix1, iy0, iy1] = interior_subtiles(q);
     const auto d_near = hn::Set(df, q.d_near);
     for (int ty = ty0; ty <= ty1; ++ty) {
         const float* row = view.d0 + std::size_t(ty) * view.stride;
@@ -177,8 +174,8 @@ void dispatch_coarse(const CoarseRectView& view, const ScreenRect* rects, std::s
 }  // namespace
 
 
-Visibility dispatch_scan(const SubtileView& view, const RectQuery& q, int sample_width) {
-    return HWY_DYNAMIC_DISPATCH(RectScan)(view, q, sample_width);
+Visibility dispatch_scan(const SubtileView& view, const RectQuery& q) {
+    return HWY_DYNAMIC_DISPATCH(RectScan)(view, q);
 }
 
 CoarseRectKernel selected_coarse_rect_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_coarse; }

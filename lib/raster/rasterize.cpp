@@ -14,7 +14,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 namespace homcull::detail {
 namespace {
@@ -35,12 +34,7 @@ inline int ceil_int(double x) {
 }  // namespace
 
 std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_height) {
-    const int columns = std::min(kW, sample_width - tx * kW), rows = std::min(kH, sample_height - ty * kH);
-    if (columns <= 0 || rows <= 0) return 0;
-    const std::uint32_t row_bits = columns >= 32 ? 0xFFFFFFFFu : (1u << columns) - 1u;
-    std::uint32_t mask = 0;
-    for (int j = 0; j < rows; ++j) mask |= row_bits << (j * kW);
-    return mask;
+    return subtile_rect_bits(tx, ty, 0, sample_width - 1, 0, sample_height - 1);
 }
 
 // The plane d(X, Y) = z0 + dzdx (X - x0) + dzdy (Y - y0) through the vertices, rewritten as

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 
 namespace homcull::detail {
 
@@ -92,15 +94,33 @@ std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangl
 std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                            const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height);
 
+// The float next to a finite f towards +infinity (up) or -infinity, by one step of its bits
+// (what std::nextafter does, without the library call these hot paths would pay).
+inline float float_step(float f, bool up) {
+    if (f == 0.0f) return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    bits = (up == (f > 0.0f)) ? bits + 1u : bits - 1u;  // away from zero: larger magnitude
+    std::memcpy(&f, &bits, sizeof bits);
+    return f;
+}
+
 // float(v) rounded towards -infinity / +infinity: bounds that must stay on one side of a double
-// (rectangles rounded outwards, depths towards the eye).
+// (rectangles rounded outwards, depths towards the eye). Beyond the float range the result is
+// the largest float or infinity on the safe side; NaN stays NaN.
 inline float float_down(double v) {
+    constexpr double kMax = std::numeric_limits<float>::max();
+    if (!(v >= -kMax)) return v > 0.0 || v != v ? float(v) : -std::numeric_limits<float>::infinity();  // NaN, or below the range
+    if (v > kMax) return std::numeric_limits<float>::max();
     const float f = float(v);
-    return double(f) > v ? std::nextafter(f, -INFINITY) : f;
+    return double(f) > v ? float_step(f, false) : f;
 }
 inline float float_up(double v) {
+    constexpr double kMax = std::numeric_limits<float>::max();
+    if (!(v <= kMax)) return v != v ? float(v) : std::numeric_limits<float>::infinity();  // NaN, or above the range
+    if (v < -kMax) return -std::numeric_limits<float>::max();
     const float f = float(v);
-    return double(f) < v ? std::nextafter(f, INFINITY) : f;
+    return double(f) < v ? float_step(f, true) : f;
 }
 
 // The mask of subtile (tx, ty)'s samples that lie in the sample range [i0, i1] x [j0, j1].
