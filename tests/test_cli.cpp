@@ -94,6 +94,10 @@ TEST(Cli, CullRejectsInconsistentOptions) {
     EXPECT_EQ(r.exit_code, 1);
     r = run_cli("cull " + kCityCamera + " --depth zbuffer");
     EXPECT_NE(r.exit_code, 0);
+    // accuracy's culling options belong to --scene; without it (S1) they would be ignored.
+    r = run_cli("accuracy --mode approximate --hole 4");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--mode needs --scene");
     // Approximate mode takes any buffer.
     r = run_cli("cull " + kCityCamera + " --buffer 40x20 --samples 4 --mode approximate --hole 2 --json");
     EXPECT_EQ(r.exit_code, 0) << r.err;

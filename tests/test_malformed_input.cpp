@@ -5,6 +5,7 @@
 #include <homcull/generate.hpp>
 #include <homcull/io/camera_path.hpp>
 #include <homcull/io/scene_io.hpp>
+#include <homcull/occlusion_buffer.hpp>
 
 #include <gtest/gtest.h>
 
@@ -156,6 +157,28 @@ TEST(MalformedInput, CameraPathFiles) {
     path.frames.push_back(ok.frames[0]);
     path.frames[0].eye = {0.1, 1.0 / 3.0, -7e5};
     EXPECT_EQ(parse_camera_path(camera_path_to_json(path), "p").frames[0].eye, path.frames[0].eye);
+}
+
+// Engine-side input to the occlusion buffer: missing arrays and counts that would overflow.
+TEST(MalformedInput, OccluderArraysAndCounts) {
+    std::uint8_t flags[2] = {};
+    const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    EXPECT_THROW(compute_shared_edges(nullptr, 12, 3, nullptr, 1, flags), Error);
+    EXPECT_THROW(compute_shared_edges(positions, 8, 3, nullptr, 1, flags), Error);
+    EXPECT_THROW(compute_shared_edges(positions, 12, 3, nullptr, 1, nullptr), Error);
+    EXPECT_NO_THROW(compute_shared_edges(nullptr, 12, 0, nullptr, 0, nullptr));  // nothing to do
+    compute_shared_edges(positions, 12, 3, nullptr, 1, flags);
+    EXPECT_EQ(flags[0], 0u);
+
+    BufferConfig c;
+    c.width = c.height = 8;
+    OcclusionBuffer buffer(c);
+    TriangleInput in = test::clip_space_input(std::vector<float>(positions, positions + 9));
+    in.position_components = 3;
+    in.position_stride = 12;
+    in.vertex_count = 3;
+    in.triangle_count = std::numeric_limits<std::size_t>::max() / 3 + 1;  // 3 * count wraps around to 2
+    EXPECT_THROW(buffer.render(in), Error);
 }
 
 }  // namespace

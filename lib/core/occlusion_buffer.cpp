@@ -107,7 +107,7 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
     if (in.position_components != 3 && in.position_components != 4) throw Error("render: positions must have 3 or 4 components");
     if (!in.positions || in.position_stride < sizeof(float) * std::size_t(in.position_components))
         throw Error("render: positions missing, or stride smaller than one position");
-    if (!in.indices && in.vertex_count < in.triangle_count * 3)
+    if (!in.indices && in.vertex_count / 3 < in.triangle_count)  // (no overflow for any count)
         throw Error("render: without indices, vertex_count must be at least 3 * triangle_count");
 
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
@@ -162,17 +162,7 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         b.band_touched_[band] = touched;
     }, &job);
 
-    for (std::size_t c = 0; c < chunk_count; ++c) {
-        const RasterStats& s = chunks_[c].stats;
-        stats_.triangles_in += s.triangles_in;
-        stats_.invalid += s.invalid;
-        stats_.outside += s.outside;
-        stats_.near_clipped += s.near_clipped;
-        stats_.too_large += s.too_large;
-        stats_.backface_culled += s.backface_culled;
-        stats_.degenerate += s.degenerate;
-        stats_.rasterized += s.rasterized;
-    }
+    for (std::size_t c = 0; c < chunk_count; ++c) stats_ += chunks_[c].stats;
     for (std::uint64_t touched : band_touched_) stats_.subtiles_touched += touched;
     build_pyramid();
 }

@@ -102,7 +102,11 @@ void register_accuracy(CLI::App& app) {
     cmd->add_option("--orbit", o->orbit, "--scene: N views on an orbit");
     add_cull_options(*cmd, o->cull, /*with_display=*/false);  // --scene: --buffer, --mode, --hole, --depth, --occluders, ...
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
-    cmd->callback([o] {
+    cmd->callback([o, cmd] {
+        if (o->scene.empty())  // S1 has its own buffer and no scene: these would be silently ignored
+            for (const char* name : {"--path", "--walk", "--orbit", "--buffer", "--mode", "--hole", "--distribution", "--transparency",
+                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--occluders"})
+                if (cmd->get_option(name)->count() > 0) throw Error(std::string("accuracy: ") + name + " needs --scene");
         if (!o->scene.empty()) {
             o->cull.resolution = o->resolution;
             o->cull.samples = o->samples;

@@ -34,12 +34,6 @@ double median(std::vector<double> v) {
     return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-nlohmann::json stats_json(const RasterStats& s) {
-    return {{"triangles_in", s.triangles_in}, {"invalid", s.invalid}, {"outside", s.outside}, {"near_clipped", s.near_clipped},
-            {"too_large", s.too_large}, {"backface_culled", s.backface_culled}, {"degenerate", s.degenerate},
-            {"rasterized", s.rasterized}, {"subtiles_touched", s.subtiles_touched}};
-}
-
 void run_bench(const BenchOptions& o) {
     select_isa(o.isa);
     if (o.threads < 1) throw Error("bench: --threads must be at least 1");

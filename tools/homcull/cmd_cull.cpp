@@ -27,12 +27,6 @@ struct CullCommandOptions {
     int threads = 1, repeat = 1;
 };
 
-nlohmann::json stats_json(const RasterStats& s) {
-    return {{"triangles_in", s.triangles_in}, {"invalid", s.invalid},   {"outside", s.outside},
-            {"near_clipped", s.near_clipped}, {"too_large", s.too_large}, {"backface_culled", s.backface_culled},
-            {"degenerate", s.degenerate},     {"rasterized", s.rasterized}, {"subtiles_touched", s.subtiles_touched}};
-}
-
 void run_cull(const CullCommandOptions& o) {
     select_isa(o.isa);
     const Camera camera = resolve_camera(o.camera);

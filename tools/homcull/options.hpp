@@ -1,6 +1,7 @@
 #pragma once
 // Options several subcommands share: the scene, the camera, the display resolution.
 #include <homcull/camera.hpp>
+#include <homcull/occlusion_buffer.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -29,6 +30,9 @@ Resolution parse_resolution(const std::string& text);
 
 // {"eye","target","up","fov_y","near","far"}: a camera as commands print it (the path format's fields).
 nlohmann::json camera_json(const Camera& camera);
+
+// The rasterizer's statistics as JSON, field by field.
+nlohmann::json stats_json(const RasterStats& stats);
 
 // Milliseconds since `start` (std::chrono::steady_clock).
 double elapsed_ms(long long start_ns);

@@ -69,6 +69,13 @@ struct RasterStats {
     std::uint64_t degenerate = 0;         // zero area after projection
     std::uint64_t rasterized = 0;         // triangles (after clipping) that reached the buffer
     std::uint64_t subtiles_touched = 0;   // subtile updates
+
+    RasterStats& operator+=(const RasterStats& o) {
+        triangles_in += o.triangles_in, invalid += o.invalid, outside += o.outside, near_clipped += o.near_clipped;
+        too_large += o.too_large, backface_culled += o.backface_culled, degenerate += o.degenerate, rasterized += o.rasterized;
+        subtiles_touched += o.subtiles_touched;
+        return *this;
+    }
 };
 
 // Vertex input as engines have it: positions (x, y, z, or x, y, z, w as floats) every
@@ -95,7 +102,8 @@ struct TriangleInput {
 // Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
 // in opposite order as consistently wound neighbours have them) and writes the
 // TriangleInput::shared_edges bits. `indices` may be null (vertices 3k, 3k+1, 3k+2). Meant
-// for load time: it allocates and sorts.
+// for load time: it allocates and sorts. Throws homcull::Error when positions or the output are
+// missing or the stride is below one position (12 bytes).
 void compute_shared_edges(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                           const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
 
@@ -130,8 +138,9 @@ public:
     void clear();
     // Rasterizes occluders: triangles are set up in chunks and binned into bands of subtile
     // rows, then each band is rasterized in submission order (so every subtile sees the same
-    // sequence of triangles whatever the threads). Scratch memory grows to the largest input
-    // seen and is reused: no allocation per frame after the first. Statistics accumulate until
+    // sequence of triangles whatever the threads). Scratch memory (the per-chunk band bins) is
+    // reused and only grows, so a frame allocates only when a bin outgrows every earlier frame's:
+    // after a few frames of a walkthrough, rarely. Statistics accumulate until
     // clear(). Not thread-safe with itself or with tests.
     void render(const TriangleInput& input, const ParallelFor& parallel = {});
 
@@ -146,7 +155,8 @@ public:
     Visibility test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
     // World (or model) AABB under a model-to-clip matrix (column-major).
     Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
-    // Batches: results[k] is what test_rect / test_aabb answer for item k, bit for bit. The
+    // Batches: results[k] is what test_rect / test_aabb answer for item k, bit for bit.
+    // rects/boxes and results must hold `count` elements (they may be null when count is 0). The
     // rectangles' first stage (validity, frustum, sample span, nearest depth and the coarse
     // pyramid check, which decides most hidden rectangles) runs with one rectangle per SIMD
     // lane; the rest one at a time. No allocation; thread-safe like the single tests.
