@@ -6,6 +6,7 @@
 #include <homcull/io/workload_s1.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/tbb_parallel_for.hpp>
+#include <homcull/error.hpp>
 #include <homcull/truth/exact_depth.hpp>
 
 #include <gtest/gtest.h>
@@ -42,6 +43,24 @@ TEST(S1Accuracy, NoFalseCullsAndFewerMissesThanMoc) {
     const RectAccuracy low = measure(s1, 640, 360, 1);
     EXPECT_EQ(low.false_culls, 0u);
     EXPECT_LE(double(low.missed_culls), 0.176 * double(low.truly_hidden));
+}
+
+// The oracle itself on bad input: errors for a bad grid or vertex, defined answers for any
+// rectangle (huge coordinates once converted unclamped doubles to int).
+TEST(S1Accuracy, ExactDepthOracleOnBadInput) {
+    EXPECT_THROW(ExactDepth(-2, 3), Error);
+    EXPECT_THROW(ExactDepth(4, 0), Error);
+    ExactDepth exact(16, 8);
+    const float good[3][4] = {{-2, -2, 0, 2}, {2, -2, 0, 2}, {0, 2, 0, 2}};
+    const float nan_vertex[4] = {NAN, 0, 0, 1};
+    EXPECT_THROW(exact.add_triangle(good[0], good[1], nan_vertex, false), Error);
+    const float huge[3][4] = {{-1e30f, -1e30f, 0, 1}, {1e30f, -1e30f, 0, 1}, {0, 1e30f, 0, 1}};
+    exact.add_triangle(huge[0], huge[1], huge[2], false);  // covers everything at w = 1
+    exact.finish();
+    EXPECT_TRUE(exact.hidden(-1e30f, -1e30f, 1e30f, 1e30f, 2.0f));
+    EXPECT_FALSE(exact.hidden(-1e30f, -1e30f, 1e30f, 1e30f, 0.5f));
+    EXPECT_FALSE(exact.hidden(NAN, -1, 1, 1, 2.0f));
+    EXPECT_FALSE(exact.hidden(1, -1, -1, 1, 2.0f));  // inverted
 }
 
 }  // namespace

@@ -7,19 +7,36 @@
 
 namespace homcull {
 
-ExactDepth::ExactDepth(int sample_width, int sample_height)
-    : width_(sample_width), height_(sample_height),
-      depth_(std::size_t(sample_width) * std::size_t(sample_height), std::numeric_limits<float>::infinity()) {
-    if (sample_width < 1 || sample_height < 1) throw Error("exact depth: the sample grid must be at least 1x1");
+namespace {
+
+std::size_t checked_sample_count(int width, int height) {
+    if (width < 1 || height < 1) throw Error("exact depth: the sample grid must be at least 1x1");
+    return std::size_t(width) * std::size_t(height);
 }
 
-// The sample-span rule (centres in [lo, hi]) is written out here again on purpose rather than
-// shared with the rasterizer: this is the oracle, and a shared helper would hide a shared bug.
+// The samples of a grid of `count` whose centres lie in [lo, hi]. This rule is written out
+// here again on purpose rather than shared with the rasterizer: this is the oracle, and a
+// shared helper would hide a shared bug. lo and hi are clamped to [-1, count + 1] first, so
+// that the conversions to int are defined for any finite input.
+void centre_span(double lo, double hi, int count, int& first, int& last) {
+    lo = std::clamp(lo, -1.0, double(count) + 1.0);
+    hi = std::clamp(hi, -1.0, double(count) + 1.0);
+    first = std::max(0, int(std::ceil(lo - 0.5)));
+    last = std::min(count - 1, int(std::floor(hi - 0.5)));
+}
+
+}  // namespace
+
+ExactDepth::ExactDepth(int sample_width, int sample_height)
+    : width_(sample_width), height_(sample_height),
+      depth_(checked_sample_count(sample_width, sample_height), std::numeric_limits<float>::infinity()) {}
+
 void ExactDepth::add_triangle(const float* a, const float* b, const float* c, bool cull_clockwise) {
     const float* v[3] = {a, b, c};
     double x[3], y[3], inv_w[3];
     for (int k = 0; k < 3; ++k) {
-        if (!(v[k][3] > 0.0f)) throw Error("exact depth: a vertex has w <= 0 (this reference does not clip)");
+        if (!(v[k][3] > 0.0f) || !std::isfinite(v[k][0]) || !std::isfinite(v[k][1]) || !std::isfinite(v[k][3]))
+            throw Error("exact depth: a vertex is not finite or has w <= 0 (this reference does not clip)");
         inv_w[k] = 1.0 / double(v[k][3]);
         x[k] = (double(v[k][0]) * inv_w[k] + 1.0) * 0.5 * width_;
         y[k] = (1.0 - double(v[k][1]) * inv_w[k]) * 0.5 * height_;
@@ -29,10 +46,9 @@ void ExactDepth::add_triangle(const float* a, const float* b, const float* c, bo
     if (cull_clockwise && area > 0.0) return;  // clockwise in NDC (y up)
     const double s = area > 0.0 ? 1.0 : -1.0;
     area *= s;
-    const int i0 = std::max(0, int(std::ceil(std::min({x[0], x[1], x[2]}) - 0.5)));
-    const int i1 = std::min(width_ - 1, int(std::floor(std::max({x[0], x[1], x[2]}) - 0.5)));
-    const int j0 = std::max(0, int(std::ceil(std::min({y[0], y[1], y[2]}) - 0.5)));
-    const int j1 = std::min(height_ - 1, int(std::floor(std::max({y[0], y[1], y[2]}) - 0.5)));
+    int i0, i1, j0, j1;
+    centre_span(std::min({x[0], x[1], x[2]}), std::max({x[0], x[1], x[2]}), width_, i0, i1);
+    centre_span(std::min({y[0], y[1], y[2]}), std::max({y[0], y[1], y[2]}), height_, j0, j1);
     for (int j = j0; j <= j1; ++j)
         for (int i = i0; i <= i1; ++i) {
             const double px = i + 0.5, py = j + 0.5;
@@ -66,10 +82,14 @@ void ExactDepth::finish() {
 }
 
 bool ExactDepth::hidden(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
+    if (!std::isfinite(ndc_min_x) || !std::isfinite(ndc_min_y) || !std::isfinite(ndc_max_x) || !std::isfinite(ndc_max_y) ||
+        !(ndc_min_x <= ndc_max_x) || !(ndc_min_y <= ndc_max_y) || !(w_min == w_min))
+        return false;  // nothing to reason with: not known to be hidden
     const double sx0 = (double(ndc_min_x) + 1.0) * 0.5 * width_, sx1 = (double(ndc_max_x) + 1.0) * 0.5 * width_;
     const double sy0 = (1.0 - double(ndc_max_y)) * 0.5 * height_, sy1 = (1.0 - double(ndc_min_y)) * 0.5 * height_;
-    const int i0 = std::max(0, int(std::ceil(sx0 - 0.5))), i1 = std::min(width_ - 1, int(std::floor(sx1 - 0.5)));
-    const int j0 = std::max(0, int(std::ceil(sy0 - 0.5))), j1 = std::min(height_ - 1, int(std::floor(sy1 - 0.5)));
+    int i0, i1, j0, j1;
+    centre_span(sx0, sx1, width_, i0, i1);
+    centre_span(sy0, sy1, height_, j0, j1);
     if (i0 > i1 || j0 > j1) return true;
     int level = 0;
     while ((2 << level) <= i1 - i0 + 1) ++level;

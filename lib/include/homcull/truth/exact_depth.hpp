@@ -17,7 +17,7 @@ public:
     // A triangle in clip space (x, y, z, w per vertex; z unused). Every vertex must have
     // w > 0 (throws homcull::Error otherwise: there is no clipping here). Closed triangles:
     // samples on an edge count as covered. Backface culling as OcclusionBuffer's Backface::cw
-    // when cull_clockwise.
+    // when cull_clockwise. Throws homcull::Error for a non-finite vertex or w <= 0.
     void add_triangle(const float* xyzw0, const float* xyzw1, const float* xyzw2, bool cull_clockwise);
 
     // Call once after the last triangle, before hidden().
@@ -25,7 +25,8 @@ public:
 
     // True when every sample whose centre lies in the NDC rectangle (y up) has an occluder
     // strictly nearer than w_min (a rectangle with no sample inside is hidden too: nothing of
-    // it can be seen at a sample). Thread-safe after finish().
+    // it can be seen at a sample). A non-finite or inverted rectangle is not hidden (the buffer
+    // answers such input visible). Thread-safe after finish().
     bool hidden(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
 
     // Nearest w per sample (infinity where no triangle covers it), rounded up to float.
