@@ -96,6 +96,11 @@ struct TriangleInput {
     // finds them once per mesh). Samples on a shared edge are covered by one of the two
     // triangles, so the coverage margin, which keeps silhouettes conservative, is not applied
     // there and meshes leave no cracks. Without flags every edge is treated as a silhouette.
+    // Known gap: the flag assumes the neighbour is drawn on the other side of the edge. At a
+    // view silhouette of a closed mesh (front and back face meet there, or the back face is
+    // culled) or next to a skipped neighbour the edge is a silhouette without its margin, so
+    // a sample within rounding of it may be covered. Deciding "shared" per view needs the
+    // neighbour's orientation at render time (planned).
     const std::uint8_t* shared_edges = nullptr;
 };
 
