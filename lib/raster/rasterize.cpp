@@ -65,24 +65,27 @@ PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], d
     return tri;
 }
 
-std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tri) {
-    glm::dvec2 p0 = tri.p[0], p1 = tri.p[1], p2 = tri.p[2];
-    double z0 = tri.d[0], z1 = tri.d[1], z2 = tri.d[2];
-    bool shared[3] = {(tri.shared & 1u) != 0, (tri.shared & 2u) != 0, (tri.shared & 4u) != 0};
-    double area2 = (p1.x - p0.x) * (p2.y - p0.y) - (p1.y - p0.y) * (p2.x - p0.x);
-    if (area2 == 0.0) return 0;
-    if (area2 < 0.0) {  // make the edge functions positive inside: order 0, 2, 1
-        std::swap(p1, p2);
-        std::swap(z1, z2);
-        std::swap(shared[0], shared[2]);  // edges 0->2, 2->1, 1->0 were edges 2, 1, 0
-        area2 = -area2;
+bool orient_triangle(const ScreenTriangle& tri, OrientedTriangle& out) {
+    out.v[0] = tri.p[0], out.v[1] = tri.p[1], out.v[2] = tri.p[2];
+    out.d[0] = tri.d[0], out.d[1] = tri.d[1], out.d[2] = tri.d[2];
+    for (int k = 0; k < 3; ++k) out.shared[k] = (tri.shared >> k) & 1u;
+    const glm::dvec2 p0 = tri.p[0], p1 = tri.p[1], p2 = tri.p[2];
+    out.area2 = (p1.x - p0.x) * (p2.y - p0.y) - (p1.y - p0.y) * (p2.x - p0.x);
+    if (out.area2 == 0.0) return false;
+    if (out.area2 < 0.0) {  // make the edge functions positive inside: order 0, 2, 1
+        std::swap(out.v[1], out.v[2]);
+        std::swap(out.d[1], out.d[2]);
+        std::swap(out.shared[0], out.shared[2]);  // edges 0->2, 2->1, 1->0 were edges 2, 1, 0
+        out.area2 = -out.area2;
     }
-    const glm::dvec2 v[3] = {p0, p1, p2};
+    return true;
+}
 
+TriangleEdges edge_functions(const OrientedTriangle& tri) {
     TriangleEdges edges;
     for (int k = 0; k < 3; ++k) {
-        const glm::dvec2& from = v[k];
-        const glm::dvec2& to = v[(k + 1) % 3];
+        const glm::dvec2& from = tri.v[k];
+        const glm::dvec2& to = tri.v[(k + 1) % 3];
         const bool forward = from.y != to.y ? from.y < to.y : from.x < to.x;
         const glm::dvec2& lo = forward ? from : to;
         const glm::dvec2& hi = forward ? to : from;
@@ -92,21 +95,47 @@ std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& tr
         edges.sa[k] = sign * a;
         edges.sb[k] = sign * b;
         edges.inverse_sa[k] = edges.sa[k] != 0.0 ? 1.0 / edges.sa[k] : 0.0;
-        edges.shared[k] = shared[k];
-        edges.threshold[k] = shared[k] ? 0.0 : t.edge_margin * (std::abs(a) + std::abs(b));
+        edges.shared[k] = tri.shared[k];
+        edges.threshold[k] = 0.0;
     }
+    return edges;
+}
+
+std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& triangle) {
+    OrientedTriangle tri;
+    if (!orient_triangle(triangle, tri)) return 0;
+    TriangleEdges edges = edge_functions(tri);
+    for (int k = 0; k < 3; ++k)  // inner margin on silhouette edges (see the top of this file)
+        edges.threshold[k] = edges.shared[k] ? 0.0 : t.edge_margin * (std::abs(edges.sa[k]) + std::abs(edges.sb[k]));
 
     // Sample rows and columns whose centres lie in the triangle's bounding box.
-    const double min_x = std::min({p0.x, p1.x, p2.x}), max_x = std::max({p0.x, p1.x, p2.x});
-    const double min_y = std::min({p0.y, p1.y, p2.y}), max_y = std::max({p0.y, p1.y, p2.y});
+    const glm::dvec2* v = tri.v;
     int i0, i1, j0, j1;
-    sample_span(min_x, max_x, t.sample_width, i0, i1);
-    sample_span(min_y, max_y, t.sample_height, j0, j1);
+    sample_span(std::min({v[0].x, v[1].x, v[2].x}), std::max({v[0].x, v[1].x, v[2].x}), t.sample_width, i0, i1);
+    sample_span(std::min({v[0].y, v[1].y, v[2].y}), std::max({v[0].y, v[1].y, v[2].y}), t.sample_height, j0, j1);
     if (i0 > i1 || j0 > j1) return 0;
 
-    const double depth[3] = {z0, z1, z2};
-    const PreparedTriangle prepared = prepare_depth_plane(v, depth, area2, t.sample_width, t.sample_height);
+    const PreparedTriangle prepared = prepare_depth_plane(tri.v, tri.d, tri.area2, t.sample_width, t.sample_height);
     return t.kernel(t, edges, prepared, i0, i1, j0, j1);
+}
+
+void sample_row_interval(const TriangleEdges& edges, int row, int i0, int i1, std::int32_t& first, std::int32_t& last) {
+    first = i0;
+    last = i1;
+    const double py = row + 0.5;
+    for (int k = 0; k < 3; ++k) {
+        const double c = edges.threshold[k] - edges.sb[k] * (py - edges.oy[k]);  // need sa * (x - o.x) > c
+        if (edges.sa[k] == 0.0) {
+            if (edges.shared[k] ? !(0.0 >= c) : !(0.0 > c)) last = first - 1;
+            continue;
+        }
+        const double x = edges.ox[k] + c * edges.inverse_sa[k];  // boundary, in samples
+        // The boundary may lie far outside the buffer for a nearly horizontal edge: clamp
+        // before converting to int (the interval is clamped to [i0, i1] anyway).
+        const double xs = std::clamp(x - 0.5, double(i0) - 2.0, double(i1) + 2.0);
+        if (edges.sa[k] > 0.0) first = std::max(first, edges.shared[k] ? ceil_int(xs) : floor_int(xs) + 1);
+        else last = std::min(last, edges.shared[k] ? floor_int(xs) : ceil_int(xs) - 1);
+    }
 }
 
 std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdges& edges, const PreparedTriangle& prepared, int i0,
@@ -117,25 +146,11 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdge
         std::int32_t first[kH], last[kH];
         for (int j = 0; j < kH; ++j) {
             const int sy = ty * kH + j;
-            first[j] = i0;
-            last[j] = i1;
             if (sy < j0 || sy > j1) {
-                last[j] = first[j] - 1;
-                continue;
-            }
-            const double py = sy + 0.5;
-            for (int k = 0; k < 3; ++k) {
-                const double c = edges.threshold[k] - edges.sb[k] * (py - edges.oy[k]);  // need sa * (x - o.x) > c
-                if (edges.sa[k] == 0.0) {
-                    if (edges.shared[k] ? !(0.0 >= c) : !(0.0 > c)) last[j] = first[j] - 1;
-                    continue;
-                }
-                const double x = edges.ox[k] + c * edges.inverse_sa[k];  // boundary, in samples
-                // The boundary may lie far outside the buffer for a nearly horizontal edge: clamp
-                // before converting to int (the interval is clamped to [i0, i1] anyway).
-                const double xs = std::clamp(x - 0.5, double(i0) - 2.0, double(i1) + 2.0);
-                if (edges.sa[k] > 0.0) first[j] = std::max(first[j], edges.shared[k] ? ceil_int(xs) : floor_int(xs) + 1);
-                else last[j] = std::min(last[j], edges.shared[k] ? floor_int(xs) : ceil_int(xs) - 1);
+                first[j] = i0;
+                last[j] = i0 - 1;
+            } else {
+                sample_row_interval(edges, sy, i0, i1, first[j], last[j]);
             }
         }
         int tx_begin, tx_end;
@@ -145,23 +160,31 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdge
     return touched;
 }
 
+SubtileCoverage subtile_coverage(const std::int32_t first[4], const std::int32_t last[4], int tx) {
+    SubtileCoverage c;
+    for (int j = 0; j < kH; ++j) {
+        const int lo = std::max(first[j] - tx * kW, 0), hi = std::min(last[j] - tx * kW, kW - 1);
+        if (lo > hi) continue;
+        c.mask |= ((0xFFu >> (kW - 1 - hi)) & (0xFFu << lo)) << (j * kW);
+        c.column_lo = std::min(c.column_lo, lo);
+        c.column_hi = std::max(c.column_hi, hi);
+        c.row_lo = std::min(c.row_lo, j);
+        c.row_hi = j;
+    }
+    return c;
+}
+
 std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                            const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
     std::uint64_t touched = 0;
     for (int tx = tx_begin; tx <= tx_end; ++tx) {
         // The coverage mask, and the column and row of its bounding rectangle where the depth
         // plane is smallest.
-        std::uint32_t m = 0;
-        int far_column = tri.far_is_left ? kW : -1, far_row = kH;
-        for (int j = 0; j < kH; ++j) {
-            const int lo = std::max(first[j] - tx * kW, 0), hi = std::min(last[j] - tx * kW, kW - 1);
-            if (lo > hi) continue;
-            m |= ((0xFFu >> (kW - 1 - hi)) & (0xFFu << lo)) << (j * kW);
-            far_column = tri.far_is_left ? std::min(far_column, lo) : std::max(far_column, hi);
-            if (!tri.far_is_top || far_row == kH) far_row = j;
-        }
+        const SubtileCoverage c = subtile_coverage(first, last, tx);
+        const std::uint32_t m = c.mask;
         if (m == 0) continue;
         ++touched;
+        const int far_column = tri.far_is_left ? c.column_lo : c.column_hi, far_row = tri.far_is_top ? c.row_lo : c.row_hi;
         const std::size_t i = std::size_t(ty) * planes.stride + std::size_t(tx);
         planes.covered[i] |= m;
 

@@ -88,6 +88,34 @@ inline float conservative_depth(const PreparedTriangle& tri, int column, int row
 // Rasterizes a triangle of either orientation. Returns the number of subtiles updated.
 std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangle& triangle);
 
+// A screen triangle with its vertices ordered so that twice its signed area, area2, is
+// positive: its edge functions are then positive inside. Shared-edge flags follow the edges.
+struct OrientedTriangle {
+    glm::dvec2 v[3];
+    double d[3];
+    bool shared[3];
+    double area2;
+};
+// False (and `out` unusable) when the triangle's area is zero.
+bool orient_triangle(const ScreenTriangle& triangle, OrientedTriangle& out);
+
+// The three edge functions of an oriented triangle (see TriangleEdges), with the shared flags
+// copied and every threshold 0: the caller sets the thresholds it needs (inner margins for
+// occluders, outer ones for occludees).
+TriangleEdges edge_functions(const OrientedTriangle& triangle);
+
+// The samples [first, last] of sample row `row` (centres at row + 0.5) within [i0, i1] on the
+// covered side of every edge: the row formula of rasterize.cpp. Empty when first > last.
+void sample_row_interval(const TriangleEdges& edges, int row, int i0, int i1, std::int32_t& first, std::int32_t& last);
+
+// The samples of subtile column tx that a subtile row's intervals [first[j], last[j]] cover,
+// and the columns and rows (within the subtile) of their bounding rectangle; mask 0 when none.
+struct SubtileCoverage {
+    std::uint32_t mask = 0;
+    int column_lo = OcclusionBuffer::kSubtileWidth, column_hi = -1, row_lo = OcclusionBuffer::kSubtileHeight, row_hi = -1;
+};
+SubtileCoverage subtile_coverage(const std::int32_t first[4], const std::int32_t last[4], int tx);
+
 // The scalar reference of the subtile-row update: the subtiles (tx_begin..tx_end, ty) from the
 // row intervals [first[j], last[j]] of the subtile row's four sample rows. Returns the number
 // of subtiles updated.

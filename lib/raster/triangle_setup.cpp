@@ -7,20 +7,9 @@
 #include <cstring>
 
 namespace homcull::detail {
-namespace {
 
-// Guard band in NDC units: triangles reaching beyond |x/w| or |y/w| = 32 are clipped there, so
-// that sample coordinates stay small enough for double edge functions to be exact to far
-// below the coverage margin.
-constexpr double kGuardBand = 32.0;
-
-}  // namespace
-
-SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w, int sample_width, int sample_height,
-                           RasterStats& stats) {
-    SetupResult result;
+bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3]) {
     const auto* bytes = static_cast<const unsigned char*>(in.positions);
-    ++stats.triangles_in;
     std::uint32_t index[3];
     for (int k = 0; k < 3; ++k) {
         const std::size_t n = 3 * t + std::size_t(k);
@@ -28,32 +17,46 @@ SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w
         else if (in.indices_16bit) index[k] = static_cast<const std::uint16_t*>(in.indices)[n];
         else index[k] = static_cast<const std::uint32_t*>(in.indices)[n];
     }
-    if (index[0] >= in.vertex_count || index[1] >= in.vertex_count || index[2] >= in.vertex_count) {
-        ++stats.invalid;
-        return result;
-    }
-    glm::dvec4 clip[3];
+    if (index[0] >= in.vertex_count || index[1] >= in.vertex_count || index[2] >= in.vertex_count) return false;
     bool valid = true;
     for (int k = 0; k < 3; ++k) {
         float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};
         std::memcpy(p, bytes + std::size_t(index[k]) * in.position_stride, sizeof(float) * std::size_t(in.position_components));
+        model[k] = {p[0], p[1], p[2], p[3]};
         clip[k] = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
         valid = valid && finite_clip(clip[k]);
     }
-    if (!valid) {
-        ++stats.invalid;
-        return result;
-    }
-    // Entirely outside one plane of the view frustum (or behind the near plane)?
+    return valid;
+}
+
+bool outside_side_plane(const glm::dvec4 clip[3]) {
     auto all = [&](auto outside) { return outside(clip[0]) && outside(clip[1]) && outside(clip[2]); };
-    if (all([&](const glm::dvec4& c) { return c.w < near_w; }) || all([](const glm::dvec4& c) { return c.x > c.w; }) ||
-        all([](const glm::dvec4& c) { return c.x < -c.w; }) || all([](const glm::dvec4& c) { return c.y > c.w; }) ||
-        all([](const glm::dvec4& c) { return c.y < -c.w; })) {
+    return all([](const glm::dvec4& c) { return c.x > c.w; }) || all([](const glm::dvec4& c) { return c.x < -c.w; }) ||
+           all([](const glm::dvec4& c) { return c.y > c.w; }) || all([](const glm::dvec4& c) { return c.y < -c.w; });
+}
+
+SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w, int sample_width, int sample_height,
+                           RasterStats& stats) {
+    ++stats.triangles_in;
+    glm::dvec4 model[3], clip[3];
+    if (!fetch_clip_triangle(in, t, model, clip)) {
+        ++stats.invalid;
+        return {};
+    }
+    return setup_clip_triangle(clip, in.shared_edges ? in.shared_edges[t] : 0, in.backface, near_w, sample_width, sample_height, stats);
+}
+
+SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
+                                int sample_height, RasterStats& stats) {
+    SetupResult result;
+    // Entirely outside one plane of the view frustum (or behind the near plane)?
+    if ((clip[0].w < near_w && clip[1].w < near_w && clip[2].w < near_w) || outside_side_plane(clip)) {
         ++stats.outside;
         return result;
     }
     double extent = 0.0, min_w = HUGE_VAL;
-    for (const auto& c : clip) {
+    for (int k = 0; k < 3; ++k) {
+        const glm::dvec4& c = clip[k];
         extent = std::max({extent, std::abs(c.x), std::abs(c.y)});
         min_w = std::min(min_w, c.w);
     }
@@ -62,11 +65,11 @@ SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w
         return result;
     }
     bool needs_clip = false;
-    for (const auto& c : clip)
-        needs_clip = needs_clip || c.w < near_w || std::abs(c.x) > kGuardBand * c.w || std::abs(c.y) > kGuardBand * c.w;
-    const std::uint8_t shared_bits = in.shared_edges ? in.shared_edges[t] : 0;
+    for (int k = 0; k < 3; ++k)
+        needs_clip = needs_clip || clip[k].w < near_w || std::abs(clip[k].x) > kGuardBand * clip[k].w ||
+                     std::abs(clip[k].y) > kGuardBand * clip[k].w;
     const ClipVertex corners[3] = {{clip[0].x, clip[0].y, clip[0].w}, {clip[1].x, clip[1].y, clip[1].w},
-                                           {clip[2].x, clip[2].y, clip[2].w}};
+                                   {clip[2].x, clip[2].y, clip[2].w}};
     ClipPolygon poly;
     if (needs_clip) {
         poly = clip_triangle(corners, shared_bits, near_w, kGuardBand);
@@ -105,7 +108,7 @@ SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w
         return result;
     }
     const bool ccw_in_ndc = det > 0.0;
-    if ((in.backface == Backface::cw && !ccw_in_ndc) || (in.backface == Backface::ccw && ccw_in_ndc)) {
+    if ((backface == Backface::cw && !ccw_in_ndc) || (backface == Backface::ccw && ccw_in_ndc)) {
         ++stats.backface_culled;
         return result;
     }
