@@ -5,17 +5,12 @@
 // over 2 x 2 cells, the two depth maps' minimum. A plain reference for one output row, and a
 // SIMD kernel (opacity_pyramid_simd.cpp) for the cells with four children; sums and minima are
 // exact, so every instruction set gives the reference's bits.
+#include "raster/rasterize.hpp"
+
 #include <cstddef>
 #include <cstdint>
 
 namespace homcull::detail {
-
-// Bit count without a library call (the baseline x86-64 target has no popcnt instruction).
-inline std::uint32_t bit_count(std::uint32_t v) {
-    v = v - ((v >> 1) & 0x55555555u);
-    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
-    return (((v + (v >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24;
-}
 
 // The buffer's subtile planes (OcclusionBuffer's layout) and the level-0 maps to fill.
 struct Level0Maps {

@@ -57,8 +57,10 @@ PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], d
         tri.dzdx = float(dzdx);
         tri.dzdy = float(dzdy);
         tri.error = float_up(error);
+        tri.has_plane = true;
     } else {  // a plane too steep for float (a sliver seen edge-on): the farthest vertex alone
         tri.a = tri.dzdx = tri.dzdy = tri.error = 0.0f;
+        tri.has_plane = false;
     }
     tri.far_is_left = tri.dzdx > 0.0f;
     tri.far_is_top = tri.dzdy > 0.0f;

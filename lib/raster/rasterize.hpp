@@ -67,6 +67,7 @@ struct TriangleEdges {
 struct PreparedTriangle {
     float a, dzdx, dzdy, error, z_vertex_min;
     bool far_is_left, far_is_top;  // where the plane is smallest: towards lower X, lower Y
+    bool has_plane;                // false: too steep for float, a, dzdx, dzdy and error are 0
 };
 
 // The depth plane of a triangle with vertices p[k] and depths d[k] (counter-clockwise,
@@ -149,6 +150,13 @@ inline float float_up(double v) {
     if (v < -kMax) return -std::numeric_limits<float>::max();
     const float f = float(v);
     return double(f) < v ? float_step(f, true) : f;
+}
+
+// Bit count without a library call (the baseline x86-64 target has no popcnt instruction).
+inline std::uint32_t bit_count(std::uint32_t v) {
+    v = v - ((v >> 1) & 0x55555555u);
+    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+    return (((v + (v >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24;
 }
 
 // The mask of subtile (tx, ty)'s samples that lie in the sample range [i0, i1] x [j0, j1].

@@ -167,6 +167,25 @@ public:
     // lane; the rest one at a time. No allocation; thread-safe like the single tests.
     void test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const;
     void test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& model_to_clip, Visibility* results) const;
+    // Occludee triangles, sample by sample (the occludee's own shape instead of a box around
+    // it, as masked occlusion culling's TestTriangles). Every triangle counts, whatever its
+    // orientation (backface and shared_edges are ignored), by its outer coverage: the samples
+    // within a margin outside it that absorbs the rounding of this test, of its float input and
+    // of an exact ray cast (edge_margin plus the input's own rounding bound). At each such sample
+    // the triangle's nearest depth over the subtile (its plane, bounded by its nearest vertex,
+    // raised by the rounding bounds) is compared with the subtile's layer bound.
+    // Occluded when at most `tolerated_samples` samples (counted per triangle, so overlaps
+    // count twice) are not certainly behind an occluder; view-culled when every triangle lies
+    // outside the view frustum; visible otherwise, and as soon as a triangle reaches before
+    // near_w, has a non-finite vertex or an index out of range, or is too large to clip.
+    // Degenerate triangles (zero area in clip space) cover nothing. The counts stop with the
+    // answer, so they are partial for visible occludees. No allocation; thread-safe like the other tests.
+    struct TriangleTest {
+        Visibility visibility = Visibility::view_culled;
+        std::uint64_t samples = 0;          // samples the triangles may cover
+        std::uint64_t visible_samples = 0;  // of those, samples with no occluder certainly nearer
+    };
+    TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0) const;
 
     const BufferConfig& config() const { return config_; }
     int sample_width() const { return sample_width_; }
