@@ -89,6 +89,16 @@ TEST(OccludeeTriangles, EachAnswerOnAWall) {
     EXPECT_EQ(answer(buffer, crossing_off_screen), Visibility::occluded);
     EXPECT_EQ(answer(buffer, crossing_on_screen), Visibility::visible);
 
+    // Crossing the near plane (ground truth sees from it on): a floor under the eye whose part
+    // on screen lies behind the wall is hidden; raised into view, it is not. Its corner at
+    // w = 0.2 has NDC y = -200 (clip y = -40): the edge to (-5, -5, 20) enters the screen at
+    // w = 14.6; with NDC y = -50 (clip y = -10) at w = 8.0, before the wall.
+    Soup floor_hidden, floor_seen;
+    floor_hidden.add(0.0f, -200.0f, 0.2f, -0.25f, -0.25f, 20.0f, 0.25f, -0.25f, 20.0f);
+    floor_seen.add(0.0f, -50.0f, 0.2f, -0.25f, -0.25f, 20.0f, 0.25f, -0.25f, 20.0f);
+    EXPECT_EQ(answer(buffer, floor_hidden), Visibility::occluded);
+    EXPECT_EQ(answer(buffer, floor_seen), Visibility::visible);
+
     // Behind the eye entirely: nothing of it can be seen.
     Soup behind_eye;
     behind_eye.xyw = {0.0f, 0.0f, -1.0f, 1.0f, 0.0f, -2.0f, 0.0f, 1.0f, -1.0f};

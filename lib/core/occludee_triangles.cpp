@@ -6,8 +6,9 @@
 //   input is accounted for (the Minkowski sum of the triangle with a box of that size is inside
 //   the three edge half-planes pushed out by the box's support, |a| dx + |b| dy);
 // - depth is the triangle's nearest over the covered samples of a subtile: its plane at the
-//   nearest corner of their bounding rectangle, raised by the plane's float error and by how
-//   much the rounding of the vertices can tilt the plane, never above its nearest vertex.
+//   nearest corner of their bounding rectangle (or at each sample, against a per-sample depth),
+//   raised by the plane's float error and by how much the rounding of the vertices can move
+//   the plane, never above its nearest vertex.
 // The row intervals and subtile masks are the rasterizer's (one formula, see rasterize.cpp).
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
@@ -27,38 +28,54 @@ using detail::PreparedTriangle;
 using detail::TriangleEdges;
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 
-// How far, in samples, a projected vertex may lie from where an exact computation with the
-// same scene puts it, and how far its w may be off, relatively. The matrix and the positions
-// are floats (ground truth rounds its world positions to float as well): each entry and each
-// coordinate carries a relative rounding of 2^-24, so clip coordinate r is off by at most
-// 2^-24 (1 + 2^-24) sum_i |m_ri p_i| ~ 2^-23 of that sum; 2^-22 leaves a factor 2 for the
-// ray's own rounding and second-order terms. NDC x = x / w is then off by (ex + |x / w| ew) / w.
-struct VertexSlack {
-    double x = 0.0, y = 0.0, w_relative = 0.0;
+// How far an exact computation with the same scene may put the triangle's clip coordinates
+// from ours. The matrix and the positions are floats (ground truth rounds its world positions
+// to float as well): each entry and each coordinate carries a relative rounding of 2^-24, so
+// clip coordinate r is off by at most about 2^-23 sum_i |m_ri p_i|; 2^-22 leaves a factor 2
+// for the ray's own rounding and second-order terms. A point of the triangle (or of its part
+// clipped at the near plane: a convex combination of the corners) is off by at most the
+// largest corner error, per coordinate.
+struct ClipError {
+    double x = 0.0, y = 0.0, w = 0.0;
 };
 
-VertexSlack vertex_slack(const std::array<float, 16>& m, const glm::dvec4 model[3], const glm::dvec4 clip[3], int sample_width,
-                         int sample_height) {
-    VertexSlack s;
+ClipError clip_error(const std::array<float, 16>& m, const glm::dvec4 model[3]) {
+    ClipError e;
     for (int k = 0; k < 3; ++k) {
         double magnitude[4] = {0.0, 0.0, 0.0, 0.0};
         for (int row = 0; row < 4; ++row)
             for (int i = 0; i < 4; ++i) magnitude[row] += std::abs(double(m[std::size_t(4 * i + row)]) * model[k][i]);
-        const double w = clip[k].w;  // >= near_w > 0 here
-        const double ex = 0x1.0p-22 * magnitude[0], ey = 0x1.0p-22 * magnitude[1], ew = 0x1.0p-22 * magnitude[3];
-        s.x = std::max(s.x, (ex + std::abs(clip[k].x / w) * ew) / w * 0.5 * sample_width);
-        s.y = std::max(s.y, (ey + std::abs(clip[k].y / w) * ew) / w * 0.5 * sample_height);
-        s.w_relative = std::max(s.w_relative, ew / w);
+        e.x = std::max(e.x, 0x1.0p-22 * magnitude[0]);
+        e.y = std::max(e.y, 0x1.0p-22 * magnitude[1]);
+        e.w = std::max(e.w, 0x1.0p-22 * magnitude[3]);
+    }
+    return e;
+}
+
+// The same in samples for a projected triangle (corners with d = 1/w): NDC x = x / w is off
+// by (ex + |x / w| ew) / w; and how far its w may be off, relatively.
+struct VertexSlack {
+    double x = 0.0, y = 0.0, w_relative = 0.0;
+};
+
+VertexSlack vertex_slack(const ClipError& e, const detail::ScreenTriangle& t, int sample_width, int sample_height) {
+    VertexSlack s;
+    for (int k = 0; k < 3; ++k) {
+        const double ndc_x = t.p[k].x / (0.5 * sample_width) - 1.0, ndc_y = 1.0 - t.p[k].y / (0.5 * sample_height);
+        s.x = std::max(s.x, (e.x + std::abs(ndc_x) * e.w) * t.d[k] * 0.5 * sample_width);
+        s.y = std::max(s.y, (e.y + std::abs(ndc_y) * e.w) * t.d[k] * 0.5 * sample_height);
+        s.w_relative = std::max(s.w_relative, e.w * t.d[k]);
     }
     return s;
 }
 
-// The triangle's nearest depth bound over the samples of one subtile row, per subtile.
+// An upper bound of the triangle's 1/w at a sample, or over a rectangle of samples when given
+// the rectangle's corner where the plane is largest.
 struct OccludeeDepth {
-    PreparedTriangle plane;  // usable when plane.has_plane
-    float error;             // plane.error plus the tilt bound, rounded up
-    float z_vertex_max;      // the nearest vertex, rounded up
-    float raise;             // final relative raise, rounded up: 1 + 2^-20 + the w rounding
+    PreparedTriangle plane{};  // usable when plane.has_plane
+    float error = 0.0f;        // plane.error plus plane_error, rounded up
+    float z_vertex_max = 0.0f; // the nearest vertex, rounded up
+    float raise = 1.0f;        // final relative raise, rounded up: 1 + 2^-20 + the w rounding
 
     float at(int column, int row) const {
         float bound = z_vertex_max;
@@ -70,21 +87,35 @@ struct OccludeeDepth {
     }
 };
 
-// How much moving each vertex by up to (dx, dy) samples can change the plane at a point of
-// the padded bounding box (W x H samples): barycentric l_k = E_k / A, where the edge function
-// E_k changes by at most B = 2 dx (H + dy) + 2 dy W and the doubled area A by at most 3 B, and
-// |E_k| <= e_max; so l_k changes by at most (B A + 3 B e_max) / (A (A - 3 B)), and the
-// plane, sum l_k d_k with sum l_k = 1, by 3 times that times the depth range. Infinite when
-// A <= 6 B (the plane could tilt arbitrarily: only the nearest vertex bounds it).
-double plane_tilt_bound(const OrientedTriangle& tri, const TriangleEdges& e, double dx, double dy, double width, double height) {
-    const double b = 2.0 * dx * (height + dy) + 2.0 * dy * width;
-    const double area = tri.area2;
-    if (!(area > 6.0 * b)) return HUGE_VAL;
-    double e_max = 0.0;
-    for (int k = 0; k < 3; ++k) e_max = std::max(e_max, std::abs(e.sa[k]) * width + std::abs(e.sb[k]) * height);
-    const double lambda = (b * area + 3.0 * b * e_max) / (area * (area - 3.0 * b));
-    const double range = std::max({tri.d[0], tri.d[1], tri.d[2]}) - std::min({tri.d[0], tri.d[1], tri.d[2]});
-    return 3.0 * lambda * range;
+// How far the rounding of the input (ClipError) can move the triangle's 1/w at an on-screen
+// point. In clip space (x, y, w) the triangle spans the plane n . V = c, n = (V1 - V0) x
+// (V2 - V0), c = n . V0, so at NDC (u, v) its 1/w is d = n . q / c with q = (u, v, 1),
+// |q| <= sqrt(3) on screen. Moving each coordinate by at most e moves the edge vectors by at
+// most 2 |e| and so n by dn <= 2 |e| (|E1| + |E2|) + 4 |e|^2, and c by dc <= dn |V0| +
+// (|n| + dn) |e|; then d changes by at most (dn sqrt(3) + d dc) / (|c| - dc). The bound
+// depends on how the triangle sits in space (c = 0: seen edge-on), not on how it is clipped,
+// so a floor cut at the near plane keeps its plane. Unusable (infinite) when |c| <= 2 dc.
+double plane_error(const glm::dvec4 clip[3], const ClipError& e, double d_max) {
+    const glm::dvec3 v0(clip[0].x, clip[0].y, clip[0].w), v1(clip[1].x, clip[1].y, clip[1].w), v2(clip[2].x, clip[2].y, clip[2].w);
+    const glm::dvec3 e1 = v1 - v0, e2 = v2 - v0, n = glm::cross(e1, e2);
+    const double ee = std::sqrt(e.x * e.x + e.y * e.y + e.w * e.w);
+    const double dn = 2.0 * ee * (glm::length(e1) + glm::length(e2)) + 4.0 * ee * ee;
+    const double dc = dn * glm::length(v0) + (glm::length(n) + dn) * ee;
+    const double c = std::abs(glm::dot(n, v0));
+    if (!(c > 2.0 * dc)) return HUGE_VAL;
+    return (dn * std::sqrt(3.0) + d_max * dc) / (c - dc);
+}
+
+// Of the samples `unhidden` of subtile (tx, ty), those the per-sample depth does not hide
+// either: the triangle's bound at the sample itself against the occluders' there.
+std::uint32_t unhidden_by_sample_depth(const detail::SubtileView& view, int tx, int ty, std::uint32_t unhidden, const OccludeeDepth& depth) {
+    std::uint32_t left = 0;
+    for (std::uint32_t bits = unhidden; bits != 0; bits &= bits - 1) {
+        const int bit = __builtin_ctz(bits);
+        const int x = tx * kW + bit % kW, y = ty * kH + bit / kW;
+        if (!(depth.at(x, y) < view.sample_depth[std::size_t(y) * view.sample_stride + std::size_t(x)])) left |= 1u << bit;
+    }
+    return left;
 }
 
 struct SampleCounts {
@@ -93,8 +124,9 @@ struct SampleCounts {
 
 // Counts one screen triangle's outer-covered samples and those not certainly hidden; stops
 // once more than `tolerated` are visible.
-void count_triangle(const detail::ScreenTriangle& screen, const VertexSlack& slack, double margin, const detail::SubtileView& view,
-                    int sample_width, int sample_height, std::uint64_t tolerated, SampleCounts& counts) {
+void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error, double depth_error, double margin,
+                    const detail::SubtileView& view, int sample_width, int sample_height, std::uint64_t tolerated, SampleCounts& counts) {
+    const VertexSlack slack = vertex_slack(error, screen, sample_width, sample_height);
     OrientedTriangle tri;
     const bool has_area = detail::orient_triangle(screen, tri);
     const double pad_x = slack.x + margin, pad_y = slack.y + margin;
@@ -117,8 +149,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const VertexSlack& sla
             edges.threshold[k] = -(std::abs(edges.sa[k]) * pad_x + std::abs(edges.sb[k]) * pad_y);
         }
         depth.plane = detail::prepare_depth_plane(tri.v, tri.d, tri.area2, sample_width, sample_height);
-        const double tilt = plane_tilt_bound(tri, edges, pad_x, pad_y, max_x - min_x, max_y - min_y);
-        depth.error = detail::float_up(double(depth.plane.error) + tilt);
+        depth.error = detail::float_up(double(depth.plane.error) + depth_error);
         if (!std::isfinite(depth.error)) depth.plane.has_plane = false;
     } else {
         depth.plane.has_plane = false;  // zero area after projection: its padded bounding box, at its nearest vertex
@@ -148,7 +179,9 @@ void count_triangle(const detail::ScreenTriangle& screen, const VertexSlack& sla
             // The plane is largest (nearest) away from its far side.
             const float d_near = depth.at(tx * kW + (far_is_left ? c.column_hi : c.column_lo), ty * kH + (far_is_top ? c.row_hi : c.row_lo));
             counts.samples += detail::bit_count(c.mask);
-            counts.visible += std::uint64_t(detail::subtile_visible_samples(view, tx, ty, c.mask, d_near));
+            std::uint32_t unhidden = detail::subtile_unhidden_samples(view, tx, ty, c.mask, d_near);
+            if (view.sample_depth && unhidden) unhidden = unhidden_by_sample_depth(view, tx, ty, unhidden, depth);
+            counts.visible += detail::bit_count(unhidden);
             if (counts.visible > tolerated) return;
         }
     }
@@ -178,16 +211,22 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
     for (std::size_t t = 0; t < in.triangle_count; ++t) {
         glm::dvec4 model[3], clip[3];
         if (!detail::fetch_clip_triangle(in, t, model, clip)) return visible();  // nothing to reason with: never cull
-        if ((clip[0].w <= 0.0 && clip[1].w <= 0.0 && clip[2].w <= 0.0) || detail::outside_side_plane(clip)) continue;
+        // Ground truth sees surfaces from the near plane on: the part before it is clipped
+        // away, at a plane moved towards the eye by the rounding bound of w.
+        const ClipError error = clip_error(in.model_to_clip, model);
+        const double near_clip = near_w * (1.0 - 0x1.0p-20) - error.w;
+        if ((clip[0].w < near_clip && clip[1].w < near_clip && clip[2].w < near_clip) || detail::outside_side_plane(clip)) continue;
         in_frustum = true;
-        if (clip[0].w < near_w || clip[1].w < near_w || clip[2].w < near_w) return visible();  // reaches before the near plane
-        const VertexSlack slack = vertex_slack(in.model_to_clip, model, clip, sample_width_, sample_height_);
+        if (!(near_clip > 0.0)) return visible();  // coordinates too large to place the near plane
         RasterStats stats;
         const detail::SetupResult setup =
-            detail::setup_clip_triangle(clip, 0, Backface::none, near_w, sample_width_, sample_height_, stats);
+            detail::setup_clip_triangle(clip, 0, Backface::none, near_clip, sample_width_, sample_height_, stats);
         if (stats.too_large) return visible();  // not clipped precisely enough to reason with
+        double d_max = 0.0;
+        for (int k = 0; k < setup.count; ++k) d_max = std::max({d_max, setup.triangles[k].d[0], setup.triangles[k].d[1], setup.triangles[k].d[2]});
+        const double depth_error = plane_error(clip, error, d_max);
         for (int k = 0; k < setup.count; ++k) {
-            count_triangle(setup.triangles[k], slack, config_.edge_margin, view, sample_width_, sample_height_, tolerated_samples, counts);
+            count_triangle(setup.triangles[k], error, depth_error, config_.edge_margin, view, sample_width_, sample_height_, tolerated_samples, counts);
             if (counts.visible > tolerated_samples) return visible();
         }
     }

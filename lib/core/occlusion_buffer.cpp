@@ -49,6 +49,7 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     d1_.assign(plane, 0.0f);
     mask_.assign(plane, 0u);
     covered_.assign(plane, 0u);
+    if (config.sample_depth) sample_depth_.assign(std::size_t(sample_width_) * std::size_t(sample_height_), 0.0f);
     band_touched_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
     std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
@@ -69,6 +70,7 @@ void OcclusionBuffer::clear() {
     std::fill(d1_.begin(), d1_.end(), 0.0f);
     std::fill(mask_.begin(), mask_.end(), 0u);
     std::fill(covered_.begin(), covered_.end(), 0u);
+    std::fill(sample_depth_.begin(), sample_depth_.end(), 0.0f);
     std::fill(pyramid_.begin(), pyramid_.end(), 0.0f);
     stats_ = RasterStats{};
 }
@@ -150,7 +152,13 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         const Job& j = *static_cast<Job*>(data);
         OcclusionBuffer& b = *j.self;
         const int row_begin = int(band) * kBandSubtileRows;
-        const detail::SubtilePlanes planes{b.d0_.data(), b.d1_.data(), b.mask_.data(), b.covered_.data(), b.stride_};
+        const detail::SubtilePlanes planes{b.d0_.data(),
+                                           b.d1_.data(),
+                                           b.mask_.data(),
+                                           b.covered_.data(),
+                                           b.stride_,
+                                           b.sample_depth_.empty() ? nullptr : b.sample_depth_.data(),
+                                           std::size_t(b.sample_width_)};
         const detail::RasterTarget target{planes, b.sample_width_, b.sample_height_,
                                           b.config_.edge_margin, row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_),
                                           detail::selected_rows_kernel()};
@@ -195,8 +203,10 @@ void OcclusionBuffer::read_depth(std::vector<float>& w) const {
         for (int x = 0; x < sample_width_; ++x) {
             const Subtile s = subtile(x / kW, y / kH);
             const bool in_mask = (s.mask >> ((y % kH) * kW + x % kW)) & 1u;
-            const float d = in_mask ? std::max(s.d0, s.d1) : s.d0;
-            w[std::size_t(y) * std::size_t(sample_width_) + std::size_t(x)] = d > 0.0f ? 1.0f / d : INFINITY;
+            const std::size_t at = std::size_t(y) * std::size_t(sample_width_) + std::size_t(x);
+            float d = in_mask ? std::max(s.d0, s.d1) : s.d0;
+            if (!sample_depth_.empty()) d = std::max(d, sample_depth_[at]);
+            w[at] = d > 0.0f ? 1.0f / d : INFINITY;
         }
 }
 

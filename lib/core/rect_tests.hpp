@@ -39,6 +39,8 @@ struct SubtileView {
     const float* d1;
     const std::uint32_t* mask;
     std::size_t stride;
+    const float* sample_depth;  // per sample, rows of sample_stride; null when the buffer keeps none
+    std::size_t sample_stride;
 };
 
 // Whether subtile (tx, ty) hides the rectangle's samples in it: its bound there is d0, or
@@ -50,16 +52,16 @@ inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery&
     return q.d_near < bound;
 }
 
-// How many of the samples `samples` of subtile (tx, ty) an occludee at 1/w `d_near` may be
-// seen at: those whose layer bound (d0, or max(d0, d1) in the working layer's mask) is not
-// above d_near. The same rule as subtile_hides, sample by sample.
-inline int subtile_visible_samples(const SubtileView& v, int tx, int ty, std::uint32_t samples, float d_near) {
+// Which of the samples `samples` of subtile (tx, ty) an occludee at 1/w `d_near` may be seen
+// at by the layers: those whose layer bound (d0, or max(d0, d1) in the working layer's mask)
+// is not above d_near. The same rule as subtile_hides, sample by sample.
+inline std::uint32_t subtile_unhidden_samples(const SubtileView& v, int tx, int ty, std::uint32_t samples, float d_near) {
     const std::size_t i = std::size_t(ty) * v.stride + std::size_t(tx);
     if (d_near < v.d0[i]) return 0;
     const std::uint32_t layer = v.mask[i];
     std::uint32_t visible = samples & ~layer;
     if (!(d_near < std::max(v.d0[i], v.d1[i]))) visible |= samples & layer;
-    return int(bit_count(visible));
+    return visible;
 }
 
 // The rectangle's interior subtiles [ix0, ix1] x [iy0, iy1] (all their samples in it, so their

@@ -158,8 +158,18 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdge
         int tx_begin, tx_end;
         if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, first, last, prepared, t.sample_width, t.sample_height);
+        if (t.planes.sample_depth) update_sample_depth(t.planes, ty, first, last, prepared);
     }
     return touched;
+}
+
+void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t first[4], const std::int32_t last[4],
+                         const PreparedTriangle& tri) {
+    for (int j = 0; j < kH; ++j) {
+        const int row = ty * kH + j;
+        float* depth = planes.sample_depth + std::size_t(row) * planes.sample_stride;
+        for (int x = first[j]; x <= last[j]; ++x) depth[x] = std::max(depth[x], conservative_depth(tri, x, row));
+    }
 }
 
 SubtileCoverage subtile_coverage(const std::int32_t first[4], const std::int32_t last[4], int tx) {

@@ -41,6 +41,8 @@ struct SubtilePlanes {
     std::uint32_t* mask;
     std::uint32_t* covered;
     std::size_t stride;
+    float* sample_depth;        // per sample, rows of sample_width; null when not kept
+    std::size_t sample_stride;
 };
 
 struct RasterTarget {
@@ -203,6 +205,12 @@ inline bool reached_subtile_columns(const std::int32_t first[4], const std::int3
 // The mask of the samples of subtile (tx, ty) that exist (the buffer's right and bottom
 // subtiles may be partly outside the sample grid).
 std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_height);
+
+// The per-sample depth of a subtile row's covered samples (planes.sample_depth, which must be
+// non-null): the maximum of what it holds and conservative_depth at the sample. One plain loop
+// for every instruction set, so that all give the same bits.
+void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t first[4], const std::int32_t last[4],
+                         const PreparedTriangle& tri);
 
 // The reference row loop: scalar intervals and update_subtile_row_reference.
 std::uint64_t rasterize_rows_reference(const RasterTarget& target, const TriangleEdges& edges, const PreparedTriangle& tri, int i0,

@@ -150,6 +150,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const TriangleEdges& e, const
         int tx_begin, tx_end;
         if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         touched += UpdateSubtileRow(t.planes, ty, tx_begin, tx_end, first, last, tri, t.sample_width, t.sample_height);
+        if (t.planes.sample_depth) update_sample_depth(t.planes, ty, first, last, tri);
     }
     return touched;
 }

@@ -31,6 +31,7 @@ BufferConfig scene_buffer_config(const SceneCullerConfig& c, float near_w) {
     BufferConfig b;
     b.samples = c.samples;
     b.near_w = near_w;
+    b.sample_depth = c.sample_depth && resolved_occludee_shape(c) == OccludeeShape::samples;
     if (c.buffer.width == 0 && c.buffer.height == 0) {
         if (c.display.width % c.samples != 0 || c.display.height % c.samples != 0)
             throw Error("the display resolution " + std::to_string(c.display.width) + "x" + std::to_string(c.display.height) +
@@ -57,7 +58,26 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
       occluder_ids_(occluders),
       occluders_(gather_world_triangles(scene, occluders)),
       buffer_(scene_buffer_config(config, 0.1f)),
-      maps_(buffer_, maps_config(config)) {}
+      maps_(buffer_, maps_config(config)) {
+    if (shape() != OccludeeShape::samples) return;
+    occludee_first_vertex_.assign(scene.objects.size(), kNotGathered);
+    for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+        const Object& object = scene.objects[id];
+        if (scene.triangle_count(object) > config.triangle_test_limit) continue;
+        occludee_first_vertex_[id] = occludee_positions_.size() / 3;
+        for (const glm::vec3& p : scene.meshes[object.mesh].positions) {
+            const glm::vec3 w = transform_point(object.world, p);
+            occludee_positions_.insert(occludee_positions_.end(), {w.x, w.y, w.z});
+        }
+    }
+}
+
+OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config) {
+    if (config.occludees != OccludeeShape::automatic) return config.occludees;
+    return config.maps.depth == DepthTest::masked ? OccludeeShape::samples : OccludeeShape::rectangles;
+}
+
+OccludeeShape SceneCuller::shape() const { return resolved_occludee_shape(config_); }
 
 void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     validate_camera(camera);
@@ -83,6 +103,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
     start = std::chrono::steady_clock::now();
     answers.resize(scene_->objects.size());
     exits_ = {};
+    const OccludeeShape shape = this->shape();
     for (std::size_t id = 0; id < scene_->objects.size(); ++id) {
         const Aabb& box = scene_->objects[id].world_bounds;
         if (box.empty()) {
@@ -92,10 +113,12 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
         answers[id] = maps_.test_aabb(box, clip);
         ++exits_.count[answers[id].overlap_exit];
         const Object& object = scene_->objects[id];
-        if (answers[id].visibility == Visibility::visible && config_.test_triangles &&
-            scene_->triangle_count(object) <= config_.triangle_test_limit && triangles_hidden(object, clip_double)) {
+        if (answers[id].visibility != Visibility::visible || scene_->triangle_count(object) > config_.triangle_test_limit) continue;
+        if (shape == OccludeeShape::rectangles && triangle_rectangles_hidden(object, clip_double)) {
             answers[id].visibility = Visibility::occluded;
             answers[id].level_of_visibility = 0.0f;  // the holes its triangles tolerated are not estimated
+        } else if (shape == OccludeeShape::samples && triangle_samples_hidden(id, clip, answers[id].level_of_visibility)) {
+            answers[id].visibility = Visibility::occluded;
         }
     }
     timings_.test_ms = ms_since(start);
@@ -131,7 +154,7 @@ bool triangle_hidden(const OcclusionMaps& maps, float near_w, const glm::dvec4 c
 
 // Every triangle hidden (see triangle_hidden), corners transformed in double as ground truth
 // transforms them.
-bool SceneCuller::triangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
+bool SceneCuller::triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
     const Mesh& mesh = scene_->meshes[object.mesh];
     const glm::dmat4 m = clip_from_world * object.world;
     double budget = maps_.hole_budget();  // approximate mode: L pixels of holes for the whole object
@@ -140,6 +163,26 @@ bool SceneCuller::triangles_hidden(const Object& object, const glm::dmat4& clip_
         for (int k = 0; k < 3; ++k) c[k] = m * glm::dvec4(glm::dvec3(mesh.positions[mesh.indices[3 * t + std::size_t(k)]]), 1.0);
         if (!triangle_hidden(maps_, buffer_.config().near_w, c, 3, budget)) return false;
     }
+    return true;
+}
+
+// The object's triangles sample by sample (OcclusionBuffer::test_triangles), tolerating the
+// maps' hole budget in approximate mode; its level of visibility is then the share of its
+// samples left visible.
+bool SceneCuller::triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) const {
+    const std::size_t first = occludee_first_vertex_[id];
+    if (first == kNotGathered) return false;
+    const Mesh& mesh = scene_->meshes[scene_->objects[id].mesh];
+    TriangleInput in;
+    in.positions = occludee_positions_.data() + 3 * first;
+    in.vertex_count = mesh.positions.size();
+    in.indices = mesh.indices.data();
+    in.triangle_count = mesh.triangle_count();
+    in.model_to_clip = clip_from_world;
+    in.backface = Backface::none;
+    const OcclusionBuffer::TriangleTest r = buffer_.test_triangles(in, std::uint64_t(maps_.hole_budget()));
+    if (r.visibility == Visibility::visible) return false;
+    level_of_visibility = r.samples > 0 ? float(double(r.visible_samples) / double(r.samples)) : 0.0f;
     return true;
 }
 

@@ -27,8 +27,14 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--finest-level", o.finest_level, "Finest active level of the opacity pyramid")->capture_default_str();
     app.add_option("--coarsest-level", o.coarsest_level, "Coarsest active level (-1: the pyramid's last)")->capture_default_str();
     app.add_option("--occludees", o.occludees,
-                   "box: test each object's world box; triangles: where the box is visible, also its triangles' rectangles")
-        ->capture_default_str()->check(CLI::IsMember({"box", "triangles"}));
+                   "box: each object's world box; where the box is visible, also its triangles: rects (their screen rectangles, "
+                   "through the maps' depth test) or samples (sample by sample against the masked depth); auto: samples with "
+                   "--depth masked, else rects")
+        ->capture_default_str()->check(CLI::IsMember({"box", "rects", "samples", "auto"}));
+    app.add_option("--sample-depth", o.sample_depth,
+                   "on: with samples occludees, keep the occluders' depth per sample (precise at silhouettes); off: the "
+                   "subtile layers alone (faster render)")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--occluders", o.occluders, "role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
 }
@@ -50,7 +56,9 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.maps.deb_height = deb.height;
     c.maps.depth = o.depth == "hzb" ? DepthTest::hzb : o.depth == "deb" ? DepthTest::deb : o.depth == "nbz" ? DepthTest::nbz
                  : o.depth == "plane" ? DepthTest::plane : DepthTest::masked;
-    c.test_triangles = o.occludees == "triangles";
+    c.occludees = o.occludees == "box" ? OccludeeShape::box : o.occludees == "rects" ? OccludeeShape::rectangles
+                : o.occludees == "samples" ? OccludeeShape::samples : OccludeeShape::automatic;
+    c.sample_depth = o.sample_depth == "on";
     return c;
 }
 

@@ -16,7 +16,7 @@ struct CullOptions {
     int samples = 1;
     double hole = 0.0, distribution = 1.0, transparency = 0.0;
     int finest_level = 0, coarsest_level = -1;
-    std::string deb = "64x64", occludees = "triangles";
+    std::string deb = "64x64", occludees = "auto", sample_depth = "on";
 };
 
 // with_display: also --resolution and --samples (commands that define their own leave them out

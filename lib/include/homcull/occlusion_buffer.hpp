@@ -55,6 +55,12 @@ struct BufferConfig {
     float near_w = 0.1f;
     // Inner margin of coverage, in samples: see "Conservative" above.
     double edge_margin = 1.0 / 1024.0;
+    // Also keep a conservative depth per sample: at each covered sample, the nearest of the
+    // occluders' own lower bounds there (their planes lowered by their float error, as for
+    // the subtile layers, but evaluated at the sample). The layers lose depth where a subtile
+    // holds occluders at different depths, at silhouettes; per-sample depth does not, which
+    // test_triangles uses. Costs 4 bytes a sample and a plane evaluation per covered sample.
+    bool sample_depth = false;
 };
 
 struct RasterStats {
@@ -174,11 +180,13 @@ public:
     // of an exact ray cast (edge_margin plus the input's own rounding bound). At each such sample
     // the triangle's nearest depth over the subtile (its plane, bounded by its nearest vertex,
     // raised by the rounding bounds) is compared with the subtile's layer bound.
+    // Triangles are clipped at the near plane (near_w, moved towards the eye by the input's
+    // rounding bound): what lies before it is not seen, as in ground truth.
     // Occluded when at most `tolerated_samples` samples (counted per triangle, so overlaps
     // count twice) are not certainly behind an occluder; view-culled when every triangle lies
-    // outside the view frustum; visible otherwise, and as soon as a triangle reaches before
-    // near_w, has a non-finite vertex or an index out of range, or is too large to clip.
-    // Degenerate triangles (zero area in clip space) cover nothing. The counts stop with the
+    // outside the view frustum; visible otherwise, and as soon as a triangle has a non-finite
+    // vertex or an index out of range, or is too large to clip. Degenerate triangles (zero
+    // area in clip space) cover nothing. The counts stop with the
     // answer, so they are partial for visible occludees. No allocation; thread-safe like the other tests.
     struct TriangleTest {
         Visibility visibility = Visibility::view_culled;
@@ -198,7 +206,8 @@ public:
     int subtiles_y() const { return subtiles_y_; }
 
     // Read-back per sample (row-major, top row first): whether an occluder covers it, and
-    // the conservative occluder depth as clip w (infinity where nothing is known).
+    // the conservative occluder depth as clip w (infinity where nothing is known): the layers'
+    // bound, or the per-sample depth where that is nearer (BufferConfig::sample_depth).
     void read_coverage(std::vector<std::uint8_t>& covered) const;
     void read_depth(std::vector<float>& w) const;
 
@@ -213,6 +222,7 @@ private:
     std::size_t stride_ = 0;
     std::vector<float> d0_, d1_;
     std::vector<std::uint32_t> mask_, covered_;
+    std::vector<float> sample_depth_;  // 1/w per sample, row-major; empty unless config_.sample_depth
     std::size_t at(int tx, int ty) const { return std::size_t(ty) * stride_ + std::size_t(tx); }
     RasterStats stats_;
 

@@ -12,6 +12,13 @@
 
 namespace homcull {
 
+enum class OccludeeShape : std::uint8_t {
+    box,         // the world box alone
+    rectangles,  // each triangle's screen rectangle at its nearest depth, through the maps and their depth test
+    samples,     // the triangles sample by sample against the buffer's masked depth (OcclusionBuffer::test_triangles)
+    automatic,   // samples with the masked depth test, rectangles with the others
+};
+
 struct SceneCullerConfig {
     Resolution display{1280, 720};
     // Buffer pixels; 0 x 0 means display / samples, whose samples are the display's pixel
@@ -22,13 +29,20 @@ struct SceneCullerConfig {
     OcclusionMapsConfig maps;  // display_width/height are taken from `display`
     // Back faces are surfaces to ground truth and to the eye: none are culled by default.
     Backface backface = Backface::none;
-    // Occludee shape: the world box alone, or, where the box is found visible, the screen
-    // rectangles of the object's triangles (hidden when every one is): much tighter for
-    // objects whose box reaches past what hides them, at the cost of transforming their
-    // vertices. Objects with more than triangle_test_limit triangles keep the box's answer.
-    bool test_triangles = true;
+    // Occludee shape: the world box alone, or, where the box is found visible, the object's
+    // triangles (much tighter for objects whose box reaches past what hides them, at the cost
+    // of transforming their vertices). Objects with more than triangle_test_limit triangles
+    // keep the box's answer.
+    OccludeeShape occludees = OccludeeShape::automatic;
     std::size_t triangle_test_limit = 20000;
+    // With the samples shape: give the buffer a per-sample depth (BufferConfig::sample_depth),
+    // the occluders' depth without the layers' loss at silhouettes. Off: the layers alone,
+    // rendering faster.
+    bool sample_depth = true;
 };
+
+// The shape `automatic` stands for with this configuration.
+OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config);
 
 struct SceneCullTimings {
     double render_ms = 0.0;  // occluder triangles into the buffer
@@ -69,7 +83,14 @@ private:
     OcclusionMaps maps_;
     SceneCullTimings timings_;
     OverlapExitCounts exits_;
-    bool triangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const;
+    // Occludee triangles in world space (transformed as ground truth transforms them) for the
+    // samples test: object id -> its first vertex in occludee_positions_, or kNotGathered.
+    static constexpr std::size_t kNotGathered = ~std::size_t(0);
+    std::vector<float> occludee_positions_;
+    std::vector<std::size_t> occludee_first_vertex_;
+    OccludeeShape shape() const;
+    bool triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const;
+    bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) const;
 };
 
 // The buffer configuration a SceneCullerConfig asks for (resolved buffer size), for callers
