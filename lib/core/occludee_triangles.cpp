@@ -73,9 +73,9 @@ VertexSlack vertex_slack(const ClipError& e, const detail::ScreenTriangle& t, in
 // the rectangle's corner where the plane is largest.
 struct OccludeeDepth {
     PreparedTriangle plane{};  // usable when plane.has_plane
-    float error = 0.0f;        // plane.error plus plane_error, rounded up
+    float error = 0.0f;        // plane.error plus plane_error's absolute part, rounded up
     float z_vertex_max = 0.0f; // the nearest vertex, rounded up
-    float raise = 1.0f;        // final relative raise, rounded up: 1 + 2^-20 + the w rounding
+    float raise = 1.0f;        // final relative raise, rounded up: 1 + 2^-20 + the w rounding (+ plane_error's relative part)
 
     float at(int column, int row) const {
         float bound = z_vertex_max;
@@ -92,18 +92,23 @@ struct OccludeeDepth {
 // (V2 - V0), c = n . V0, so at NDC (u, v) its 1/w is d = n . q / c with q = (u, v, 1),
 // |q| <= sqrt(3) on screen. Moving each coordinate by at most e moves the edge vectors by at
 // most 2 |e| and so n by dn <= 2 |e| (|E1| + |E2|) + 4 |e|^2, and c by dc <= dn |V0| +
-// (|n| + dn) |e|; then d changes by at most (dn sqrt(3) + d dc) / (|c| - dc). The bound
-// depends on how the triangle sits in space (c = 0: seen edge-on), not on how it is clipped,
-// so a floor cut at the near plane keeps its plane. Unusable (infinite) when |c| <= 2 dc.
-double plane_error(const glm::dvec4 clip[3], const ClipError& e, double d_max) {
+// (|n| + dn) |e|; then d changes by at most (dn sqrt(3) + d dc) / (|c| - dc): an absolute
+// part and a part relative to d. The bound depends on how the triangle sits in space (c = 0:
+// seen edge-on), not on how it is clipped, so a floor cut at the near plane keeps its plane.
+// Unusable (infinite) when |c| <= 2 dc.
+struct PlaneError {
+    double absolute = HUGE_VAL, relative = HUGE_VAL;
+};
+
+PlaneError plane_error(const glm::dvec4 clip[3], const ClipError& e) {
     const glm::dvec3 v0(clip[0].x, clip[0].y, clip[0].w), v1(clip[1].x, clip[1].y, clip[1].w), v2(clip[2].x, clip[2].y, clip[2].w);
     const glm::dvec3 e1 = v1 - v0, e2 = v2 - v0, n = glm::cross(e1, e2);
     const double ee = std::sqrt(e.x * e.x + e.y * e.y + e.w * e.w);
     const double dn = 2.0 * ee * (glm::length(e1) + glm::length(e2)) + 4.0 * ee * ee;
     const double dc = dn * glm::length(v0) + (glm::length(n) + dn) * ee;
     const double c = std::abs(glm::dot(n, v0));
-    if (!(c > 2.0 * dc)) return HUGE_VAL;
-    return (dn * std::sqrt(3.0) + d_max * dc) / (c - dc);
+    if (!(c > 2.0 * dc)) return {};
+    return {dn * std::sqrt(3.0) / (c - dc), dc / (c - dc)};
 }
 
 // Of the samples `unhidden` of subtile (tx, ty), those the per-sample depth does not hide
@@ -124,7 +129,7 @@ struct SampleCounts {
 
 // Counts one screen triangle's outer-covered samples and those not certainly hidden; stops
 // once more than `tolerated` are visible.
-void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error, double depth_error, double margin,
+void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error, const PlaneError& depth_error, double margin,
                     const detail::SubtileView& view, int sample_width, int sample_height, std::uint64_t tolerated, SampleCounts& counts) {
     const VertexSlack slack = vertex_slack(error, screen, sample_width, sample_height);
     OrientedTriangle tri;
@@ -149,8 +154,11 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
             edges.threshold[k] = -(std::abs(edges.sa[k]) * pad_x + std::abs(edges.sb[k]) * pad_y);
         }
         depth.plane = detail::prepare_depth_plane(tri.v, tri.d, tri.area2, sample_width, sample_height);
-        depth.error = detail::float_up(double(depth.plane.error) + depth_error);
-        if (!std::isfinite(depth.error)) depth.plane.has_plane = false;
+        depth.error = detail::float_up(double(depth.plane.error) + depth_error.absolute);
+        if (std::isfinite(depth.error) && std::isfinite(depth_error.relative))
+            depth.raise = detail::float_up(1.0 + 0x1.0p-20 + slack.w_relative + depth_error.relative);
+        else
+            depth.plane.has_plane = false;  // seen edge-on, as far as the rounding can tell: the nearest vertex alone
     } else {
         depth.plane.has_plane = false;  // zero area after projection: its padded bounding box, at its nearest vertex
     }
@@ -222,9 +230,7 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         const detail::SetupResult setup =
             detail::setup_clip_triangle(clip, 0, Backface::none, near_clip, sample_width_, sample_height_, stats);
         if (stats.too_large) return visible();  // not clipped precisely enough to reason with
-        double d_max = 0.0;
-        for (int k = 0; k < setup.count; ++k) d_max = std::max({d_max, setup.triangles[k].d[0], setup.triangles[k].d[1], setup.triangles[k].d[2]});
-        const double depth_error = plane_error(clip, error, d_max);
+        const PlaneError depth_error = plane_error(clip, error);
         for (int k = 0; k < setup.count; ++k) {
             count_triangle(setup.triangles[k], error, depth_error, config_.edge_margin, view, sample_width_, sample_height_, tolerated_samples, counts);
             if (counts.visible > tolerated_samples) return visible();
