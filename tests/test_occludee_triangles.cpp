@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <utility>
 
 namespace homcull {
 namespace {
@@ -41,12 +42,13 @@ struct Soup {
     }
 };
 
-OcclusionBuffer make_buffer(int w, int h, int s = 1) {
+OcclusionBuffer make_buffer(int w, int h, int s = 1, bool sample_depth = false) {
     BufferConfig c;
     c.width = w;
     c.height = h;
     c.samples = s;
     c.near_w = 0.5f;
+    c.sample_depth = sample_depth;
     return OcclusionBuffer(c);
 }
 
@@ -208,8 +210,8 @@ TEST(OccludeeTriangles, NeverHidesATriangleSeenAtASample) {
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<float> pos(-1.3f, 1.3f), size(0.02f, 0.4f), far_depth(2.0f, 40.0f);
     int hidden_by_buffer = 0, hidden_by_test = 0, trials = 0;
-    for (int samples : {1, 2, 4}) {
-        OcclusionBuffer buffer = make_buffer(37, 23, samples);  // odd sizes: partial subtiles
+    for (const auto& [samples, sample_depth] : {std::pair{1, false}, {2, false}, {4, false}, {1, true}, {2, true}}) {
+        OcclusionBuffer buffer = make_buffer(37, 23, samples, sample_depth);  // odd sizes: partial subtiles
         const int sw = buffer.sample_width(), sh = buffer.sample_height();
         for (int scene = 0; scene < 20; ++scene) {
             buffer.clear();
@@ -257,7 +259,8 @@ TEST(OccludeeTriangles, NeverHidesATriangleSeenAtASample) {
                     }
                 const Visibility v_test = buffer.test_triangles(occludee.input()).visibility;
                 if (seen) {
-                    ASSERT_EQ(v_test, Visibility::visible) << "hid a triangle seen at a sample (S = " << samples << ")";
+                    ASSERT_EQ(v_test, Visibility::visible) << "hid a triangle seen at a sample (S = " << samples << ", per-sample depth "
+                                                           << sample_depth << ")";
                 }
                 if (any_sample && hidden_with_room) {
                     ++hidden_by_buffer;

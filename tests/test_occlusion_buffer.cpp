@@ -113,7 +113,13 @@ TEST(OcclusionBuffer, CoverageAndDepthAreConservativeOnRandomTriangles) {
     std::uniform_real_distribution<float> pos(-1.3f, 1.3f), depth(1.0f, 50.0f);
     for (int samples : {1, 2, 4}) {
         for (int trial = 0; trial < 200; ++trial) {
-            OcclusionBuffer buffer = make_buffer(37, 23, samples);  // odd sizes: partial subtiles
+            BufferConfig config;  // odd sizes: partial subtiles; per-sample depth every other trial
+            config.width = 37;
+            config.height = 23;
+            config.samples = samples;
+            config.near_w = 0.5f;
+            config.sample_depth = trial % 2 == 1;
+            OcclusionBuffer buffer(config);
             std::vector<float> v;
             float x[3], y[3], w[3];
             for (int k = 0; k < 3; ++k) {

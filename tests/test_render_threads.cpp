@@ -25,13 +25,18 @@ void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t
     for (std::size_t i : order) task(data, i);
 }
 
+// The same subtiles, and the same read-back depth (which includes the per-sample depth when
+// the buffers keep one).
 bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
     const auto x = a.subtiles();
     const auto y = b.subtiles();
     if (x.size() != y.size()) return false;
     for (std::size_t i = 0; i < x.size(); ++i)
         if (x[i].d0 != y[i].d0 || x[i].d1 != y[i].d1 || x[i].mask != y[i].mask || x[i].covered != y[i].covered) return false;
-    return true;
+    std::vector<float> depth_a, depth_b;
+    a.read_depth(depth_a);
+    b.read_depth(depth_b);
+    return depth_a == depth_b;
 }
 
 TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
@@ -43,6 +48,7 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     config.height = 201;
     config.samples = 2;
     config.near_w = 1.0f;
+    config.sample_depth = true;
 
     OcclusionBuffer serial(config), threaded(config), shuffled(config);
     serial.render(in);
@@ -118,7 +124,8 @@ namespace homcull {
 namespace {
 
 // Every instruction set gives the scalar reference's bits: S1-like random triangles at every
-// sample count, and a city seen from the street (shared edges, near clipping).
+// sample count, and a city seen from the street (shared edges, near clipping); with and
+// without per-sample depth.
 TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
     const std::vector<float> xyzw = test::random_clip_triangles(23, 20000, 0.4f);
     const Scene city = generate_scene("city:seed=8,blocks=6");
@@ -133,6 +140,7 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
             config.height = 173;
             config.samples = samples;
             config.near_w = 1.0f;
+            config.sample_depth = samples != 4;
             out.emplace_back(config);
             out.back().render(test::clip_space_input(xyzw));
         }
@@ -140,6 +148,7 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
         config.width = 777;
         config.height = 333;
         config.near_w = float(street.near_plane);
+        config.sample_depth = true;
         out.emplace_back(config);
         out.back().render(occluders.input(clip_from_world(street, 777.0 / 333.0), Backface::none));
     };
