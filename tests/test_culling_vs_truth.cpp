@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
+
 namespace homcull {
 namespace {
 
@@ -111,11 +113,17 @@ TEST(CullingVsTruth, CastleViewsHaveNoFalseCulls) {
     tally_culling(castle, rays, quarter, views.frames[0], tally);
     report("castle views", tally);
     EXPECT_EQ(tally.false_culls, 0u);
+    EXPECT_GE(tally.efficiency(), 0.94) << "culling efficiency regressed (96.0 % when this floor was set)";
 }
 
 TEST(CullingVsTruth, SharedScenesAlongWalksHaveNoFalseCulls) {
     int found = 0;
-    for (const char* file : {"crytek_sponza.glb", "fzk_haus.glb", "openarena_oa_thor.glb", "openarena_pul1duel-oa.glb"}) {
+    // Floors under the efficiency measured when they were set (100, 89.9, 98.2, 97.5 %): the
+    // house's misses are coplanar neighbours and coincident faces, ties no conservative test
+    // can break.
+    const std::pair<const char*, double> scenes[] = {
+        {"crytek_sponza.glb", 0.97}, {"fzk_haus.glb", 0.85}, {"openarena_oa_thor.glb", 0.96}, {"openarena_pul1duel-oa.glb", 0.95}};
+    for (const auto& [file, floor] : scenes) {
         const std::string path = test::shared_scene(file);
         if (path.empty()) continue;
         ++found;
@@ -124,6 +132,7 @@ TEST(CullingVsTruth, SharedScenesAlongWalksHaveNoFalseCulls) {
         tally_walk(scene, objects_with_role(scene, ""), 5, {640, 360}, 1, tally);
         report(file, tally);
         EXPECT_EQ(tally.false_culls, 0u) << file;
+        EXPECT_GE(tally.efficiency(), floor) << file << ": culling efficiency regressed";
     }
     if (found == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
 }
