@@ -75,13 +75,14 @@ struct OccludeeDepth {
     PreparedTriangle plane{};  // usable when plane.has_plane
     float error = 0.0f;        // plane.error plus plane_error's absolute part, rounded up
     float z_vertex_max = 0.0f; // the nearest vertex, rounded up
-    float raise = 1.0f;        // final relative raise, rounded up: 1 + 2^-20 + the w rounding (+ plane_error's relative part)
+    float plane_raise = 1.0f;  // 1 + plane_error's relative part, rounded up
+    float raise = 1.0f;        // final relative raise, rounded up: 1 + 2^-20 + the w rounding
 
     float at(int column, int row) const {
         float bound = z_vertex_max;
         if (plane.has_plane) {
             const float x = float(column) + 0.5f, y = float(row) + 0.5f;
-            bound = std::min(bound, ((plane.a + plane.dzdy * y) + plane.dzdx * x) + error);
+            bound = std::min(bound, (((plane.a + plane.dzdy * y) + plane.dzdx * x) + error) * plane_raise);
         }
         return bound * raise;
     }
@@ -156,7 +157,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
         depth.plane = detail::prepare_depth_plane(tri.v, tri.d, tri.area2, sample_width, sample_height);
         depth.error = detail::float_up(double(depth.plane.error) + depth_error.absolute);
         if (std::isfinite(depth.error) && std::isfinite(depth_error.relative))
-            depth.raise = detail::float_up(1.0 + 0x1.0p-20 + slack.w_relative + depth_error.relative);
+            depth.plane_raise = detail::float_up(1.0 + depth_error.relative);
         else
             depth.plane.has_plane = false;  // seen edge-on, as far as the rounding can tell: the nearest vertex alone
     } else {
