@@ -164,7 +164,8 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdge
 }
 
 void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t first[4], const std::int32_t last[4],
-                         const PreparedTriangle& tri) {
+                         const PreparedTriangle& triangle) {
+    const PreparedTriangle tri = triangle;  // a local copy: the stores below cannot alias it, so the loop vectorizes
     for (int j = 0; j < kH; ++j) {
         const int row = ty * kH + j;
         float* depth = planes.sample_depth + std::size_t(row) * planes.sample_stride;
