@@ -168,18 +168,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
 
     for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
         std::int32_t first[kH], last[kH];
-        for (int j = 0; j < kH; ++j) {
-            const int row = ty * kH + j;
-            if (row < j0 || row > j1) {
-                first[j] = i0;
-                last[j] = i0 - 1;
-            } else if (has_area) {
-                detail::sample_row_interval(edges, row, i0, i1, first[j], last[j]);
-            } else {
-                first[j] = i0;
-                last[j] = i1;
-            }
-        }
+        detail::subtile_row_intervals(has_area ? &edges : nullptr, ty, i0, i1, j0, j1, first, last);
         int tx_begin, tx_end;
         if (!detail::reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         for (int tx = tx_begin; tx <= tx_end; ++tx) {

@@ -146,15 +146,7 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdge
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         // The covered interval [first, last] of each of the subtile row's sample rows.
         std::int32_t first[kH], last[kH];
-        for (int j = 0; j < kH; ++j) {
-            const int sy = ty * kH + j;
-            if (sy < j0 || sy > j1) {
-                first[j] = i0;
-                last[j] = i0 - 1;
-            } else {
-                sample_row_interval(edges, sy, i0, i1, first[j], last[j]);
-            }
-        }
+        subtile_row_intervals(&edges, ty, i0, i1, j0, j1, first, last);
         int tx_begin, tx_end;
         if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, first, last, prepared, t.sample_width, t.sample_height);
@@ -170,6 +162,17 @@ void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t
         const int row = ty * kH + j;
         float* depth = planes.sample_depth + std::size_t(row) * planes.sample_stride;
         for (int x = first[j]; x <= last[j]; ++x) depth[x] = std::max(depth[x], conservative_depth(tri, x, row));
+    }
+}
+
+void subtile_row_intervals(const TriangleEdges* edges, int ty, int i0, int i1, int j0, int j1, std::int32_t first[4],
+                           std::int32_t last[4]) {
+    for (int j = 0; j < kH; ++j) {
+        const int row = ty * kH + j;
+        first[j] = i0;
+        last[j] = i1;
+        if (row < j0 || row > j1) last[j] = i0 - 1;
+        else if (edges) sample_row_interval(*edges, row, i0, i1, first[j], last[j]);
     }
 }
 

@@ -111,6 +111,11 @@ TriangleEdges edge_functions(const OrientedTriangle& triangle);
 // covered side of every edge: the row formula of rasterize.cpp. Empty when first > last.
 void sample_row_interval(const TriangleEdges& edges, int row, int i0, int i1, std::int32_t& first, std::int32_t& last);
 
+// The intervals [first[j], last[j]] of subtile row ty's four sample rows: sample_row_interval
+// for the rows in [j0, j1] (the whole span [i0, i1] when edges is null), empty for the others.
+void subtile_row_intervals(const TriangleEdges* edges, int ty, int i0, int i1, int j0, int j1, std::int32_t first[4],
+                           std::int32_t last[4]);
+
 // The samples of subtile column tx that a subtile row's intervals [first[j], last[j]] cover,
 // and the columns and rows (within the subtile) of their bounding rectangle; mask 0 when none.
 struct SubtileCoverage {
