@@ -63,6 +63,16 @@ std::vector<float> random_clip_triangles(std::uint64_t seed, int count, float ma
     return xyzw;
 }
 
+BufferConfig buffer_config(int width, int height, int samples, float near_w, bool sample_depth) {
+    BufferConfig c;
+    c.width = width;
+    c.height = height;
+    c.samples = samples;
+    c.near_w = near_w;
+    c.sample_depth = sample_depth;
+    return c;
+}
+
 TriangleInput clip_space_input(const std::vector<float>& xyzw) {
     TriangleInput in;
     in.positions = xyzw.data();

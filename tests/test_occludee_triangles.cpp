@@ -1,6 +1,8 @@
 // OcclusionBuffer::test_triangles: occludee triangles tested sample by sample. Hand-built
 // cases for each answer, a hole counted sample by sample, bad input, and a brute-force check on
 // random triangles that the test never hides a triangle seen at a sample of the buffer.
+#include "support.hpp"
+
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
@@ -43,13 +45,7 @@ struct Soup {
 };
 
 OcclusionBuffer make_buffer(int w, int h, int s = 1, bool sample_depth = false) {
-    BufferConfig c;
-    c.width = w;
-    c.height = h;
-    c.samples = s;
-    c.near_w = 0.5f;
-    c.sample_depth = sample_depth;
-    return OcclusionBuffer(c);
+    return OcclusionBuffer(test::buffer_config(w, h, s, 0.5f, sample_depth));
 }
 
 OcclusionBuffer wall_at(float w) {

@@ -1,5 +1,7 @@
 // The occlusion buffer on hand-built input: coverage, conservative depth, clipping, input
 // formats, bad input, and the occludee tests.
+#include "support.hpp"
+
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
@@ -44,14 +46,7 @@ struct Soup {
     }
 };
 
-OcclusionBuffer make_buffer(int w, int h, int s = 1) {
-    BufferConfig c;
-    c.width = w;
-    c.height = h;
-    c.samples = s;
-    c.near_w = 0.5f;
-    return OcclusionBuffer(c);
-}
+OcclusionBuffer make_buffer(int w, int h, int s = 1) { return OcclusionBuffer(test::buffer_config(w, h, s, 0.5f)); }
 
 TEST(OcclusionBuffer, FullScreenQuadHidesWhatIsBehindIt) {
     OcclusionBuffer buffer = make_buffer(64, 36);
@@ -113,13 +108,8 @@ TEST(OcclusionBuffer, CoverageAndDepthAreConservativeOnRandomTriangles) {
     std::uniform_real_distribution<float> pos(-1.3f, 1.3f), depth(1.0f, 50.0f);
     for (int samples : {1, 2, 4}) {
         for (int trial = 0; trial < 200; ++trial) {
-            BufferConfig config;  // odd sizes: partial subtiles; per-sample depth every other trial
-            config.width = 37;
-            config.height = 23;
-            config.samples = samples;
-            config.near_w = 0.5f;
-            config.sample_depth = trial % 2 == 1;
-            OcclusionBuffer buffer(config);
+            // Odd sizes: partial subtiles; per-sample depth every other trial.
+            OcclusionBuffer buffer(test::buffer_config(37, 23, samples, 0.5f, trial % 2 == 1));
             std::vector<float> v;
             float x[3], y[3], w[3];
             for (int k = 0; k < 3; ++k) {

@@ -44,12 +44,7 @@ ScreenRect pixel_rect(int width, int height, double x0, double y0, double x1, do
 }
 
 OcclusionBuffer buffer_of(int width, int height, int samples, const Occluders& occluders) {
-    BufferConfig c;
-    c.width = width;
-    c.height = height;
-    c.samples = samples;
-    c.near_w = 0.5f;
-    OcclusionBuffer buffer(c);
+    OcclusionBuffer buffer(test::buffer_config(width, height, samples, 0.5f));
     if (!occluders.xyzw.empty()) buffer.render(occluders.input());
     return buffer;
 }

@@ -17,12 +17,7 @@ namespace homcull {
 namespace {
 
 RectAccuracy measure(const WorkloadS1& s1, int width, int height, int samples) {
-    BufferConfig config;
-    config.width = width;
-    config.height = height;
-    config.samples = samples;
-    config.near_w = 1.0f;
-    OcclusionBuffer buffer(config);
+    OcclusionBuffer buffer(test::buffer_config(width, height, samples, 1.0f));
     buffer.render(s1.occluder_input(), tbb_parallel_for());
     const ExactDepth exact =
         exact_depth_of_triangles(s1.occluders.data(), s1.occluder_count(), buffer.sample_width(), buffer.sample_height(), true);

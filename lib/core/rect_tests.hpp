@@ -43,18 +43,9 @@ struct SubtileView {
     std::size_t sample_stride;
 };
 
-// Whether subtile (tx, ty) hides the rectangle's samples in it: its bound there is d0, or
-// max(d0, d1) when they all lie in the working layer's mask.
-inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery& q) {
-    const std::uint32_t rect = subtile_rect_bits(tx, ty, q.i0, q.i1, q.j0, q.j1);
-    const std::size_t i = std::size_t(ty) * v.stride + std::size_t(tx);
-    const float bound = (v.mask[i] != 0 && (rect & ~v.mask[i]) == 0) ? std::max(v.d0[i], v.d1[i]) : v.d0[i];
-    return q.d_near < bound;
-}
-
 // Which of the samples `samples` of subtile (tx, ty) an occludee at 1/w `d_near` may be seen
 // at by the layers: those whose layer bound (d0, or max(d0, d1) in the working layer's mask)
-// is not above d_near. The same rule as subtile_hides, sample by sample.
+// is not above d_near.
 inline std::uint32_t subtile_unhidden_samples(const SubtileView& v, int tx, int ty, std::uint32_t samples, float d_near) {
     const std::size_t i = std::size_t(ty) * v.stride + std::size_t(tx);
     if (d_near < v.d0[i]) return 0;
@@ -62,6 +53,13 @@ inline std::uint32_t subtile_unhidden_samples(const SubtileView& v, int tx, int 
     std::uint32_t visible = samples & ~layer;
     if (!(d_near < std::max(v.d0[i], v.d1[i]))) visible |= samples & layer;
     return visible;
+}
+
+// Whether subtile (tx, ty) hides the rectangle's samples in it (the rectangle reaches the
+// subtile, so it has some): its bound there is d0, or max(d0, d1) when they all lie in the
+// working layer's mask.
+inline bool subtile_hides(const SubtileView& v, int tx, int ty, const RectQuery& q) {
+    return subtile_unhidden_samples(v, tx, ty, subtile_rect_bits(tx, ty, q.i0, q.i1, q.j0, q.j1), q.d_near) == 0;
 }
 
 // The rectangle's interior subtiles [ix0, ix1] x [iy0, iy1] (all their samples in it, so their

@@ -59,16 +59,13 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
       occluders_(gather_world_triangles(scene, occluders)),
       buffer_(scene_buffer_config(config, 0.1f)),
       maps_(buffer_, maps_config(config)) {
-    if (shape() != OccludeeShape::samples) return;
+    if (resolved_occludee_shape(config) != OccludeeShape::samples) return;
     occludee_first_vertex_.assign(scene.objects.size(), kNotGathered);
     for (std::size_t id = 0; id < scene.objects.size(); ++id) {
         const Object& object = scene.objects[id];
         if (scene.triangle_count(object) > config.triangle_test_limit) continue;
         occludee_first_vertex_[id] = occludee_positions_.size() / 3;
-        for (const glm::vec3& p : scene.meshes[object.mesh].positions) {
-            const glm::vec3 w = transform_point(object.world, p);
-            occludee_positions_.insert(occludee_positions_.end(), {w.x, w.y, w.z});
-        }
+        append_world_positions(scene, object, occludee_positions_);
     }
 }
 
@@ -76,8 +73,6 @@ OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config) {
     if (config.occludees != OccludeeShape::automatic) return config.occludees;
     return config.maps.depth == DepthTest::masked ? OccludeeShape::samples : OccludeeShape::rectangles;
 }
-
-OccludeeShape SceneCuller::shape() const { return resolved_occludee_shape(config_); }
 
 void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     validate_camera(camera);
@@ -103,7 +98,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
     start = std::chrono::steady_clock::now();
     answers.resize(scene_->objects.size());
     exits_ = {};
-    const OccludeeShape shape = this->shape();
+    const OccludeeShape shape = resolved_occludee_shape(config_);
     for (std::size_t id = 0; id < scene_->objects.size(); ++id) {
         const Aabb& box = scene_->objects[id].world_bounds;
         if (box.empty()) {

@@ -14,16 +14,20 @@ TriangleInput WorldTriangles::input(const std::array<float, 16>& clip_from_world
     return in;
 }
 
+void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions) {
+    for (const glm::vec3& p : scene.meshes[object.mesh].positions) {
+        const glm::vec3 w = transform_point(object.world, p);
+        positions.insert(positions.end(), {w.x, w.y, w.z});
+    }
+}
+
 WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects) {
     WorldTriangles out;
     for (std::uint32_t id : objects) {
         const Object& object = scene.objects.at(id);
         const Mesh& mesh = scene.meshes[object.mesh];
         const auto base = std::uint32_t(out.positions.size() / 3);
-        for (const glm::vec3& p : mesh.positions) {
-            const glm::vec3 w = transform_point(object.world, p);
-            out.positions.insert(out.positions.end(), {w.x, w.y, w.z});
-        }
+        append_world_positions(scene, object, out.positions);
         for (std::uint32_t index : mesh.indices) out.indices.push_back(base + index);
     }
     out.shared_edges.resize(out.triangle_count());

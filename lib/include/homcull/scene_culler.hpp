@@ -88,7 +88,6 @@ private:
     static constexpr std::size_t kNotGathered = ~std::size_t(0);
     std::vector<float> occludee_positions_;
     std::vector<std::size_t> occludee_first_vertex_;
-    OccludeeShape shape() const;
     bool triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const;
     bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) const;
 };

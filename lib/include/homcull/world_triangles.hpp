@@ -19,6 +19,10 @@ struct WorldTriangles {
     TriangleInput input(const std::array<float, 16>& clip_from_world, Backface backface = Backface::cw) const;
 };
 
+// Appends an object's vertices in world space (x, y, z each), transformed exactly as ground
+// truth transforms them, in the order of its mesh's positions.
+void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions);
+
 // The triangles of the given objects. Allocates: meant for load time or tools.
 WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects);
 
