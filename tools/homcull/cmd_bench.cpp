@@ -26,7 +26,7 @@ struct BenchOptions {
     std::string workload = "s1", resolution = "1920x1080", isa = "best";
     std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views = "data/views/castle.json";
     int samples = 1, threads = 1, repeat = 0;
-    bool json = false;
+    bool json = false, sample_depth = false;
 };
 
 double median(std::vector<double> v) {
@@ -45,8 +45,9 @@ void run_bench(const BenchOptions& o) {
     config.width = res.width;
     config.height = res.height;
     config.samples = o.samples;
+    config.sample_depth = o.sample_depth;
     nlohmann::json out = {{"workload", o.workload}, {"resolution", {res.width, res.height}}, {"samples", o.samples},
-                          {"threads", o.threads}, {"isa", selected_isa()}};
+                          {"threads", o.threads}, {"isa", selected_isa()}, {"sample_depth", o.sample_depth}};
 
     if (o.workload == "s1") {
         const WorkloadS1 s1 = load_workload_s1(o.s1_folder);
@@ -161,6 +162,7 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
     cmd->add_option("--scene", o->scene, "Castle scene for --workload castle")->capture_default_str();
     cmd->add_option("--views", o->views, "Camera path with the views for --workload castle")->capture_default_str();
+    cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o] { run_bench(*o); });
 }
