@@ -58,6 +58,7 @@ int Level0SingleSample(const Level0Maps& m) {
     const int full_columns = m.width / kW;
     const auto one = hn::Set(du, 1u);
     const auto infinity = hn::Set(df, HUGE_VALF);
+    const auto lane = hn::Iota(du, 0u);  // once: Highway's Iota goes through memory
     for (int ty = 0; ty < m.subtiles_y; ++ty) {
         const int rows = std::min(kH, m.height - ty * kH);
         for (int tx = 0; tx < full_columns; ++tx) {
@@ -67,7 +68,7 @@ int Level0SingleSample(const Level0Maps& m) {
             for (int r = 0; r < rows; ++r) {
                 const std::size_t out = std::size_t(ty * kH + r) * std::size_t(m.width) + std::size_t(tx * kW);
                 for (int h = 0; h < kW; h += lanes) {
-                    const auto shift = hn::Iota(du, std::uint32_t(r * kW + h));
+                    const auto shift = hn::Add(lane, hn::Set(du, std::uint32_t(r * kW + h)));
                     const auto bit = hn::And(hn::Shr(covered, shift), one);
                     const auto in_mask = hn::And(hn::Shr(mask, shift), one);
                     const auto outside = hn::RebindMask(df, hn::Ne(hn::AndNot(in_mask, bit), hn::Zero(du)));

@@ -135,6 +135,7 @@ Visibility RectScan(const SubtileView& view, const RectQuery& q) {
     const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
     const auto [ix0, ix1, iy0, iy1] = interior_subtiles(q);
     const auto d_near = hn::Set(df, q.d_near);
+    const auto lane = hn::Iota(di, 0);  // once: Highway's Iota goes through memory
     for (int ty = ty0; ty <= ty1; ++ty) {
         const float* row = view.d0 + std::size_t(ty) * view.stride;
         const bool interior_row = ty >= iy0 && ty <= iy1;
@@ -144,7 +145,7 @@ Visibility RectScan(const SubtileView& view, const RectQuery& q) {
             const auto shows = hn::And(reached, hn::Not(hn::Lt(d_near, hn::LoadU(df, row + tx))));
             if (hn::AllFalse(df, shows)) continue;
             if (interior_row) {
-                const auto column = hn::Iota(di, tx);
+                const auto column = hn::Add(lane, hn::Set(di, tx));
                 const auto interior = hn::And(hn::Not(hn::Lt(column, hn::Set(di, ix0))), hn::Not(hn::Gt(column, hn::Set(di, ix1))));
                 if (!hn::AllFalse(df, hn::And(shows, hn::RebindMask(df, interior)))) return Visibility::visible;
             }

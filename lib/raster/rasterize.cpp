@@ -103,22 +103,21 @@ TriangleEdges edge_functions(const OrientedTriangle& tri) {
     return edges;
 }
 
-std::uint64_t rasterize_triangle(const RasterTarget& t, const ScreenTriangle& triangle) {
+bool setup_raster_triangle(const ScreenTriangle& triangle, double edge_margin, int sample_width, int sample_height,
+                           RasterTriangle& out) {
     OrientedTriangle tri;
-    if (!orient_triangle(triangle, tri)) return 0;
-    TriangleEdges edges = edge_functions(tri);
-    for (int k = 0; k < 3; ++k)  // inner margin on silhouette edges (see the top of this file)
-        edges.threshold[k] = edges.shared[k] ? 0.0 : t.edge_margin * (std::abs(edges.sa[k]) + std::abs(edges.sb[k]));
-
+    if (!orient_triangle(triangle, tri)) return false;
     // Sample rows and columns whose centres lie in the triangle's bounding box.
     const glm::dvec2* v = tri.v;
-    int i0, i1, j0, j1;
-    sample_span(std::min({v[0].x, v[1].x, v[2].x}), std::max({v[0].x, v[1].x, v[2].x}), t.sample_width, i0, i1);
-    sample_span(std::min({v[0].y, v[1].y, v[2].y}), std::max({v[0].y, v[1].y, v[2].y}), t.sample_height, j0, j1);
-    if (i0 > i1 || j0 > j1) return 0;
+    sample_span(std::min({v[0].x, v[1].x, v[2].x}), std::max({v[0].x, v[1].x, v[2].x}), sample_width, out.i0, out.i1);
+    sample_span(std::min({v[0].y, v[1].y, v[2].y}), std::max({v[0].y, v[1].y, v[2].y}), sample_height, out.j0, out.j1);
+    if (out.i0 > out.i1 || out.j0 > out.j1) return false;
 
-    const PreparedTriangle prepared = prepare_depth_plane(tri.v, tri.d, tri.area2, t.sample_width, t.sample_height);
-    return t.kernel(t, edges, prepared, i0, i1, j0, j1);
+    out.edges = edge_functions(tri);
+    for (int k = 0; k < 3; ++k)  // inner margin on silhouette edges (see the top of this file)
+        out.edges.threshold[k] = out.edges.shared[k] ? 0.0 : edge_margin * (std::abs(out.edges.sa[k]) + std::abs(out.edges.sb[k]));
+    out.plane = prepare_depth_plane(tri.v, tri.d, tri.area2, sample_width, sample_height);
+    return true;
 }
 
 void sample_row_interval(const TriangleEdges& edges, int row, int i0, int i1, std::int32_t& first, std::int32_t& last) {
@@ -140,8 +139,10 @@ void sample_row_interval(const TriangleEdges& edges, int row, int i0, int i1, st
     }
 }
 
-std::uint64_t rasterize_rows_reference(const RasterTarget& t, const TriangleEdges& edges, const PreparedTriangle& prepared, int i0,
-                                       int i1, int j0, int j1) {
+std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriangle& triangle) {
+    const TriangleEdges& edges = triangle.edges;
+    const PreparedTriangle& prepared = triangle.plane;
+    const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
     std::uint64_t touched = 0;
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         // The covered interval [first, last] of each of the subtile row's sample rows.

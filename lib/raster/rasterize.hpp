@@ -24,11 +24,12 @@ struct PreparedTriangle;
 struct TriangleEdges;
 struct RasterTarget;
 
-// Rasterizes the rows of a prepared triangle: for each subtile row in the target's band and
-// the triangle's sample rows [j0, j1], the coverage interval of each sample row (within
-// columns [i0, i1]), then the subtile-row update. Returns the number of subtiles updated.
-using TriangleRowsKernel = std::uint64_t (*)(const RasterTarget& target, const TriangleEdges& edges, const PreparedTriangle& tri,
-                                             int i0, int i1, int j0, int j1);
+struct RasterTriangle;
+
+// Rasterizes the rows of a set-up triangle: for each subtile row in the target's band and the
+// triangle's sample rows [j0, j1], the coverage interval of each sample row (within columns
+// [i0, i1]), then the subtile-row update. Returns the number of subtiles updated.
+using TriangleRowsKernel = std::uint64_t (*)(const RasterTarget& target, const RasterTriangle& triangle);
 
 // The widest SIMD vector the kernels use, in 32-bit lanes: subtile rows are padded so that a
 // vector of this many subtiles loads and stores within the row (see OcclusionBuffer::stride_).
@@ -48,7 +49,6 @@ struct SubtilePlanes {
 struct RasterTarget {
     SubtilePlanes planes;
     int sample_width, sample_height;
-    double edge_margin;
     int row_begin, row_end;  // the subtile rows [row_begin, row_end) this call may write
     TriangleRowsKernel kernel;
 };
@@ -88,8 +88,20 @@ inline float conservative_depth(const PreparedTriangle& tri, int column, int row
     return bound * (1.0f - 0x1.0p-20f);
 }
 
-// Rasterizes a triangle of either orientation. Returns the number of subtiles updated.
-std::uint64_t rasterize_triangle(const RasterTarget& target, const ScreenTriangle& triangle);
+// A triangle set up for the row kernels, once, however many bands then rasterize it: its
+// edge functions with the coverage thresholds, its depth plane, and the samples [i0, i1] x
+// [j0, j1] whose centres lie in its bounding box.
+struct RasterTriangle {
+    TriangleEdges edges;
+    PreparedTriangle plane;
+    int i0, i1, j0, j1;
+};
+
+// Sets up a triangle of either orientation for a sample grid of width x height, with the inner
+// coverage margin edge_margin (samples) on its silhouette edges. False when it covers no
+// sample centre's bounding box or has no area: nothing to rasterize.
+bool setup_raster_triangle(const ScreenTriangle& triangle, double edge_margin, int sample_width, int sample_height,
+                           RasterTriangle& out);
 
 // A screen triangle with its vertices ordered so that twice its signed area, area2, is
 // positive: its edge functions are then positive inside. Shared-edge flags follow the edges.
@@ -218,8 +230,7 @@ void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t
                          const PreparedTriangle& tri);
 
 // The reference row loop: scalar intervals and update_subtile_row_reference.
-std::uint64_t rasterize_rows_reference(const RasterTarget& target, const TriangleEdges& edges, const PreparedTriangle& tri, int i0,
-                                       int i1, int j0, int j1);
+std::uint64_t rasterize_rows_reference(const RasterTarget& target, const RasterTriangle& triangle);
 
 // The kernel for the selected instruction set (see select_isa in occlusion_buffer.hpp).
 TriangleRowsKernel selected_rows_kernel();

@@ -50,10 +50,12 @@ HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, i
     const VF a = hn::Set(df, tri.a), dzdx = hn::Set(df, tri.dzdx), dzdy = hn::Set(df, tri.dzdy), error = hn::Set(df, tri.error);
     const VF z_vertex_min = hn::Set(df, tri.z_vertex_min), half = hn::Set(df, 0.5f), lower = hn::Set(df, 1.0f - 0x1.0p-20f);
 
+    // Highway's Iota goes through memory (a store-forwarding stall per call): built once.
+    const VI lane = hn::Iota(di, 0);
     std::uint64_t touched = 0;
     const std::size_t row = std::size_t(ty) * planes.stride;
     for (int tx = tx_begin; tx <= tx_end; tx += lanes) {
-        const VI column0 = hn::ShiftLeft<3>(hn::Iota(di, tx));  // tx * 8 per lane
+        const VI column0 = hn::ShiftLeft<3>(hn::Add(lane, hn::Set(di, tx)));  // tx * 8 per lane
 
         // Mask and far corner, as the reference (lanes past tx_end get empty masks).
         VU m = hn::Zero(du);
@@ -115,19 +117,22 @@ HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, i
 
 // The reference's row loop with the 4 sample rows of a subtile row as vector lanes (2 at a
 // time on SSE4): each lane evaluates rasterize_rows_reference's formula for its row.
-std::uint64_t RasterizeRows(const RasterTarget& t, const TriangleEdges& e, const PreparedTriangle& tri, int i0, int i1, int j0,
-                            int j1) {
+std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangle) {
+    const TriangleEdges& e = triangle.edges;
+    const PreparedTriangle& tri = triangle.plane;
+    const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
     constexpr int kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<double, kH> d4;
     const hn::Rebind<std::int32_t, decltype(d4)> di4;
     const int lanes = int(hn::Lanes(d4));
     const auto lo_clamp = hn::Set(d4, double(i0) - 2.0), hi_clamp = hn::Set(d4, double(i1) + 2.0);
     const auto half = hn::Set(d4, 0.5), one = hn::Set(d4, 1.0), zero = hn::Zero(d4);
+    const auto lane = hn::Iota(d4, 0.0);  // once: Highway's Iota goes through memory
     std::uint64_t touched = 0;
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         HWY_ALIGN std::int32_t first[kH], last[kH];
         for (int j = 0; j < kH; j += lanes) {
-            const auto sy = hn::Iota(d4, double(ty * kH + j));
+            const auto sy = hn::Add(lane, hn::Set(d4, double(ty * kH + j)));  // exact: small integers
             const auto py = hn::Add(sy, half);
             auto lo = hn::Set(d4, double(i0)), hi = hn::Set(d4, double(i1));
             auto empty = hn::Or(hn::Lt(sy, hn::Set(d4, double(j0))), hn::Gt(sy, hn::Set(d4, double(j1))));
@@ -174,8 +179,8 @@ namespace {
 // The selected kernel: the reference, or Highway's choice among the allowed targets.
 std::atomic<bool> use_reference{false};
 
-std::uint64_t dispatch(const RasterTarget& t, const TriangleEdges& e, const PreparedTriangle& tri, int i0, int i1, int j0, int j1) {
-    return HWY_DYNAMIC_DISPATCH(RasterizeRows)(t, e, tri, i0, i1, j0, j1);
+std::uint64_t dispatch(const RasterTarget& t, const RasterTriangle& triangle) {
+    return HWY_DYNAMIC_DISPATCH(RasterizeRows)(t, triangle);
 }
 
 struct NamedTarget {

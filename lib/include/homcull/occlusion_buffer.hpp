@@ -37,6 +37,8 @@ struct PyramidLevel {
 };
 struct RectQuery;
 struct SubtileView;
+struct RasterTarget;
+struct RasterTriangle;
 }  // namespace detail
 
 enum class Backface : std::uint8_t {
@@ -241,6 +243,14 @@ private:
                  Visibility& decided) const;
     Visibility test_prepared_rect(const detail::RectQuery& q) const;
     detail::SubtileView subtile_view() const;
+
+    // Rendering (occlusion_buffer.cpp): without a job system straight through, with one
+    // binned by bands of subtile rows; the same bits either way.
+    detail::RasterTarget raster_target(int row_begin, int row_end);
+    template <typename Emit>
+    void setup_for_raster(const TriangleInput& in, std::size_t t, RasterStats& stats, Emit&& emit) const;
+    void render_serial(const TriangleInput& in);
+    void render_binned(const TriangleInput& in, const ParallelFor& parallel);
 
     // Render scratch, reused across frames.
     struct Chunk;
