@@ -59,7 +59,7 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
         levels_.push_back({(below.width + 1) / 2, (below.height + 1) / 2, size});
         size += std::size_t(levels_.back().width) * std::size_t(levels_.back().height);
     }
-    pyramid_.assign(size, 0.0f);
+    pyramid_.assign(size + detail::kMaxSimdLanes, 0.0f);  // padded: RectScan loads whole vectors of a level's row
     for (const detail::PyramidLevel& l : levels_) {
         level_offset_.push_back(std::int32_t(l.offset));
         level_width_.push_back(l.width);

@@ -41,6 +41,11 @@ struct SubtileView {
     std::size_t stride;
     const float* sample_depth;  // per sample, rows of sample_stride; null when the buffer keeps none
     std::size_t sample_stride;
+    // The farthest-d0 pyramid (level 0: the subtiles' d0), padded at the end for whole-vector
+    // loads of any row.
+    const float* pyramid;
+    const PyramidLevel* levels;
+    int level_count;
 };
 
 // Which of the samples `samples` of subtile (tx, ty) an occludee at 1/w `d_near` may be seen

@@ -38,18 +38,19 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
     const VI code_visible = hn::Set(di, int(Visibility::visible)), code_occluded = hn::Set(di, int(Visibility::occluded));
     const VI code_view_culled = hn::Set(di, int(Visibility::view_culled)), code_undecided = hn::Set(di, kUndecided);
 
-    HWY_ALIGN float field[5][8];
     HWY_ALIGN std::int32_t code_out[8], i0_out[8], i1_out[8], j0_out[8], j1_out[8];
     HWY_ALIGN float d_near_out[8];
+    static_assert(sizeof(ScreenRect) == 5 * sizeof(float), "rectangles are 5 packed floats");
+    const VI field_stride = hn::Mul(hn::Iota(di, 0), hn::Set(di, 5));  // lane k reads rectangle k's fields
     for (std::size_t base = 0; base < count; base += lanes) {
         const std::size_t n = std::min(lanes, count - base);
-        for (std::size_t k = 0; k < lanes; ++k) {  // to structure of arrays; missing lanes get rectangle 0 of the block
-            const ScreenRect& r = rects[base + (k < n ? k : 0)];
-            field[0][k] = r.ndc_min_x, field[1][k] = r.ndc_min_y, field[2][k] = r.ndc_max_x, field[3][k] = r.ndc_max_y;
-            field[4][k] = r.w_min;
-        }
-        const VF min_x = hn::LoadU(df, field[0]), min_y = hn::LoadU(df, field[1]), max_x = hn::LoadU(df, field[2]);
-        const VF max_y = hn::LoadU(df, field[3]), w_min = hn::LoadU(df, field[4]);
+        // To structure of arrays by gathers (scalar stores and a vector load stall on store
+        // forwarding); missing lanes read rectangle 0 of the block.
+        const VI index = hn::IfThenElseZero(hn::FirstN(di, n), field_stride);
+        const float* fields = &rects[base].ndc_min_x;
+        const VF min_x = hn::GatherIndex(df, fields, index), min_y = hn::GatherIndex(df, fields + 1, index);
+        const VF max_x = hn::GatherIndex(df, fields + 2, index), max_y = hn::GatherIndex(df, fields + 3, index);
+        const VF w_min = hn::GatherIndex(df, fields + 4, index);
 
         // prepare(): invalid input and the near plane (visible), outside the frustum.
         auto finite = hn::And(hn::And(hn::Lt(hn::Abs(min_x), infinity), hn::Lt(hn::Abs(min_y), infinity)),
@@ -123,37 +124,76 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
     }
 }
 
-// The exact stage: every subtile the rectangle reaches, row by row, a vector of subtiles at a
-// time. A subtile with d0 > d_near hides it whatever its mask; one with d0 <= d_near shows it
-// if it is interior (all its samples in the rectangle, so its bound is d0), and otherwise is
-// decided by subtile_hides. Same answers as test_rect_exhaustive.
-Visibility RectScan(const SubtileView& view, const RectQuery& q) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+// The exact stage on the subtiles [sx0, sx1] x [sy0, sy1] of the rectangle, row by row, a
+// vector of subtiles at a time: false when one shows it. A subtile with d0 > d_near hides it
+// whatever its mask; one with d0 <= d_near shows it if it is interior (all its samples in the
+// rectangle, so its bound is d0), and otherwise is decided by subtile_hides.
+HWY_INLINE bool SubtilesHide(const SubtileView& view, const RectQuery& q, const InteriorSubtiles& interior, int sx0, int sx1, int sy0,
+                             int sy1) {
     const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many (rasterize.hpp)
     const hn::RebindToSigned<decltype(df)> di;
     const int lanes = int(hn::Lanes(df));
-    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
-    const auto [ix0, ix1, iy0, iy1] = interior_subtiles(q);
     const auto d_near = hn::Set(df, q.d_near);
     const auto lane = hn::Iota(di, 0);  // once: Highway's Iota goes through memory
-    for (int ty = ty0; ty <= ty1; ++ty) {
+    for (int ty = sy0; ty <= sy1; ++ty) {
         const float* row = view.d0 + std::size_t(ty) * view.stride;
-        const bool interior_row = ty >= iy0 && ty <= iy1;
-        for (int tx = tx0; tx <= tx1; tx += lanes) {
-            // Lanes past tx1 read the row's padding or its next subtiles: masked out.
-            const auto reached = hn::FirstN(df, std::size_t(tx1 - tx + 1));
+        const bool interior_row = ty >= interior.iy0 && ty <= interior.iy1;
+        for (int tx = sx0; tx <= sx1; tx += lanes) {
+            // Lanes past sx1 read the row's padding or its next subtiles: masked out.
+            const auto reached = hn::FirstN(df, std::size_t(sx1 - tx + 1));
             const auto shows = hn::And(reached, hn::Not(hn::Lt(d_near, hn::LoadU(df, row + tx))));
             if (hn::AllFalse(df, shows)) continue;
             if (interior_row) {
                 const auto column = hn::Add(lane, hn::Set(di, tx));
-                const auto interior = hn::And(hn::Not(hn::Lt(column, hn::Set(di, ix0))), hn::Not(hn::Gt(column, hn::Set(di, ix1))));
-                if (!hn::AllFalse(df, hn::And(shows, hn::RebindMask(df, interior)))) return Visibility::visible;
+                const auto inside =
+                    hn::And(hn::Not(hn::Lt(column, hn::Set(di, interior.ix0))), hn::Not(hn::Gt(column, hn::Set(di, interior.ix1))));
+                if (!hn::AllFalse(df, hn::And(shows, hn::RebindMask(df, inside)))) return false;
             }
             HWY_ALIGN std::uint8_t bits[8];
             hn::StoreMaskBits(df, shows, bits);
             for (int k = 0; k < lanes; ++k)
                 if ((bits[k / 8] >> (k % 8)) & 1u)
-                    if (!subtile_hides(view, tx + k, ty, q)) return Visibility::visible;
+                    if (!subtile_hides(view, tx + k, ty, q)) return false;
+        }
+    }
+    return true;
+}
+
+// The exact stage: occluded when every subtile the rectangle reaches hides it. Rectangles of
+// more than a few subtile rows first read the farthest-d0 pyramid's cells of
+// kCellLevel (4 x 4 subtiles): a cell whose minimum d0 is above d_near hides the rectangle
+// wherever it reaches it, and only the others are scanned subtile by subtile (Greene's pruned
+// search, one level deep and a vector of cells at a time). Same answers as
+// test_rect_exhaustive.
+Visibility RectScan(const SubtileView& view, const RectQuery& q) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kCellLevel = 2, kCell = 1 << kCellLevel;
+    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+    const InteriorSubtiles interior = interior_subtiles(q);
+    if (ty1 - ty0 < kCell || view.level_count <= kCellLevel)
+        return SubtilesHide(view, q, interior, tx0, tx1, ty0, ty1) ? Visibility::occluded : Visibility::visible;
+
+    const hn::CappedTag<float, kMaxSimdLanes> df;
+    const int lanes = int(hn::Lanes(df));
+    const auto d_near = hn::Set(df, q.d_near);
+    const PyramidLevel& level = view.levels[kCellLevel];
+    const int cx0 = tx0 >> kCellLevel, cx1 = tx1 >> kCellLevel;
+    for (int cy = ty0 >> kCellLevel; cy <= ty1 >> kCellLevel; ++cy) {
+        const float* row = view.pyramid + level.offset + std::size_t(cy) * std::size_t(level.width);
+        const int sy0 = std::max(ty0, cy * kCell), sy1 = std::min(ty1, cy * kCell + kCell - 1);
+        for (int cx = cx0; cx <= cx1; cx += lanes) {
+            // Lanes past cx1 read the next row or the pyramid's padding: masked out.
+            const auto reached = hn::FirstN(df, std::size_t(cx1 - cx + 1));
+            const auto open = hn::And(reached, hn::Not(hn::Lt(d_near, hn::LoadU(df, row + cx))));
+            if (hn::AllFalse(df, open)) continue;
+            HWY_ALIGN std::uint8_t bits[8];
+            hn::StoreMaskBits(df, open, bits);
+            for (int k = 0; k < lanes; ++k)
+                if ((bits[k / 8] >> (k % 8)) & 1u) {
+                    const int c = cx + k;
+                    if (!SubtilesHide(view, q, interior, std::max(tx0, c * kCell), std::min(tx1, c * kCell + kCell - 1), sy0, sy1))
+                        return Visibility::visible;
+                }
         }
     }
     return Visibility::occluded;
