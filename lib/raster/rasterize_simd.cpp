@@ -18,12 +18,14 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// The subtiles tx..tx + lanes - 1 of a row as vector lanes, float and 32-bit integer, at most
-// kMaxSimdLanes (wider vectors, as SVE may have, are capped: the rows are padded for that many).
+// The subtiles tx..tx + lanes - 1 of a row as vector lanes, float and 32-bit integer, at most 8
+// (4 on SSE4 and NEON; wider vectors are capped, and rows are padded for kMaxSimdLanes).
 HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    const hn::CappedTag<float, kMaxSimdLanes> df;
+    // At most 8 subtiles per vector: S1's triangles reach about 5 subtiles per row, and 16-lane
+    // AVX-512 vectors were 10 % slower on S1 than 8-lane ones (same bits either way).
+    const hn::CappedTag<float, 8> df;
     const hn::RebindToSigned<decltype(df)> di;
     const hn::RebindToUnsigned<decltype(df)> du;
     const int lanes = int(hn::Lanes(df));
