@@ -37,6 +37,17 @@ Frustum make_frustum(const Camera& c, double aspect) {
     return fr;
 }
 
+bool may_meet(const Frustum& fr, const Aabb& box) {
+    if (box.empty()) return false;
+    for (const glm::dvec4& plane : fr.planes) {
+        // The box corner farthest along the plane's inward normal.
+        const glm::dvec3 p(plane.x >= 0.0 ? box.max.x : box.min.x, plane.y >= 0.0 ? box.max.y : box.min.y,
+                           plane.z >= 0.0 ? box.max.z : box.min.z);
+        if (glm::dot(glm::dvec3(plane), p) + plane.w < 0.0) return false;
+    }
+    return true;
+}
+
 bool intersects(const Frustum& fr, const Aabb& box) {
     if (box.empty()) return false;
     const glm::dvec3 lo(box.min), hi(box.max);

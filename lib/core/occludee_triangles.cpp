@@ -187,7 +187,8 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
 
 }  // namespace
 
-OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInput& in, std::uint64_t tolerated_samples) const {
+OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInput& in, std::uint64_t tolerated_samples,
+                                                              std::size_t first_triangle) const {
     TriangleTest result;
     if (in.triangle_count == 0) return result;
     if (in.position_components != 3 && in.position_components != 4) throw Error("test_triangles: positions must have 3 or 4 components");
@@ -206,7 +207,9 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         result.visible_samples = counts.visible;
         return result;
     };
-    for (std::size_t t = 0; t < in.triangle_count; ++t) {
+    const std::size_t start = first_triangle < in.triangle_count ? first_triangle : 0;
+    for (std::size_t n = 0, t = start; n < in.triangle_count; ++n, t = t + 1 == in.triangle_count ? 0 : t + 1) {
+        result.deciding_triangle = t;
         glm::dvec4 model[3], clip[3];
         if (!detail::fetch_clip_triangle(in, t, model, clip)) return visible();  // nothing to reason with: never cull
         // Ground truth sees surfaces from the near plane on: the part before it is clipped

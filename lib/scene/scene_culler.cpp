@@ -1,20 +1,17 @@
+// SceneCuller: set-up, and a frame's occluder selection and rendering. The tests are in
+// scene_traversal.cpp.
 #include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 
-#include "core/rect_tests.hpp"
-#include "raster/rasterize.hpp"
+#include "scene/scene_culler_frame.hpp"
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
 #include <string>
 
 namespace homcull {
 namespace {
 
-double ms_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
+using Clock = std::chrono::steady_clock;
 
 OcclusionMapsConfig maps_config(const SceneCullerConfig& c) {
     OcclusionMapsConfig m = c.maps;
@@ -52,26 +49,49 @@ BufferConfig scene_buffer_config(const SceneCullerConfig& c, float near_w) {
     return b;
 }
 
+OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config) {
+    if (config.occludees != OccludeeShape::automatic) return config.occludees;
+    return config.maps.depth == DepthTest::masked ? OccludeeShape::samples : OccludeeShape::rectangles;
+}
+
 SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config)
     : scene_(&scene),
       config_(config),
       occluder_ids_(occluders),
       occluders_(gather_world_triangles(scene, occluders)),
+      hierarchy_(ObjectHierarchy::build(scene, config.hierarchy_leaf_size)),
       buffer_(scene_buffer_config(config, 0.1f)),
       maps_(buffer_, maps_config(config)) {
+    if (config.strategy == CullStrategy::progressive && config.progressive_batch_triangles == 0)
+        throw Error("progressive culling needs a batch of at least one triangle");
+    // Where each candidate's triangles are, and their shared edges within the object alone.
+    candidate_of_.assign(scene.objects.size(), kNone);
+    first_triangle_.push_back(0);
+    for (std::size_t k = 0; k < occluders.size(); ++k) {
+        candidate_of_[occluders[k]] = std::uint32_t(k);
+        first_triangle_.push_back(first_triangle_.back() + std::uint32_t(scene.triangle_count(scene.objects[occluders[k]])));
+    }
+    own_shared_edges_.resize(occluders_.triangle_count());
+    for (std::size_t k = 0; k < occluders.size(); ++k) {
+        const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
+        if (count == 0) continue;
+        compute_shared_edges(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
+                             occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first);
+    }
+    frame_occluders_.reserve(occluders.size());
+    frame_indices_.reserve(occluders_.indices.size());
+    frame_shared_.reserve(occluders_.triangle_count());
+    last_visibility_.assign(scene.objects.size(), Visibility::visible);
+
     if (resolved_occludee_shape(config) != OccludeeShape::samples) return;
     occludee_first_vertex_.assign(scene.objects.size(), kNotGathered);
+    first_visible_triangle_.assign(scene.objects.size(), 0);
     for (std::size_t id = 0; id < scene.objects.size(); ++id) {
         const Object& object = scene.objects[id];
         if (scene.triangle_count(object) > config.triangle_test_limit) continue;
         occludee_first_vertex_[id] = occludee_positions_.size() / 3;
         append_world_positions(scene, object, occludee_positions_);
     }
-}
-
-OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config) {
-    if (config.occludees != OccludeeShape::automatic) return config.occludees;
-    return config.maps.depth == DepthTest::masked ? OccludeeShape::samples : OccludeeShape::rectangles;
 }
 
 void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
@@ -81,104 +101,94 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
         buffer_ = OcclusionBuffer(scene_buffer_config(config_, float(camera.near_plane)));
         maps_ = OcclusionMaps(buffer_, maps_config(config_));
     }
-    const auto clip = clip_from_world(camera, config_.display.aspect());
-    const glm::dmat4 clip_double = projection_matrix(camera, config_.display.aspect()) * view_matrix(camera);
-    auto start = std::chrono::steady_clock::now();
+    const double aspect = config_.display.aspect();
+    const Frame frame{&camera, clip_from_world(camera, aspect), projection_matrix(camera, aspect) * view_matrix(camera)};
+    timings_ = {};
+    work_ = {};
+    exits_ = {};
+    frame_occluders_.clear();
+    frame_indices_.clear();
+    frame_shared_.clear();
+    frame_rendered_ = 0;
     buffer_.clear();
-    buffer_.render(occluders_.input(clip, config_.backface), parallel);
-    timings_.render_ms = ms_since(start);
 
-    start = std::chrono::steady_clock::now();
+    // one_pass (and temporal's first frame): the candidates in the frustum. temporal: those not
+    // found occluded last frame. progressive draws as it traverses.
+    if (config_.strategy != CullStrategy::progressive) {
+        select_occluders(frame);
+        render_pending(frame, parallel);
+    }
+    build_maps(frame);
+    traverse(frame, answers, parallel);
+
+    if (config_.strategy == CullStrategy::temporal) {
+        for (std::size_t id = 0; id < answers.size(); ++id) last_visibility_[id] = answers[id].visibility;
+        has_history_ = true;
+    }
+}
+
+// one_pass and temporal: the frame's occluders into frame_indices_. temporal keeps the
+// candidates that were not found occluded last frame: those seen, and those that were outside
+// the frustum (rank_occluders then keeps the ones inside it now).
+//
+// Shared-edge flags: an edge may go without its coverage margin only where the neighbour
+// across it is drawn too. Within an object that always holds. Between objects it holds when
+// every candidate whose box may meet the frustum is drawn: a neighbour left out lies wholly
+// outside a frustum plane, and so does the edge it shares, at least half a sample from every
+// sample centre, far beyond the margin's 2^-10 sample (near plane: the part of a triangle
+// before it is clipped away, and the edge with it). With a budget or temporal's choice,
+// neighbours may be missing: each object's own flags then.
+void SceneCuller::select_occluders(const Frame& frame) {
+    const auto start = Clock::now();
+    const std::vector<std::uint32_t>* pool = &occluder_ids_;
+    if (config_.strategy == CullStrategy::temporal && has_history_) {
+        temporal_pool_.clear();
+        for (std::uint32_t id : occluder_ids_)
+            if (last_visibility_[id] != Visibility::occluded) temporal_pool_.push_back(id);
+        pool = &temporal_pool_;
+    }
+    rank_occluders(*scene_, *pool, *frame.camera, config_.display.aspect(), config_.occluder_budget, ranked_, rank_scratch_);
+    const bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0;
+    const std::vector<std::uint8_t>& flags = every_candidate_in_frustum ? occluders_.shared_edges : own_shared_edges_;
+    for (std::uint32_t id : ranked_) append_occluder(id, flags);
+    timings_.select_ms += ms_since(start);
+}
+
+void SceneCuller::append_occluder(std::uint32_t id, const std::vector<std::uint8_t>& shared_edges) {
+    const std::uint32_t k = candidate_of_[id];
+    frame_occluders_.push_back(id);
+    for (std::uint32_t t = first_triangle_[k]; t < first_triangle_[k + 1]; ++t) {
+        frame_indices_.insert(frame_indices_.end(), occluders_.indices.begin() + 3 * t, occluders_.indices.begin() + 3 * t + 3);
+        frame_shared_.push_back(shared_edges[t]);
+    }
+    ++work_.occluder_objects;
+    work_.occluder_triangles += first_triangle_[k + 1] - first_triangle_[k];
+}
+
+// The triangles of frame_indices_ not rendered yet.
+void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel) {
+    const std::size_t count = frame_shared_.size() - frame_rendered_;
+    if (count == 0) return;
+    const auto start = Clock::now();
+    TriangleInput in = occluders_.input(frame.clip, config_.backface);
+    in.indices = frame_indices_.data() + 3 * frame_rendered_;
+    in.triangle_count = count;
+    in.shared_edges = frame_shared_.data() + frame_rendered_;
+    buffer_.render(in, parallel);
+    frame_rendered_ += count;
+    ++work_.renders;
+    timings_.render_ms += ms_since(start);
+}
+
+// The maps of what the buffer holds; the depth estimation buffer takes the rendered
+// occluders' boxes.
+void SceneCuller::build_maps(const Frame& frame) {
+    const auto start = Clock::now();
     maps_.clear();
     if (config_.maps.depth == DepthTest::deb)
-        for (std::uint32_t id : occluder_ids_) maps_.add_occluder_box(scene_->objects[id].world_bounds, clip);
+        for (std::uint32_t id : frame_occluders_) maps_.add_occluder_box(scene_->objects[id].world_bounds, frame.clip);
     maps_.build(buffer_);
-    timings_.maps_ms = ms_since(start);
-
-    start = std::chrono::steady_clock::now();
-    answers.resize(scene_->objects.size());
-    exits_ = {};
-    const OccludeeShape shape = resolved_occludee_shape(config_);
-    for (std::size_t id = 0; id < scene_->objects.size(); ++id) {
-        const Aabb& box = scene_->objects[id].world_bounds;
-        if (box.empty()) {
-            answers[id] = {Visibility::view_culled, 0.0f, 0};
-            continue;
-        }
-        answers[id] = maps_.test_aabb(box, clip);
-        ++exits_.count[answers[id].overlap_exit];
-        const Object& object = scene_->objects[id];
-        if (answers[id].visibility != Visibility::visible || scene_->triangle_count(object) > config_.triangle_test_limit) continue;
-        if (shape == OccludeeShape::rectangles && triangle_rectangles_hidden(object, clip_double)) {
-            answers[id].visibility = Visibility::occluded;
-            answers[id].level_of_visibility = 0.0f;  // the holes its triangles tolerated are not estimated
-        } else if (shape == OccludeeShape::samples && triangle_samples_hidden(id, clip, answers[id].level_of_visibility)) {
-            answers[id].visibility = Visibility::occluded;
-        }
-    }
-    timings_.test_ms = ms_since(start);
-}
-
-namespace {
-
-// Whether a triangle given by its clip-space corners is hidden at every sample: its screen
-// rectangle at its nearest w (w is affine on the triangle, so its nearest point is a corner)
-// tested against the maps; when that rectangle is not hidden, the four halves-of-edges
-// sub-triangles (clip space is linear on the triangle, so they tile it exactly) are tried, down
-// to `depth` more levels. A corner before the near plane makes it visible. The rectangles
-// share the object's hole budget (approximate mode).
-bool triangle_hidden(const OcclusionMaps& maps, float near_w, const glm::dvec4 c[3], int depth, double& budget) {
-    const detail::ClipBounds b = detail::clip_bounds(c, 3, double(near_w));
-    if (!b.finite || b.behind > 0) return false;
-    // Widened by 2^-20 of the magnitudes: world_bounds and ground truth round the world
-    // transform to float, this does not.
-    const double slack_x = 0x1.0p-20 * (1.0 + std::abs(b.min_x) + std::abs(b.max_x));
-    const double slack_y = 0x1.0p-20 * (1.0 + std::abs(b.min_y) + std::abs(b.max_y));
-    const ScreenRect r{detail::float_down(b.min_x - slack_x), detail::float_down(b.min_y - slack_y), detail::float_up(b.max_x + slack_x),
-                       detail::float_up(b.max_y + slack_y), detail::float_down(b.min_w * (1.0 - 0x1.0p-20))};
-    if (maps.test_rect_within(r, budget).visibility != Visibility::visible) return true;
-    if (depth == 0) return false;
-    const glm::dvec4 m01 = (c[0] + c[1]) * 0.5, m12 = (c[1] + c[2]) * 0.5, m20 = (c[2] + c[0]) * 0.5;
-    const glm::dvec4 parts[4][3] = {{c[0], m01, m20}, {m01, c[1], m12}, {m20, m12, c[2]}, {m01, m12, m20}};
-    for (const auto& part : parts)
-        if (!triangle_hidden(maps, near_w, part, depth - 1, budget)) return false;
-    return true;
-}
-
-}  // namespace
-
-// Every triangle hidden (see triangle_hidden), corners transformed in double as ground truth
-// transforms them.
-bool SceneCuller::triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
-    const Mesh& mesh = scene_->meshes[object.mesh];
-    const glm::dmat4 m = clip_from_world * object.world;
-    double budget = maps_.hole_budget();  // approximate mode: L pixels of holes for the whole object
-    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-        glm::dvec4 c[3];
-        for (int k = 0; k < 3; ++k) c[k] = m * glm::dvec4(glm::dvec3(mesh.positions[mesh.indices[3 * t + std::size_t(k)]]), 1.0);
-        if (!triangle_hidden(maps_, buffer_.config().near_w, c, 3, budget)) return false;
-    }
-    return true;
-}
-
-// The object's triangles sample by sample (OcclusionBuffer::test_triangles), tolerating the
-// maps' hole budget in approximate mode; its level of visibility is then the share of its
-// samples left visible.
-bool SceneCuller::triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) const {
-    const std::size_t first = occludee_first_vertex_[id];
-    if (first == kNotGathered) return false;
-    const Mesh& mesh = scene_->meshes[scene_->objects[id].mesh];
-    TriangleInput in;
-    in.positions = occludee_positions_.data() + 3 * first;
-    in.vertex_count = mesh.positions.size();
-    in.indices = mesh.indices.data();
-    in.triangle_count = mesh.triangle_count();
-    in.model_to_clip = clip_from_world;
-    in.backface = Backface::none;
-    const OcclusionBuffer::TriangleTest r = buffer_.test_triangles(in, std::uint64_t(maps_.hole_budget()));
-    if (r.visibility == Visibility::visible) return false;
-    level_of_visibility = r.samples > 0 ? float(double(r.visible_samples) / double(r.samples)) : 0.0f;
-    return true;
+    timings_.maps_ms += ms_since(start);
 }
 
 }  // namespace homcull

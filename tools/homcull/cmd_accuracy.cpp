@@ -105,7 +105,8 @@ void register_accuracy(CLI::App& app) {
     cmd->callback([o, cmd] {
         if (o->scene.empty())  // S1 has its own buffer and no scene: these would be silently ignored
             for (const char* name : {"--path", "--walk", "--orbit", "--buffer", "--mode", "--hole", "--distribution", "--transparency",
-                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders"})
+                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--strategy", "--rank", "--budget", "--batch",
+                                     "--hierarchy"})
                 if (cmd->get_option(name)->count() > 0) throw Error(std::string("accuracy: ") + name + " needs --scene");
         if (!o->scene.empty()) {
             o->cull.resolution = o->resolution;

@@ -1,6 +1,7 @@
 // homcull cull: per-object answers of the hierarchical occlusion maps from one camera.
 #include "commands.hpp"
 #include "cull_options.hpp"
+#include "cull_report.hpp"
 #include "options.hpp"
 
 #include <homcull/io/scene_io.hpp>
@@ -45,8 +46,8 @@ void run_cull(const CullCommandOptions& o) {
     for (int r = 0; r < o.repeat; ++r) {
         culler.cull(camera, answers, parallel);
         const SceneCullTimings& t = culler.timings();
-        best = r == 0 ? t : SceneCullTimings{std::min(best.render_ms, t.render_ms), std::min(best.maps_ms, t.maps_ms),
-                                             std::min(best.test_ms, t.test_ms)};
+        best = r == 0 ? t : SceneCullTimings{std::min(best.select_ms, t.select_ms), std::min(best.render_ms, t.render_ms),
+                                             std::min(best.maps_ms, t.maps_ms), std::min(best.test_ms, t.test_ms)};
     }
 
     // Optional ground truth at the display's pixel centres.
@@ -73,18 +74,7 @@ void run_cull(const CullCommandOptions& o) {
         triangles += n;
         after_frustum += a.visibility != Visibility::view_culled ? n : 0;
         after_occlusion += a.visibility == Visibility::visible ? n : 0;
-        nlohmann::json item = {{"id", id},
-                               {"name", scene.objects[id].name},
-                               {"triangles", n},
-                               {"result", visibility_name(a.visibility)},
-                               {"level_of_visibility", a.level_of_visibility}};
-        if (a.overlap_exit) item["overlap"] = overlap_exit_name(OverlapExit(a.overlap_exit));
-        if (o.truth) {
-            const ObjectVisibility& t = truth.objects[id];
-            item["truth"] = truth_result_name(t);
-            item["visible_samples"] = t.visible_samples;
-        }
-        objects.push_back(std::move(item));
+        objects.push_back(object_result_json(scene, id, a, o.truth ? &truth : nullptr));
     }
     const SceneCullTimings& ms = best;
     if (o.json) {
@@ -106,8 +96,10 @@ void run_cull(const CullCommandOptions& o) {
             {"summary", {{"objects", scene.objects.size()}, {"visible", counts[0]}, {"occluded", counts[1]}, {"view_culled", counts[2]},
                          {"triangles", triangles}, {"triangles_after_frustum", after_frustum},
                          {"triangles_after_occlusion", after_occlusion}}},
-            {"timings_ms", {{"load", load_ms}, {"setup", setup_ms}, {"render", ms.render_ms}, {"maps", ms.maps_ms},
-                            {"tests", ms.test_ms}}},
+            {"timings_ms", {{"load", load_ms}, {"setup", setup_ms}, {"select", ms.select_ms}, {"render", ms.render_ms},
+                            {"maps", ms.maps_ms}, {"tests", ms.test_ms}}},
+            {"work", work_json(culler.work())},
+            {"strategy", o.cull.strategy},
             {"stats", stats_json(culler.buffer().stats())},
             {"overlap_exits", exits}};
         if (o.truth) {

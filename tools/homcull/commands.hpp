@@ -11,5 +11,6 @@ void register_path(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_accuracy(CLI::App& app);
 void register_cull(CLI::App& app);
+void register_walk(CLI::App& app);
 
 }  // namespace homcull::cli

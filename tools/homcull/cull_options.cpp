@@ -4,7 +4,6 @@
 
 #include <homcull/error.hpp>
 
-#include <glm/glm.hpp>
 
 namespace homcull::cli {
 
@@ -35,8 +34,20 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "on: with samples occludees, keep the occluders' depth per sample (precise at silhouettes); off: the "
                    "subtile layers alone (faster render)")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
-    app.add_option("--occluders", o.occluders, "role, all, or auto (role when marked, else objects by size)")
+    app.add_option("--occluders", o.occluders, "Occluder candidates: role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
+    app.add_option("--strategy", o.strategy,
+                   "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
+                   "to back) or temporal (last frame's visible candidates plus those new in the frustum)")
+        ->capture_default_str()->check(CLI::IsMember({"one-pass", "progressive", "temporal"}));
+    app.add_option("--rank", o.rank, "Per-frame ranking of the candidates in the frustum under --budget: none, distance or area")
+        ->capture_default_str()->check(CLI::IsMember({"none", "distance", "area"}));
+    app.add_option("--budget", o.budget, "Occluder triangles per frame at most (0: no limit)")->capture_default_str();
+    app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
+        ->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_option("--hierarchy", o.hierarchy, "on: test the object hierarchy's nodes and skip what a hidden node holds; off: test "
+                                               "every object")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
 }
 
 SceneCullerConfig scene_culler_config(const CullOptions& o) {
@@ -59,21 +70,18 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.occludees = o.occludees == "box" ? OccludeeShape::box : o.occludees == "rects" ? OccludeeShape::rectangles
                 : o.occludees == "samples" ? OccludeeShape::samples : OccludeeShape::automatic;
     c.sample_depth = o.sample_depth == "on";
+    c.strategy = o.strategy == "progressive" ? CullStrategy::progressive : o.strategy == "temporal" ? CullStrategy::temporal
+                                                                                                 : CullStrategy::one_pass;
+    c.occluder_budget.ranking = o.rank == "distance" ? OccluderRanking::distance : o.rank == "area" ? OccluderRanking::area
+                                                                                                : OccluderRanking::none;
+    c.occluder_budget.triangles = o.budget;
+    c.progressive_batch_triangles = o.batch;
+    c.hierarchy = o.hierarchy == "on";
     return c;
 }
 
 std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice) {
-    if (choice == "all") return objects_with_role(scene, "");
-    std::vector<std::uint32_t> ids = objects_with_role(scene, "occluder");
-    if (!ids.empty()) return ids;
-    if (choice == "role") return objects_with_role(scene, "");
-    const Aabb bounds = scene.bounds();
-    const float min_diagonal = 0.02f * glm::length(bounds.extent());
-    for (std::uint32_t id = 0; id < scene.objects.size(); ++id) {
-        const Aabb& b = scene.objects[id].world_bounds;
-        if (!b.empty() && glm::length(b.extent()) >= min_diagonal) ids.push_back(id);
-    }
-    return ids;
+    return occluder_candidates(scene, choice == "all" ? OccluderFilter::all : choice == "auto" ? OccluderFilter::size : OccluderFilter::role);
 }
 
 const char* visibility_name(Visibility v) {

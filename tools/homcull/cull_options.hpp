@@ -17,6 +17,8 @@ struct CullOptions {
     double hole = 0.0, distribution = 1.0, transparency = 0.0;
     int finest_level = 0, coarsest_level = -1;
     std::string deb = "64x64", occludees = "auto", sample_depth = "on";
+    std::string strategy = "one-pass", rank = "none", hierarchy = "on";
+    std::size_t budget = 0, batch = 1024;
 };
 
 // with_display: also --resolution and --samples (commands that define their own leave them out

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     homcull::cli::register_bench(app);
     homcull::cli::register_accuracy(app);
     homcull::cli::register_cull(app);
+    homcull::cli::register_walk(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

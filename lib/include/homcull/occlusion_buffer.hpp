@@ -194,8 +194,12 @@ public:
         Visibility visibility = Visibility::view_culled;
         std::uint64_t samples = 0;          // samples the triangles may cover
         std::uint64_t visible_samples = 0;  // of those, samples with no occluder certainly nearer
+        std::size_t deciding_triangle = 0;  // visible: the triangle that made it so
     };
-    TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0) const;
+    // The triangles are scanned from `first_triangle` on, wrapping around: the answer is the
+    // same from any start, but starting at last frame's deciding triangle finds a visible
+    // occludee's visible triangle at once (frame-to-frame coherence).
+    TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0, std::size_t first_triangle = 0) const;
 
     const BufferConfig& config() const { return config_; }
     int sample_width() const { return sample_width_; }

@@ -1,8 +1,12 @@
 #pragma once
-// Culling a scene's objects from one camera with hierarchical occlusion maps: render the
-// chosen occluders into an occlusion buffer, build the maps, test every object's world box.
-// One SceneCuller is reused frame after frame: the buffer, the maps and the occluder triangles
-// are allocated once.
+// Culling a scene's objects frame after frame with hierarchical occlusion maps: select
+// occluders, render them into an occlusion buffer, build the maps, and test the objects
+// through a hierarchy of boxes, front to back, skipping what lies under a hidden node.
+// One SceneCuller is reused frame after frame: the buffer, the maps, the hierarchy and the
+// candidate occluders' triangles are set up once, and a frame allocates nothing once its
+// scratch has grown (the first frames).
+#include <homcull/object_hierarchy.hpp>
+#include <homcull/occluder_selection.hpp>
 #include <homcull/occlusion_maps.hpp>
 #include <homcull/scene.hpp>
 #include <homcull/world_triangles.hpp>
@@ -17,6 +21,20 @@ enum class OccludeeShape : std::uint8_t {
     rectangles,  // each triangle's screen rectangle at its nearest depth, through the maps and their depth test
     samples,     // the triangles sample by sample against the buffer's masked depth (OcclusionBuffer::test_triangles)
     automatic,   // samples with the masked depth test, rectangles with the others
+};
+
+// How a frame finds its occluders. Every strategy is conservative: only real geometry is drawn.
+enum class CullStrategy : std::uint8_t {
+    // Select occluders, render them, test everything (Zhang's two-pass framework).
+    one_pass,
+    // Traverse front to back from an empty buffer; the occluder candidates found visible are
+    // rendered in batches as traversal goes, and later nodes are tested against what has been
+    // drawn so far (Greene's hierarchical visibility).
+    progressive,
+    // Last frame's visible set, plus the candidates that have just entered the frustum (Zhang's
+    // eq. 7.1 candidate set), are this frame's occluders (Yoon, Salomon and Manocha). The first
+    // frame, or the first after reset_history(), works as one_pass.
+    temporal,
 };
 
 struct SceneCullerConfig {
@@ -39,15 +57,35 @@ struct SceneCullerConfig {
     // the occluders' depth without the layers' loss at silhouettes. Off: the layers alone,
     // rendering faster.
     bool sample_depth = true;
+
+    CullStrategy strategy = CullStrategy::one_pass;
+    // Per-frame ranking of the occluder candidates under a triangle budget. The default draws
+    // every candidate (progressive: every candidate found visible).
+    OccluderBudget occluder_budget;
+    // progressive: render the occluders found visible every time this many triangles wait.
+    std::size_t progressive_batch_triangles = 1024;
+    // Test the hierarchy's inner nodes (off: only objects are tested, still front to back).
+    bool hierarchy = true;
+    int hierarchy_leaf_size = 4;
 };
 
 // The shape `automatic` stands for with this configuration.
 OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config);
 
 struct SceneCullTimings {
+    double select_ms = 0.0;  // choosing the frame's occluders and gathering their triangles
     double render_ms = 0.0;  // occluder triangles into the buffer
     double maps_ms = 0.0;    // opacity pyramid, depth maps, depth estimation buffer
-    double test_ms = 0.0;    // every object's box (and triangles)
+    double test_ms = 0.0;    // the hierarchy's nodes and the objects' boxes (and triangles)
+};
+
+// What the last cull() did.
+struct SceneCullWork {
+    std::size_t occluder_objects = 0;    // objects rendered into the buffer
+    std::size_t occluder_triangles = 0;  // their triangles
+    std::size_t renders = 0;             // render calls (progressive: batches)
+    std::size_t nodes_tested = 0;        // inner hierarchy nodes tested
+    std::size_t objects_tested = 0;      // objects tested on their own (the rest answered by a node)
 };
 
 // How many objects each overlap-test exit decided (indexed by OverlapExit).
@@ -57,20 +95,27 @@ struct OverlapExitCounts {
 
 class SceneCuller {
 public:
-    // `occluders`: object ids whose triangles are rendered (gathered once, here).
-    // Throws homcull::Error on an invalid configuration.
+    // `occluders`: the occluder candidates, object ids (occluder_candidates() gives the usual
+    // choices); their triangles are gathered once, here. Throws homcull::Error on an invalid
+    // configuration.
     SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config);
 
     // answers[id] for every object of the scene (objects without geometry are view-culled).
-    // overlap_exit is the box test's; an object its triangles found hidden reports level of
-    // visibility 0.
+    // overlap_exit is the deciding box test's (the object's own, or the hidden node's above
+    // it); an object its triangles found hidden reports level of visibility 0.
     void cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
+    // temporal: forget the last frame (after a camera cut), so that the next frame works as
+    // one_pass.
+    void reset_history() { has_history_ = false; }
 
     const SceneCullerConfig& config() const { return config_; }
     const OcclusionBuffer& buffer() const { return buffer_; }
     const OcclusionMaps& maps() const { return maps_; }
     const SceneCullTimings& timings() const { return timings_; }
+    const SceneCullWork& work() const { return work_; }
     const OverlapExitCounts& overlap_exits() const { return exits_; }
+    const ObjectHierarchy& hierarchy() const { return hierarchy_; }
+    // The occluder candidates, and their triangles.
     std::size_t occluder_objects() const { return occluder_ids_.size(); }
     std::size_t occluder_triangles() const { return occluders_.triangle_count(); }
 
@@ -78,18 +123,48 @@ private:
     const Scene* scene_;
     SceneCullerConfig config_;
     std::vector<std::uint32_t> occluder_ids_;
-    WorldTriangles occluders_;
+    WorldTriangles occluders_;  // shared-edge flags across the whole candidate set
+    // Per candidate k (occluder_ids_[k]): its triangles are [first_triangle_[k], first_triangle_[k + 1]).
+    std::vector<std::uint32_t> first_triangle_;
+    std::vector<std::uint32_t> candidate_of_;  // object id -> k, or kNone
+    // Shared-edge flags within each object only: right for any subset of the candidates (an edge
+    // shared with an object that is not drawn is a silhouette and needs its margin).
+    std::vector<std::uint8_t> own_shared_edges_;
+    ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
     SceneCullTimings timings_;
+    SceneCullWork work_;
     OverlapExitCounts exits_;
+
+    // Per-frame state and scratch (reused, grown only).
+    std::vector<std::uint32_t> frame_occluders_;  // object ids drawn this frame
+    std::vector<std::uint32_t> frame_indices_;    // their triangles' indices into occluders_
+    std::vector<std::uint8_t> frame_shared_;      // and their own_shared_edges_
+    std::size_t frame_rendered_ = 0;              // triangles of frame_indices_ already rendered
+    std::vector<std::uint32_t> temporal_pool_;    // temporal: the candidates not occluded last frame
+    std::vector<std::uint32_t> ranked_;           // rank_occluders' choice
+    std::vector<std::pair<float, std::uint32_t>> rank_scratch_, node_heap_;
+    std::vector<Visibility> last_visibility_;
+    bool has_history_ = false;
+
+    static constexpr std::uint32_t kNone = ~std::uint32_t(0);
+    struct Frame;
+    void select_occluders(const Frame& frame);
+    void append_occluder(std::uint32_t id, const std::vector<std::uint8_t>& shared_edges);
+    void render_pending(const Frame& frame, const ParallelFor& parallel);
+    void build_maps(const Frame& frame);
+    void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
+    OccludeeAnswer test_object(const Frame& frame, std::uint32_t id);
     // Occludee triangles in world space (transformed as ground truth transforms them) for the
     // samples test: object id -> its first vertex in occludee_positions_, or kNotGathered.
     static constexpr std::size_t kNotGathered = ~std::size_t(0);
     std::vector<float> occludee_positions_;
     std::vector<std::size_t> occludee_first_vertex_;
     bool triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const;
-    bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) const;
+    // Per object, the triangle that found it visible last time: the next test starts there.
+    std::vector<std::uint32_t> first_visible_triangle_;
+    bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
 };
 
 // The buffer configuration a SceneCullerConfig asks for (resolved buffer size), for callers

@@ -1,0 +1,50 @@
+#pragma once
+// Which objects are drawn into the occlusion buffer (Zhang 1998, ch. 7, "occluder selection").
+// Two stages:
+//   - a static filter, once per scene: the objects the scene marks as occluders (the castle's
+//     `role: occluder`), every object, or the objects large enough to hide something;
+//   - per frame, optionally: the candidates in the view frustum ranked by distance or by
+//     projected size and kept in rank order while their triangles fit a triangle budget.
+// Selection decides only how much is hidden, never correctness: whatever is drawn is real
+// geometry, so every answer stays conservative.
+#include <homcull/camera.hpp>
+#include <homcull/scene.hpp>
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace homcull {
+
+enum class OccluderFilter : std::uint8_t {
+    role,  // objects whose extra "role" is "occluder"; every object when none is marked
+    all,   // every object
+    size,  // role when the scene marks occluders, else objects whose box diagonal is at least
+           // 2 % of the scene's (Zhang's static size filter)
+};
+
+// The objects a filter keeps, in id order. Objects without geometry are never kept.
+std::vector<std::uint32_t> occluder_candidates(const Scene& scene, OccluderFilter filter);
+
+enum class OccluderRanking : std::uint8_t {
+    none,      // every candidate, every frame (no per-frame work)
+    distance,  // nearest box first (Zhang's distance-based selection under a polygon budget)
+    area,      // largest projected size first: box diagonal over distance, squared
+};
+
+struct OccluderBudget {
+    OccluderRanking ranking = OccluderRanking::none;
+    // With a ranking: at most this many triangles per frame; 0 = no limit (every candidate in
+    // the frustum). Ranked objects that do not fit what is left are skipped, smaller ones
+    // after them may still fit.
+    std::size_t triangles = 0;
+};
+
+// Per frame: the candidates whose box meets the camera's frustum (plane test), in rank
+// order, within the budget, into `chosen` (cleared first). `scratch` is reused across frames;
+// neither allocates once it has grown to the candidate count.
+void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candidates, const Camera& camera, double aspect,
+                    const OccluderBudget& budget, std::vector<std::uint32_t>& chosen,
+                    std::vector<std::pair<float, std::uint32_t>>& scratch);
+
+}  // namespace homcull

@@ -1,0 +1,38 @@
+#pragma once
+// One frame of a walkthrough measured as Zhang's culling graphs are: objects and triangles in
+// total, after view-frustum culling, after occlusion culling and exactly visible (Embree), with
+// the false and missed culls against that ground truth and the time of every stage.
+#include <homcull/scene_culler.hpp>
+#include <homcull/truth/ground_truth.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace homcull {
+
+// Counts of objects or of their triangles at each step of the culling graph.
+struct CullingGraphCounts {
+    std::uint64_t total = 0;
+    std::uint64_t after_frustum = 0;    // whose box meets the view frustum (exact test)
+    std::uint64_t after_occlusion = 0;  // the culler's visible answers
+    std::uint64_t exactly_visible = 0;  // seen by some sample (ground truth); 0 without truth
+};
+
+struct WalkFrame {
+    CullingGraphCounts objects, triangles;
+    bool has_truth = false;
+    std::size_t false_culls = 0;        // seen, yet culled
+    std::size_t robust_false_culls = 0; // of those, seen by a robust sample
+    std::size_t hidden_in_frustum = 0;  // in the frustum, seen by no sample
+    std::size_t missed_culls = 0;       // of those, kept
+    SceneCullTimings ms;
+    SceneCullWork work;
+    double truth_ms = 0.0;
+};
+
+// Culls one frame with `culler` (answers[id] out) and measures it; with `truth` (computed for
+// the same camera at the culler's display resolution) also against ground truth.
+WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Camera& camera, const TruthResult* truth,
+                             std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
+
+}  // namespace homcull

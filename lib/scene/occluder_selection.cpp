@@ -1,0 +1,66 @@
+#include <homcull/occluder_selection.hpp>
+
+#include <homcull/frustum.hpp>
+#include <homcull/world_triangles.hpp>
+
+#include <algorithm>
+
+namespace homcull {
+
+std::vector<std::uint32_t> occluder_candidates(const Scene& scene, OccluderFilter filter) {
+    std::vector<std::uint32_t> ids;
+    if (filter != OccluderFilter::all) ids = objects_with_role(scene, "occluder");
+    if (ids.empty() && filter == OccluderFilter::size) {
+        const float min_diagonal = 0.02f * glm::length(scene.bounds().extent());
+        for (std::uint32_t id = 0; id < scene.objects.size(); ++id) {
+            const Aabb& b = scene.objects[id].world_bounds;
+            if (!b.empty() && glm::length(b.extent()) >= min_diagonal) ids.push_back(id);
+        }
+    } else if (ids.empty()) {
+        ids = objects_with_role(scene, "");
+    }
+    ids.erase(std::remove_if(ids.begin(), ids.end(), [&](std::uint32_t id) { return scene.objects[id].world_bounds.empty(); }),
+              ids.end());
+    return ids;
+}
+
+namespace {
+
+// Distance from a point to a box (0 inside it).
+double distance_to_box(const glm::dvec3& p, const Aabb& box) {
+    const glm::dvec3 nearest = glm::clamp(p, glm::dvec3(box.min), glm::dvec3(box.max));
+    return glm::length(p - nearest);
+}
+
+}  // namespace
+
+void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candidates, const Camera& camera, double aspect,
+                    const OccluderBudget& budget, std::vector<std::uint32_t>& chosen,
+                    std::vector<std::pair<float, std::uint32_t>>& scratch) {
+    chosen.clear();
+    const Frustum frustum = make_frustum(camera, aspect);
+    scratch.clear();
+    for (std::uint32_t id : candidates) {
+        const Aabb& box = scene.objects[id].world_bounds;
+        if (!may_meet(frustum, box)) continue;
+        // Smaller keys first. The near plane bounds the distance below: every object that
+        // reaches in front of it ranks alike by size.
+        const double distance = std::max(distance_to_box(camera.eye, box), camera.near_plane);
+        double key = distance;
+        if (budget.ranking == OccluderRanking::area) {
+            const double diagonal = glm::length(glm::dvec3(box.extent()));
+            key = -(diagonal * diagonal) / (distance * distance);
+        }
+        scratch.emplace_back(float(key), id);
+    }
+    if (budget.ranking != OccluderRanking::none) std::sort(scratch.begin(), scratch.end());
+    std::size_t left = budget.triangles == 0 ? ~std::size_t(0) : budget.triangles;
+    for (const auto& [key, id] : scratch) {
+        const std::size_t n = scene.triangle_count(scene.objects[id]);
+        if (n > left) continue;
+        chosen.push_back(id);
+        left -= n;
+    }
+}
+
+}  // namespace homcull

@@ -1,0 +1,21 @@
+#pragma once
+// What SceneCuller's steps share within one frame (scene_culler.cpp selects and renders,
+// scene_traversal.cpp tests).
+#include <homcull/scene_culler.hpp>
+
+#include <array>
+#include <chrono>
+
+namespace homcull {
+
+struct SceneCuller::Frame {
+    const Camera* camera;
+    std::array<float, 16> clip;  // world to clip, in float: the buffer's and the maps' input
+    glm::dmat4 clip_double;      // the same in double, as ground truth transforms
+};
+
+inline double ms_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace homcull

@@ -1,0 +1,157 @@
+// SceneCuller's tests: the hierarchy traversed front to back, a hidden node answering for
+// its objects, and each remaining object's box, then (where the box is visible) its triangles.
+#include <homcull/scene_culler.hpp>
+
+#include "core/rect_tests.hpp"
+#include "raster/rasterize.hpp"
+#include "scene/scene_culler_frame.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace homcull {
+namespace {
+
+// Squared distance from the eye to a box (0 inside it): the traversal's front-to-back key.
+float distance2_to_box(const glm::dvec3& eye, const Aabb& box) {
+    const glm::dvec3 d = eye - glm::clamp(eye, glm::dvec3(box.min), glm::dvec3(box.max));
+    return float(glm::dot(d, d));
+}
+
+}  // namespace
+
+// Nodes come out of a heap nearest first (Greene's front-to-back order, which progressive
+// culling needs so that near occluders are drawn before far nodes are tested). A node is
+// tested when the configuration asks for hierarchy tests and it holds more than one object;
+// if its box is outside the frustum or occluded, so is every object under it.
+void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+    const auto start = std::chrono::steady_clock::now();
+    const double flushes_before = timings_.render_ms + timings_.maps_ms;
+    answers.assign(scene_->objects.size(), OccludeeAnswer{Visibility::view_culled, 0.0f, 0});
+    const bool progressive = config_.strategy == CullStrategy::progressive;
+    const std::size_t budget = config_.occluder_budget.triangles == 0 ? ~std::size_t(0) : config_.occluder_budget.triangles;
+    const auto nearest_first = [](const std::pair<float, std::uint32_t>& a, const std::pair<float, std::uint32_t>& b) {
+        return a.first > b.first;
+    };
+    const std::size_t batch = config_.progressive_batch_triangles;
+    node_heap_.clear();
+    if (!hierarchy_.nodes.empty()) node_heap_.emplace_back(0.0f, 0u);
+    while (!node_heap_.empty()) {
+        std::pop_heap(node_heap_.begin(), node_heap_.end(), nearest_first);
+        const ObjectHierarchy::Node& node = hierarchy_.nodes[node_heap_.back().second];
+        node_heap_.pop_back();
+        if (progressive && frame_shared_.size() - frame_rendered_ >= batch) {
+            render_pending(frame, parallel);
+            build_maps(frame);
+        }
+        if (config_.hierarchy && node.end - node.begin > 1) {
+            const OccludeeAnswer a = maps_.test_aabb(node.bounds, frame.clip);
+            ++work_.nodes_tested;
+            if (a.visibility != Visibility::visible) {
+                for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
+                exits_.count[a.overlap_exit] += node.end - node.begin;
+                continue;
+            }
+        }
+        if (!node.leaf()) {
+            for (std::uint32_t c = node.first_child; c < node.first_child + 2; ++c) {
+                node_heap_.emplace_back(distance2_to_box(frame.camera->eye, hierarchy_.nodes[c].bounds), c);
+                std::push_heap(node_heap_.begin(), node_heap_.end(), nearest_first);
+            }
+            continue;
+        }
+        for (std::uint32_t i = node.begin; i < node.end; ++i) {
+            const std::uint32_t id = hierarchy_.object_ids[i];
+            answers[id] = test_object(frame, id);
+            // progressive: a visible candidate is drawn with the next batch, within the budget.
+            if (progressive && answers[id].visibility == Visibility::visible && candidate_of_[id] != kNone &&
+                work_.occluder_triangles + scene_->triangle_count(scene_->objects[id]) <= budget)
+                append_occluder(id, own_shared_edges_);
+        }
+    }
+    timings_.test_ms = ms_since(start) - (timings_.render_ms + timings_.maps_ms - flushes_before);
+}
+
+// The object's box, then, where the box is visible and the object small enough, its triangles.
+OccludeeAnswer SceneCuller::test_object(const Frame& frame, std::uint32_t id) {
+    const Object& object = scene_->objects[id];
+    OccludeeAnswer answer = maps_.test_aabb(object.world_bounds, frame.clip);
+    ++work_.objects_tested;
+    ++exits_.count[answer.overlap_exit];
+    if (answer.visibility != Visibility::visible || scene_->triangle_count(object) > config_.triangle_test_limit) return answer;
+    const OccludeeShape shape = resolved_occludee_shape(config_);
+    if (shape == OccludeeShape::rectangles && triangle_rectangles_hidden(object, frame.clip_double)) {
+        answer.visibility = Visibility::occluded;
+        answer.level_of_visibility = 0.0f;  // the holes its triangles tolerated are not estimated
+    } else if (shape == OccludeeShape::samples && triangle_samples_hidden(id, frame.clip, answer.level_of_visibility)) {
+        answer.visibility = Visibility::occluded;
+    }
+    return answer;
+}
+
+namespace {
+
+// Whether a triangle given by its clip-space corners is hidden at every sample: its screen
+// rectangle at its nearest w (w is affine on the triangle, so its nearest point is a corner)
+// tested against the maps; when that rectangle is not hidden, the four halves-of-edges
+// sub-triangles (clip space is linear on the triangle, so they tile it exactly) are tried, down
+// to `depth` more levels. A corner before the near plane makes it visible. The rectangles
+// share the object's hole budget (approximate mode).
+bool triangle_hidden(const OcclusionMaps& maps, float near_w, const glm::dvec4 c[3], int depth, double& budget) {
+    const detail::ClipBounds b = detail::clip_bounds(c, 3, double(near_w));
+    if (!b.finite || b.behind > 0) return false;
+    // Widened by 2^-20 of the magnitudes: world_bounds and ground truth round the world
+    // transform to float, this does not.
+    const double slack_x = 0x1.0p-20 * (1.0 + std::abs(b.min_x) + std::abs(b.max_x));
+    const double slack_y = 0x1.0p-20 * (1.0 + std::abs(b.min_y) + std::abs(b.max_y));
+    const ScreenRect r{detail::float_down(b.min_x - slack_x), detail::float_down(b.min_y - slack_y), detail::float_up(b.max_x + slack_x),
+                       detail::float_up(b.max_y + slack_y), detail::float_down(b.min_w * (1.0 - 0x1.0p-20))};
+    if (maps.test_rect_within(r, budget).visibility != Visibility::visible) return true;
+    if (depth == 0) return false;
+    const glm::dvec4 m01 = (c[0] + c[1]) * 0.5, m12 = (c[1] + c[2]) * 0.5, m20 = (c[2] + c[0]) * 0.5;
+    const glm::dvec4 parts[4][3] = {{c[0], m01, m20}, {m01, c[1], m12}, {m20, m12, c[2]}, {m01, m12, m20}};
+    for (const auto& part : parts)
+        if (!triangle_hidden(maps, near_w, part, depth - 1, budget)) return false;
+    return true;
+}
+
+}  // namespace
+
+// Every triangle hidden (see triangle_hidden), corners transformed in double as ground truth
+// transforms them.
+bool SceneCuller::triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
+    const Mesh& mesh = scene_->meshes[object.mesh];
+    const glm::dmat4 m = clip_from_world * object.world;
+    double budget = maps_.hole_budget();  // approximate mode: L pixels of holes for the whole object
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        glm::dvec4 c[3];
+        for (int k = 0; k < 3; ++k) c[k] = m * glm::dvec4(glm::dvec3(mesh.positions[mesh.indices[3 * t + std::size_t(k)]]), 1.0);
+        if (!triangle_hidden(maps_, buffer_.config().near_w, c, 3, budget)) return false;
+    }
+    return true;
+}
+
+// The object's triangles sample by sample (OcclusionBuffer::test_triangles), tolerating the
+// maps' hole budget in approximate mode; its level of visibility is then the share of its
+// samples left visible.
+bool SceneCuller::triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) {
+    const std::size_t first = occludee_first_vertex_[id];
+    if (first == kNotGathered) return false;
+    const Mesh& mesh = scene_->meshes[scene_->objects[id].mesh];
+    TriangleInput in;
+    in.positions = occludee_positions_.data() + 3 * first;
+    in.vertex_count = mesh.positions.size();
+    in.indices = mesh.indices.data();
+    in.triangle_count = mesh.triangle_count();
+    in.model_to_clip = clip_from_world;
+    in.backface = Backface::none;
+    const OcclusionBuffer::TriangleTest r = buffer_.test_triangles(in, std::uint64_t(maps_.hole_budget()), first_visible_triangle_[id]);
+    if (r.visibility == Visibility::visible) {
+        first_visible_triangle_[id] = std::uint32_t(r.deciding_triangle);
+        return false;
+    }
+    level_of_visibility = r.samples > 0 ? float(double(r.visible_samples) / double(r.samples)) : 0.0f;
+    return true;
+}
+
+}  // namespace homcull

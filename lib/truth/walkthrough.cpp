@@ -1,0 +1,44 @@
+#include <homcull/truth/walkthrough.hpp>
+
+#include <homcull/frustum.hpp>
+
+namespace homcull {
+
+WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Camera& camera, const TruthResult* truth,
+                             std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+    culler.cull(camera, answers, parallel);
+    WalkFrame f;
+    f.ms = culler.timings();
+    f.work = culler.work();
+    f.has_truth = truth != nullptr;
+    if (truth) f.truth_ms = truth->trace_ms;
+    const Frustum frustum = make_frustum(camera, culler.config().display.aspect());
+    for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+        const Object& object = scene.objects[id];
+        const std::uint64_t n = scene.triangle_count(object);
+        // The culler may answer "occluded" for an object outside the frustum (a hidden node
+        // above it): the frustum count is the exact test of the object's own box.
+        const bool in_frustum = intersects(frustum, object.world_bounds);
+        const bool kept = answers[id].visibility == Visibility::visible;
+        f.objects.total += 1;
+        f.triangles.total += n;
+        f.objects.after_frustum += in_frustum;
+        f.triangles.after_frustum += in_frustum ? n : 0;
+        f.objects.after_occlusion += kept;
+        f.triangles.after_occlusion += kept ? n : 0;
+        if (!truth || object.world_bounds.empty()) continue;
+        const ObjectVisibility& t = truth->objects[id];
+        if (t.visible_samples > 0) {
+            f.objects.exactly_visible += 1;
+            f.triangles.exactly_visible += n;
+            f.false_culls += !kept;
+            f.robust_false_culls += !kept && t.robust_samples > 0;
+        } else if (t.in_frustum) {
+            f.hidden_in_frustum += 1;
+            f.missed_culls += kept;
+        }
+    }
+    return f;
+}
+
+}  // namespace homcull

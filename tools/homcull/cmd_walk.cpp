@@ -1,0 +1,192 @@
+// homcull walk: cull a scene along a camera path, frame after frame with one culler (so the
+// temporal strategy has its history), and report Zhang's culling graph per frame against
+// Embree ground truth, with the time of every stage.
+#include "commands.hpp"
+#include "cull_options.hpp"
+#include "cull_report.hpp"
+#include "options.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/io/camera_path.hpp>
+#include <homcull/io/scene_io.hpp>
+#include <homcull/tbb_parallel_for.hpp>
+#include <homcull/truth/walkthrough.hpp>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace homcull::cli {
+namespace {
+
+struct WalkCommandOptions {
+    std::string scene, path;
+    CullOptions cull;
+    std::string isa = "best", truth = "on";
+    int threads = 1;
+    bool json = false, quiet = false;
+};
+
+// A frame's figures by name, in print order: what the summary averages and maximizes.
+std::vector<std::pair<const char*, double>> frame_figures(const WalkFrame& f) {
+    std::vector<std::pair<const char*, double>> v = {
+        {"objects", double(f.objects.total)},
+        {"objects_after_frustum", double(f.objects.after_frustum)},
+        {"objects_after_occlusion", double(f.objects.after_occlusion)},
+        {"triangles", double(f.triangles.total)},
+        {"triangles_after_frustum", double(f.triangles.after_frustum)},
+        {"triangles_after_occlusion", double(f.triangles.after_occlusion)},
+        {"occluder_objects", double(f.work.occluder_objects)},
+        {"occluder_triangles", double(f.work.occluder_triangles)},
+        {"select_ms", f.ms.select_ms},
+        {"render_ms", f.ms.render_ms},
+        {"maps_ms", f.ms.maps_ms},
+        {"tests_ms", f.ms.test_ms},
+        {"cull_ms", f.ms.select_ms + f.ms.render_ms + f.ms.maps_ms + f.ms.test_ms}};
+    if (f.has_truth) {
+        v.insert(v.end(), {{"objects_exactly_visible", double(f.objects.exactly_visible)},
+                           {"triangles_exactly_visible", double(f.triangles.exactly_visible)},
+                           {"false_culls", double(f.false_culls)},
+                           {"hidden_in_frustum", double(f.hidden_in_frustum)},
+                           {"missed_culls", double(f.missed_culls)},
+                           {"truth_ms", f.truth_ms}});
+    }
+    return v;
+}
+
+void print_progress(std::size_t done, std::size_t total) {
+    constexpr int kWidth = 30;
+    const int filled = int(kWidth * done / std::max<std::size_t>(total, 1));
+    fmt::print(stderr, "\r[{}{}] frame {}/{}", std::string(std::size_t(filled), '#'), std::string(std::size_t(kWidth - filled), '.'),
+               done, total);
+    if (done == total) fmt::print(stderr, "\n");
+    std::fflush(stderr);
+}
+
+void run_walk(const WalkCommandOptions& o) {
+    select_isa(o.isa);
+    const SceneCullerConfig config = scene_culler_config(o.cull);
+    const Scene scene = load_scene(o.scene);
+    const CameraPath path = read_camera_path(o.path);
+    if (path.frames.empty()) throw Error("camera path " + o.path + " has no frames");
+    SceneCuller culler(scene, choose_occluders(scene, o.cull.occluders), config);
+    std::unique_ptr<RayScene> rays;
+    if (o.truth == "on") rays = std::make_unique<RayScene>(scene);
+    TruthOptions truth_options;
+    truth_options.resolution = config.display;
+    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+
+    nlohmann::json frames = nlohmann::json::array();
+    std::vector<WalkFrame> measured;
+    std::vector<OccludeeAnswer> answers;
+    for (std::size_t k = 0; k < path.frames.size(); ++k) {
+        const Camera& camera = path.frames[k];
+        TruthResult truth;
+        if (rays) truth = compute_ground_truth(*rays, scene, camera, truth_options);
+        const WalkFrame f = measure_walk_frame(scene, culler, camera, rays ? &truth : nullptr, answers, parallel);
+        measured.push_back(f);
+        if (o.json) {
+            nlohmann::json objects = nlohmann::json::array();
+            for (std::size_t id = 0; id < scene.objects.size(); ++id)
+                objects.push_back(object_result_json(scene, id, answers[id], rays ? &truth : nullptr));
+            nlohmann::json frame = {{"frame", k}, {"camera", camera_json(camera)}, {"objects", std::move(objects)}};
+            for (const auto& [name, value] : frame_figures(f)) frame[name] = value;
+            frame["timings_ms"] = timings_json(f.ms);
+            frame["work"] = work_json(f.work);
+            frames.push_back(std::move(frame));
+        } else {
+            fmt::print("frame {:4}: objects {} / {} in frustum / {} kept{}; occluders {} tris; {:.3f} ms (render {:.3f}, maps {:.3f}, "
+                       "tests {:.3f}){}\n",
+                       k, f.objects.total, f.objects.after_frustum, f.objects.after_occlusion,
+                       f.has_truth ? fmt::format(" / {} visible", f.objects.exactly_visible) : "", f.work.occluder_triangles,
+                       f.ms.select_ms + f.ms.render_ms + f.ms.maps_ms + f.ms.test_ms, f.ms.render_ms, f.ms.maps_ms, f.ms.test_ms,
+                       f.has_truth ? fmt::format("; false culls {}, missed {} of {} hidden", f.false_culls, f.missed_culls,
+                                                 f.hidden_in_frustum)
+                                   : "");
+        }
+        if (!o.quiet) print_progress(k + 1, path.frames.size());
+    }
+
+    // Summary: mean and max of every figure, and the path's totals.
+    nlohmann::json summary = {{"frames", measured.size()}};
+    const auto names = frame_figures(measured.front());
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        double sum = 0.0, most = 0.0;
+        for (const WalkFrame& f : measured) {
+            const double v = frame_figures(f)[i].second;
+            sum += v;
+            most = std::max(most, v);
+        }
+        summary[names[i].first] = {{"mean", sum / double(measured.size())}, {"max", most}};
+    }
+    std::size_t false_culls = 0, robust_false_culls = 0, hidden = 0, missed = 0;
+    for (const WalkFrame& f : measured) {
+        false_culls += f.false_culls;
+        robust_false_culls += f.robust_false_culls;
+        hidden += f.hidden_in_frustum;
+        missed += f.missed_culls;
+    }
+    const double efficiency = hidden ? double(hidden - missed) / double(hidden) : 1.0;
+    if (rays) {
+        summary["total_false_culls"] = false_culls;
+        summary["total_robust_false_culls"] = robust_false_culls;
+        summary["efficiency"] = efficiency;
+    }
+    if (o.json) {
+        const nlohmann::json out = {{"scene", scene.source},
+                                    {"path", o.path},
+                                    {"strategy", o.cull.strategy},
+                                    {"rank", o.cull.rank},
+                                    {"budget", o.cull.budget},
+                                    {"hierarchy", o.cull.hierarchy},
+                                    {"display", {config.display.width, config.display.height}},
+                                    {"buffer", {culler.buffer().config().width, culler.buffer().config().height}},
+                                    {"samples", config.samples},
+                                    {"mode", o.cull.mode},
+                                    {"depth", o.cull.depth},
+                                    {"isa", selected_isa()},
+                                    {"occluder_candidates", {{"objects", culler.occluder_objects()}, {"triangles", culler.occluder_triangles()}}},
+                                    {"frames", std::move(frames)},
+                                    {"summary", std::move(summary)}};
+        fmt::print("{}\n", out.dump(1));
+        return;
+    }
+    fmt::print("\n{}: {} frames, strategy {}, {} occluder candidates ({} triangles)\n", scene.source, measured.size(), o.cull.strategy,
+               culler.occluder_objects(), culler.occluder_triangles());
+    fmt::print("{:<28}{:>14}{:>14}\n", "figure", "mean", "max");
+    for (const auto& [name, value] : names) {
+        (void)value;
+        fmt::print("{:<28}{:>14.3f}{:>14.3f}\n", name, summary[name]["mean"].get<double>(), summary[name]["max"].get<double>());
+    }
+    if (rays)
+        fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %)\n", false_culls,
+                   robust_false_culls, hidden - missed, hidden, 100.0 * efficiency);
+}
+
+}  // namespace
+
+void register_walk(CLI::App& app) {
+    auto o = std::make_shared<WalkCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("walk", "Cull a scene along a camera path and report the culling graph per frame against Embree "
+                                               "ground truth");
+    add_scene_option(*cmd, o->scene);
+    cmd->add_option("--path", o->path, "Camera path file (JSON, see `homcull path`)")->required();
+    add_cull_options(*cmd, o->cull);
+    cmd->add_option("--truth", o->truth, "on: cast Embree ground truth per frame (exactly visible, false and missed culls); off: only "
+                                         "the culler")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
+    cmd->add_option("--threads", o->threads, "Render with this many threads (TBB); 1 = the calling thread")
+        ->capture_default_str()->check(CLI::Range(1, 256));
+    cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
+        ->capture_default_str();
+    cmd->add_flag("--quiet", o->quiet, "No progress bar on stderr");
+    cmd->add_flag("--json", o->json, "Print JSON on stdout: {\"frames\":[{\"objects\":[...], figures...}], \"summary\":{...}}");
+    cmd->callback([o] { run_walk(*o); });
+}
+
+}  // namespace homcull::cli

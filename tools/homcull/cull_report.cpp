@@ -1,0 +1,31 @@
+#include "cull_report.hpp"
+
+#include "cull_options.hpp"
+
+namespace homcull::cli {
+
+nlohmann::json object_result_json(const Scene& scene, std::size_t id, const OccludeeAnswer& a, const TruthResult* truth) {
+    nlohmann::json item = {{"id", id},
+                           {"name", scene.objects[id].name},
+                           {"triangles", scene.triangle_count(scene.objects[id])},
+                           {"result", visibility_name(a.visibility)},
+                           {"level_of_visibility", a.level_of_visibility}};
+    if (a.overlap_exit) item["overlap"] = overlap_exit_name(OverlapExit(a.overlap_exit));
+    if (truth) {
+        const ObjectVisibility& t = truth->objects[id];
+        item["truth"] = truth_result_name(t);
+        item["visible_samples"] = t.visible_samples;
+    }
+    return item;
+}
+
+nlohmann::json timings_json(const SceneCullTimings& ms) {
+    return {{"select", ms.select_ms}, {"render", ms.render_ms}, {"maps", ms.maps_ms}, {"tests", ms.test_ms}};
+}
+
+nlohmann::json work_json(const SceneCullWork& w) {
+    return {{"occluder_objects", w.occluder_objects}, {"occluder_triangles", w.occluder_triangles}, {"renders", w.renders},
+            {"nodes_tested", w.nodes_tested},         {"objects_tested", w.objects_tested}};
+}
+
+}  // namespace homcull::cli

@@ -1,0 +1,17 @@
+#pragma once
+// The JSON pieces `cull` and `walk` both print: per-object results in DESIGN.md's format,
+// stage timings, the culler's work.
+#include <homcull/scene_culler.hpp>
+#include <homcull/truth/ground_truth.hpp>
+
+#include <nlohmann/json.hpp>
+
+namespace homcull::cli {
+
+// {"id","name","triangles","result","level_of_visibility"[,"overlap"][,"truth","visible_samples"]}
+nlohmann::json object_result_json(const Scene& scene, std::size_t id, const OccludeeAnswer& answer, const TruthResult* truth);
+// {"select","render","maps","tests"} in milliseconds.
+nlohmann::json timings_json(const SceneCullTimings& ms);
+nlohmann::json work_json(const SceneCullWork& work);
+
+}  // namespace homcull::cli
