@@ -12,6 +12,7 @@ packages=(
   libhwy-dev                      # SIMD with runtime dispatch (rasterizer)
   libmeshoptimizer-dev            # occluder simplification
   libcli11-dev nlohmann-json3-dev libfmt-dev
+  jq                              # scripts/walk-results.sh reads the walk JSON
   libtinygltf-dev                 # glTF/GLB import and export (keeps node order and extras)
   assimp-testmodels               # test data: the IFC source of fzk_haus.glb, for the IFC import test
   libgtest-dev libgmock-dev libbenchmark-dev

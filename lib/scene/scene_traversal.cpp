@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace homcull {
 namespace {
@@ -15,6 +16,12 @@ namespace {
 // Squared distance from the eye to a box (0 inside it): the traversal's front-to-back key.
 float distance2_to_box(const glm::dvec3& eye, const Aabb& box) {
     const glm::dvec3 d = eye - glm::clamp(eye, glm::dvec3(box.min), glm::dvec3(box.max));
+    return float(glm::dot(d, d));
+}
+
+// Squared distance from the eye to the farthest corner of a box.
+float farthest_distance2(const glm::dvec3& eye, const Aabb& box) {
+    const glm::dvec3 d = glm::max(glm::abs(eye - glm::dvec3(box.min)), glm::abs(eye - glm::dvec3(box.max)));
     return float(glm::dot(d, d));
 }
 
@@ -33,16 +40,23 @@ void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answ
     const auto nearest_first = [](const std::pair<float, std::uint32_t>& a, const std::pair<float, std::uint32_t>& b) {
         return a.first > b.first;
     };
-    const std::size_t batch = config_.progressive_batch_triangles;
+    // progressive: the waiting occluders are drawn when `batch` triangles wait, or earlier (from
+    // a sixteenth of that) once traversal reaches a node wholly beyond one of them: only then
+    // can they hide what comes next. Each draw costs a rebuild of the maps.
+    const std::size_t batch = config_.progressive_batch_triangles, early_batch = std::max<std::size_t>(1, batch / 16);
+    float waiting_nearest_far = std::numeric_limits<float>::infinity();  // squared, of the waiting occluders
     node_heap_.clear();
     if (!hierarchy_.nodes.empty()) node_heap_.emplace_back(0.0f, 0u);
     while (!node_heap_.empty()) {
         std::pop_heap(node_heap_.begin(), node_heap_.end(), nearest_first);
         const ObjectHierarchy::Node& node = hierarchy_.nodes[node_heap_.back().second];
+        const float node_key = node_heap_.back().first;
         node_heap_.pop_back();
-        if (progressive && frame_shared_.size() - frame_rendered_ >= batch) {
+        const std::size_t waiting = frame_shared_.size() - frame_rendered_;
+        if (progressive && (waiting >= batch || (waiting >= early_batch && node_key > waiting_nearest_far))) {
             render_pending(frame, parallel);
             build_maps(frame);
+            waiting_nearest_far = std::numeric_limits<float>::infinity();
         }
         if (config_.hierarchy && node.end - node.begin > 1) {
             const OccludeeAnswer a = maps_.test_aabb(node.bounds, frame.clip);
@@ -65,8 +79,10 @@ void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answ
             answers[id] = test_object(frame, id);
             // progressive: a visible candidate is drawn with the next batch, within the budget.
             if (progressive && answers[id].visibility == Visibility::visible && candidate_of_[id] != kNone &&
-                work_.occluder_triangles + scene_->triangle_count(scene_->objects[id]) <= budget)
+                work_.occluder_triangles + scene_->triangle_count(scene_->objects[id]) <= budget) {
                 append_occluder(id, own_shared_edges_);
+                waiting_nearest_far = std::min(waiting_nearest_far, farthest_distance2(frame.camera->eye, scene_->objects[id].world_bounds));
+            }
         }
     }
     timings_.test_ms = ms_since(start) - (timings_.render_ms + timings_.maps_ms - flushes_before);
