@@ -119,6 +119,54 @@ TEST(Cli, PathFileFramesDriveTheCamera) {
     EXPECT_EQ(nlohmann::json::parse(r.out)["frames"].size(), 8u);
 }
 
+TEST(Cli, WalkReportsEveryFrameAndASummary) {
+    const std::string dir = test::temp_dir("cli_walk");
+    CliRun r = run_cli("path --scene gen:city:seed=2,blocks=3 --kind walk --frames 6 --out " + dir + "/walk.json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const char* strategy : {"one-pass", "progressive", "temporal"}) {
+        r = run_cli("walk --scene gen:city:seed=2,blocks=3 --path " + dir + "/walk.json --resolution 96x54 --strategy " + strategy +
+                    " --json");
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_MENTIONS(r.err, "frame 6/6");  // the progress bar
+        const auto j = nlohmann::json::parse(r.out);
+        ASSERT_EQ(j["frames"].size(), 6u);
+        EXPECT_EQ(j["strategy"], strategy);
+        for (const auto& frame : j["frames"]) {
+            for (const char* key : {"objects_total", "objects_after_frustum", "objects_after_occlusion", "objects_exactly_visible",
+                                    "triangles_total",
+                                    "triangles_after_frustum", "triangles_after_occlusion", "triangles_exactly_visible", "false_culls",
+                                    "missed_culls", "render_ms", "maps_ms", "tests_ms", "select_ms", "truth_ms", "timings_ms", "work"})
+                EXPECT_TRUE(frame.contains(key)) << key;
+            EXPECT_EQ(frame["false_culls"], 0);
+            const auto& objects = frame["objects"];
+            ASSERT_TRUE(objects.is_array());
+            ASSERT_EQ(objects.size(), frame["objects_total"].get<std::size_t>());
+            std::size_t kept = 0;
+            for (const auto& o : objects) {
+                for (const char* key : {"id", "name", "triangles", "result", "truth"}) EXPECT_TRUE(o.contains(key)) << key;
+                kept += o["result"] == "visible";
+            }
+            EXPECT_EQ(frame["objects_after_occlusion"].get<double>(), double(kept));
+        }
+        for (const char* key : {"cull_ms", "render_ms", "objects_after_occlusion", "false_culls"}) {
+            EXPECT_TRUE(j["summary"][key].contains("mean")) << key;
+            EXPECT_TRUE(j["summary"][key].contains("max")) << key;
+        }
+        EXPECT_EQ(j["summary"]["total_false_culls"], 0);
+        EXPECT_EQ(j["summary"]["frames"], 6);
+    }
+    r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/missing.json");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "missing.json");
+    r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --strategy twice");
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_MENTIONS(r.err, "--strategy");
+    r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --resolution 96x54 --truth off --quiet");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    EXPECT_MENTIONS(r.out, "cull_ms");
+}
+
 TEST(Cli, ExportThenInfoGivesTheSameScene) {
     const std::string dir = test::temp_dir("cli_export");
     CliRun r = run_cli("export --scene gen:forest:radius=15 --out " + dir + "/forest.glb");

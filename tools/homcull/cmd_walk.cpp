@@ -35,10 +35,10 @@ struct WalkCommandOptions {
 // A frame's figures by name, in print order: what the summary averages and maximizes.
 std::vector<std::pair<const char*, double>> frame_figures(const WalkFrame& f) {
     std::vector<std::pair<const char*, double>> v = {
-        {"objects", double(f.objects.total)},
+        {"objects_total", double(f.objects.total)},
         {"objects_after_frustum", double(f.objects.after_frustum)},
         {"objects_after_occlusion", double(f.objects.after_occlusion)},
-        {"triangles", double(f.triangles.total)},
+        {"triangles_total", double(f.triangles.total)},
         {"triangles_after_frustum", double(f.triangles.after_frustum)},
         {"triangles_after_occlusion", double(f.triangles.after_occlusion)},
         {"occluder_objects", double(f.work.occluder_objects)},
