@@ -114,16 +114,17 @@ void run_walk(const WalkCommandOptions& o) {
 
     // Summary: mean and max of every figure, and the path's totals.
     nlohmann::json summary = {{"frames", measured.size()}};
-    const auto names = frame_figures(measured.front());
-    for (std::size_t i = 0; i < names.size(); ++i) {
-        double sum = 0.0, most = 0.0;
-        for (const WalkFrame& f : measured) {
-            const double v = frame_figures(f)[i].second;
-            sum += v;
-            most = std::max(most, v);
+    auto names = frame_figures(measured.front());
+    std::vector<double> sum(names.size(), 0.0), most(names.size(), 0.0);
+    for (const WalkFrame& f : measured) {
+        const auto figures = frame_figures(f);  // once per frame
+        for (std::size_t i = 0; i < figures.size(); ++i) {
+            sum[i] += figures[i].second;
+            most[i] = std::max(most[i], figures[i].second);
         }
-        summary[names[i].first] = {{"mean", sum / double(measured.size())}, {"max", most}};
     }
+    for (std::size_t i = 0; i < names.size(); ++i)
+        summary[names[i].first] = {{"mean", sum[i] / double(measured.size())}, {"max", most[i]}};
     std::size_t false_culls = 0, robust_false_culls = 0, hidden = 0, missed = 0;
     for (const WalkFrame& f : measured) {
         false_culls += f.false_culls;

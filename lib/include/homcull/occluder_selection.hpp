@@ -34,9 +34,9 @@ enum class OccluderRanking : std::uint8_t {
 
 struct OccluderBudget {
     OccluderRanking ranking = OccluderRanking::none;
-    // With a ranking: at most this many triangles per frame; 0 = no limit (every candidate in
-    // the frustum). Ranked objects that do not fit what is left are skipped, smaller ones
-    // after them may still fit.
+    // At most this many triangles per frame, taken in rank order (id order with `none`);
+    // 0 = no limit (every candidate in the frustum). Objects that do not fit what is left are
+    // skipped, smaller ones after them may still fit.
     std::size_t triangles = 0;
 };
 
