@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <sys/wait.h>
 
 namespace homcull {
@@ -165,6 +166,48 @@ TEST(Cli, WalkReportsEveryFrameAndASummary) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(r.err, "");
     EXPECT_MENTIONS(r.out, "cull_ms");
+}
+
+TEST(Cli, BakeInShardsMergeAndWalkWithTheBakedRanking) {
+    const std::string dir = test::temp_dir("cli_bake");
+    const std::string scene = "--scene gen:city:seed=2,blocks=3";
+    CliRun r = run_cli("bake " + scene + " --spacing 4 --rays 128 --quiet --out " + dir + "/whole.json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_MENTIONS(r.out, "points in");
+    for (const char* shard : {"0", "1"}) {
+        r = run_cli("bake " + scene + " --spacing 4 --rays 128 --shard " + shard + "/2 --out " + dir + "/part" + shard + ".json");
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_MENTIONS(r.err, "baking column");  // progress
+    }
+    r = run_cli("bake --merge " + dir + "/part1.json " + dir + "/part0.json --out " + dir + "/merged.json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto whole = nlohmann::json::parse(std::ifstream(dir + "/whole.json"));
+    const auto merged = nlohmann::json::parse(std::ifstream(dir + "/merged.json"));
+    EXPECT_EQ(whole, merged);
+
+    r = run_cli("path " + scene + " --frames 4 --out " + dir + "/walk.json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_cli("walk " + scene + " --path " + dir + "/walk.json --resolution 96x54 --rank baked --grid " + dir +
+                "/merged.json --budget 500 --quiet --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["rank"], "baked");
+    EXPECT_EQ(j["summary"]["total_false_culls"], 0);
+    EXPECT_LE(j["summary"]["occluder_triangles"]["max"].get<double>(), 500.0);
+
+    // Bad input: a shard beyond its count, a missing shard, a ranking without its grid, a shard as a grid.
+    r = run_cli("bake " + scene + " --shard 2/2 --out " + dir + "/x.json");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--shard");
+    r = run_cli("bake --merge " + dir + "/part0.json --out " + dir + "/x.json");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "shard 1 of 2 is missing");
+    r = run_cli("walk " + scene + " --path " + dir + "/walk.json --rank baked");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--grid");
+    r = run_cli("walk " + scene + " --path " + dir + "/walk.json --rank baked --grid " + dir + "/part0.json");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "merge the shards first");
 }
 
 TEST(Cli, ExportThenInfoGivesTheSameScene) {

@@ -1,5 +1,6 @@
 #include <homcull/occluder_selection.hpp>
 
+#include <homcull/error.hpp>
 #include <homcull/frustum.hpp>
 #include <homcull/world_triangles.hpp>
 
@@ -38,6 +39,8 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
                     const OccluderBudget& budget, std::vector<std::uint32_t>& chosen,
                     std::vector<std::pair<float, std::uint32_t>>& scratch) {
     chosen.clear();
+    if (budget.ranking == OccluderRanking::baked && !budget.grid) throw Error("baked occluder ranking needs a visibility grid");
+    const GridPoint* point = budget.ranking == OccluderRanking::baked ? budget.grid->nearest(camera.eye) : nullptr;
     const Frustum frustum = make_frustum(camera, aspect);
     scratch.clear();
     for (std::uint32_t id : candidates) {
@@ -50,6 +53,9 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
         if (budget.ranking == OccluderRanking::area) {
             const double diagonal = glm::length(glm::dvec3(box.extent()));
             key = -(diagonal * diagonal) / (distance * distance);
+        } else if (point) {
+            // Listed occluders first, by decreasing score (negative keys), then the rest by distance.
+            if (const std::uint32_t score = budget.grid->score(*point, id)) key = -double(score) / double(scene.triangle_count(scene.objects[id]));
         }
         scratch.emplace_back(float(key), id);
     }

@@ -27,8 +27,9 @@ namespace {
 
 template <class Options>
 void run_scene_accuracy(const Options& o) {
-    const SceneCullerConfig config = scene_culler_config(o.cull);
+    SceneCullerConfig config = scene_culler_config(o.cull);
     const Scene scene = load_scene(o.scene);
+    const auto grid = attach_visibility_grid(o.cull, scene, config);
     const RayScene rays(scene);
     CameraPath views;
     if (!o.path.empty()) views = read_camera_path(o.path);
@@ -105,7 +106,7 @@ void register_accuracy(CLI::App& app) {
     cmd->callback([o, cmd] {
         if (o->scene.empty())  // S1 has its own buffer and no scene: these would be silently ignored
             for (const char* name : {"--path", "--walk", "--orbit", "--buffer", "--mode", "--hole", "--distribution", "--transparency",
-                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--strategy", "--rank", "--budget", "--batch",
+                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--strategy", "--rank", "--grid", "--budget", "--batch",
                                      "--hierarchy"})
                 if (cmd->get_option(name)->count() > 0) throw Error(std::string("accuracy: ") + name + " needs --scene");
         if (!o->scene.empty()) {

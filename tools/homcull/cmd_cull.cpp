@@ -31,9 +31,10 @@ struct CullCommandOptions {
 void run_cull(const CullCommandOptions& o) {
     select_isa(o.isa);
     const Camera camera = resolve_camera(o.camera);
-    const SceneCullerConfig config = scene_culler_config(o.cull);
+    SceneCullerConfig config = scene_culler_config(o.cull);
     long long start = now_ns();
     const Scene scene = load_scene(o.scene);
+    const auto grid = attach_visibility_grid(o.cull, scene, config);
     const double load_ms = elapsed_ms(start);
     start = now_ns();
     const std::vector<std::uint32_t> occluders = choose_occluders(scene, o.cull.occluders);

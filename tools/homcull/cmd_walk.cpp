@@ -70,8 +70,9 @@ void print_progress(std::size_t done, std::size_t total) {
 
 void run_walk(const WalkCommandOptions& o) {
     select_isa(o.isa);
-    const SceneCullerConfig config = scene_culler_config(o.cull);
+    SceneCullerConfig config = scene_culler_config(o.cull);
     const Scene scene = load_scene(o.scene);
+    const auto grid = attach_visibility_grid(o.cull, scene, config);
     const CameraPath path = read_camera_path(o.path);
     if (path.frames.empty()) throw Error("camera path " + o.path + " has no frames");
     SceneCuller culler(scene, choose_occluders(scene, o.cull.occluders), config);
@@ -143,6 +144,7 @@ void run_walk(const WalkCommandOptions& o) {
                                     {"path", o.path},
                                     {"strategy", o.cull.strategy},
                                     {"rank", o.cull.rank},
+                                    {"grid", o.cull.grid},
                                     {"budget", o.cull.budget},
                                     {"hierarchy", o.cull.hierarchy},
                                     {"display", {config.display.width, config.display.height}},

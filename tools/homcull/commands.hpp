@@ -12,5 +12,6 @@ void register_bench(CLI::App& app);
 void register_accuracy(CLI::App& app);
 void register_cull(CLI::App& app);
 void register_walk(CLI::App& app);
+void register_bake(CLI::App& app);
 
 }  // namespace homcull::cli

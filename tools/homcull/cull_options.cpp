@@ -3,6 +3,9 @@
 #include "options.hpp"
 
 #include <homcull/error.hpp>
+#include <homcull/io/visibility_grid_io.hpp>
+
+#include <cstdio>
 
 
 namespace homcull::cli {
@@ -40,8 +43,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
                    "to back) or temporal (last frame's visible candidates plus those new in the frustum)")
         ->capture_default_str()->check(CLI::IsMember({"one-pass", "progressive", "temporal"}));
-    app.add_option("--rank", o.rank, "Per-frame ranking of the candidates in the frustum under --budget: none, distance or area")
-        ->capture_default_str()->check(CLI::IsMember({"none", "distance", "area"}));
+    app.add_option("--rank", o.rank, "Per-frame ranking of the candidates in the frustum under --budget: none, distance, area, or "
+                                     "baked (the --grid point nearest the eye)")
+        ->capture_default_str()->check(CLI::IsMember({"none", "distance", "area", "baked"}));
+    app.add_option("--grid", o.grid, "Visibility grid for --rank baked (homcull bake)");
     app.add_option("--budget", o.budget, "Occluder triangles per frame at most (0: no limit)")->capture_default_str();
     app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
         ->capture_default_str()->check(CLI::PositiveNumber);
@@ -73,7 +78,9 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.strategy = o.strategy == "progressive" ? CullStrategy::progressive : o.strategy == "temporal" ? CullStrategy::temporal
                                                                                                  : CullStrategy::one_pass;
     c.occluder_budget.ranking = o.rank == "distance" ? OccluderRanking::distance : o.rank == "area" ? OccluderRanking::area
-                                                                                                : OccluderRanking::none;
+                              : o.rank == "baked"  ? OccluderRanking::baked
+                                                   : OccluderRanking::none;
+    if ((o.rank == "baked") != !o.grid.empty()) throw Error("--rank baked and --grid FILE (from homcull bake) go together");
     c.occluder_budget.triangles = o.budget;
     c.progressive_batch_triangles = o.batch;
     c.hierarchy = o.hierarchy == "on";
@@ -82,6 +89,16 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
 
 std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice) {
     return occluder_candidates(scene, choice == "all" ? OccluderFilter::all : choice == "auto" ? OccluderFilter::size : OccluderFilter::role);
+}
+
+std::unique_ptr<VisibilityGrid> attach_visibility_grid(const CullOptions& o, const Scene& scene, SceneCullerConfig& config) {
+    if (o.rank != "baked") return nullptr;
+    auto grid = std::make_unique<VisibilityGrid>(read_visibility_grid(o.grid, scene));
+    if (grid->header.occluders != o.occluders)
+        std::fprintf(stderr, "homcull: warning: %s was baked for --occluders %s, ranking --occluders %s\n", o.grid.c_str(),
+                     grid->header.occluders.c_str(), o.occluders.c_str());
+    config.occluder_budget.grid = grid.get();
+    return grid;
 }
 
 const char* visibility_name(Visibility v) {

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,7 @@ struct CullOptions {
     double hole = 0.0, distribution = 1.0, transparency = 0.0;
     int finest_level = 0, coarsest_level = -1;
     std::string deb = "64x64", occludees = "auto", sample_depth = "on";
-    std::string strategy = "one-pass", rank = "none", hierarchy = "on";
+    std::string strategy = "one-pass", rank = "none", hierarchy = "on", grid;
     std::size_t budget = 0, batch = 1024;
 };
 
@@ -30,6 +31,9 @@ SceneCullerConfig scene_culler_config(const CullOptions& options);
 // marks occluders, otherwise objects whose box diagonal is at least 2 % of the scene's
 // (Zhang's static size filter).
 std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice);
+// --rank baked: reads --grid for this scene and points config.occluder_budget.grid at it (the
+// returned grid must outlive the culler). Otherwise returns null.
+std::unique_ptr<VisibilityGrid> attach_visibility_grid(const CullOptions& options, const Scene& scene, SceneCullerConfig& config);
 
 const char* visibility_name(Visibility v);
 const char* overlap_exit_name(OverlapExit e);

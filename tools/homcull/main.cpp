@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     homcull::cli::register_accuracy(app);
     homcull::cli::register_cull(app);
     homcull::cli::register_walk(app);
+    homcull::cli::register_bake(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

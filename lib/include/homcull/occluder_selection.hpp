@@ -9,6 +9,7 @@
 // geometry, so every answer stays conservative.
 #include <homcull/camera.hpp>
 #include <homcull/scene.hpp>
+#include <homcull/visibility_grid.hpp>
 
 #include <cstdint>
 #include <utility>
@@ -30,6 +31,8 @@ enum class OccluderRanking : std::uint8_t {
     none,      // every candidate, every frame (no per-frame work)
     distance,  // nearest box first (Zhang's distance-based selection under a polygon budget)
     area,      // largest projected size first: box diagonal over distance, squared
+    baked,     // the order of the visibility grid's point nearest to the eye (Zhang 7.5), then
+               // the candidates that point does not list, nearest first
 };
 
 struct OccluderBudget {
@@ -38,6 +41,8 @@ struct OccluderBudget {
     // 0 = no limit (every candidate in the frustum). Objects that do not fit what is left are
     // skipped, smaller ones after them may still fit.
     std::size_t triangles = 0;
+    // baked: the grid (not owned; it must outlive the ranking's users).
+    const VisibilityGrid* grid = nullptr;
 };
 
 // Per frame: the candidates whose box meets the camera's frustum (plane test), in rank
