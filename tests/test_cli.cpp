@@ -188,10 +188,11 @@ TEST(Cli, BakeInShardsMergeAndWalkWithTheBakedRanking) {
     r = run_cli("path " + scene + " --frames 4 --out " + dir + "/walk.json");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     r = run_cli("walk " + scene + " --path " + dir + "/walk.json --resolution 96x54 --rank baked --grid " + dir +
-                "/merged.json --budget 500 --quiet --json");
+                "/merged.json --budget 500 --lod on --quiet --json");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["rank"], "baked");
+    EXPECT_EQ(j["lod"], "on");
     EXPECT_EQ(j["summary"]["total_false_culls"], 0);
     EXPECT_LE(j["summary"]["occluder_triangles"]["max"].get<double>(), 500.0);
 

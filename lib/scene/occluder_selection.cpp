@@ -37,7 +37,7 @@ double distance_to_box(const glm::dvec3& p, const Aabb& box) {
 
 void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candidates, const Camera& camera, double aspect,
                     const OccluderBudget& budget, std::vector<std::uint32_t>& chosen,
-                    std::vector<std::pair<float, std::uint32_t>>& scratch) {
+                    std::vector<std::pair<float, std::uint32_t>>& scratch, const OccluderLods* lods) {
     chosen.clear();
     if (budget.ranking == OccluderRanking::baked && !budget.grid) throw Error("baked occluder ranking needs a visibility grid");
     const GridPoint* point = budget.ranking == OccluderRanking::baked ? budget.grid->nearest(camera.eye) : nullptr;
@@ -54,19 +54,29 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
             const double diagonal = glm::length(glm::dvec3(box.extent()));
             key = -(diagonal * diagonal) / (distance * distance);
         } else if (point) {
-            // Listed occluders first, by decreasing score (negative keys), then the rest by distance.
-            if (const std::uint32_t score = budget.grid->score(*point, id)) key = -double(score) / double(scene.triangle_count(scene.objects[id]));
+            // Listed occluders first, by decreasing score per triangle drawn (the most hidden for
+            // the budget; negative keys), then the rest by distance.
+            if (const std::uint32_t score = budget.grid->score(*point, id))
+                key = -double(score) / double(occluder_triangles_drawn(scene, id, camera, lods));
         }
         scratch.emplace_back(float(key), id);
     }
     if (budget.ranking != OccluderRanking::none) std::sort(scratch.begin(), scratch.end());
     std::size_t left = budget.triangles == 0 ? ~std::size_t(0) : budget.triangles;
     for (const auto& [key, id] : scratch) {
-        const std::size_t n = scene.triangle_count(scene.objects[id]);
+        const std::size_t n = occluder_triangles_drawn(scene, id, camera, lods);
         if (n > left) continue;
         chosen.push_back(id);
         left -= n;
     }
+}
+
+std::size_t occluder_triangles_drawn(const Scene& scene, std::uint32_t id, const Camera& camera, const OccluderLods* lods) {
+    const Object& object = scene.objects[id];
+    if (lods)
+        if (const OccluderLod* lod = lods->lod_of(object.mesh); lod && lod_usable(object.world_bounds, camera))
+            return lod->mesh.triangle_count();
+    return scene.triangle_count(object);
 }
 
 }  // namespace homcull

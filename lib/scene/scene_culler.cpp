@@ -78,6 +78,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
         compute_shared_edges(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
                              occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first);
     }
+    gather_lods();
     frame_occluders_.reserve(occluders.size());
     frame_indices_.reserve(occluders_.indices.size());
     frame_shared_.reserve(occluders_.triangle_count());
@@ -147,22 +148,64 @@ void SceneCuller::select_occluders(const Frame& frame) {
             if (last_visibility_[id] != Visibility::occluded) temporal_pool_.push_back(id);
         pool = &temporal_pool_;
     }
-    rank_occluders(*scene_, *pool, *frame.camera, config_.display.aspect(), config_.occluder_budget, ranked_, rank_scratch_);
-    const bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0;
+    rank_occluders(*scene_, *pool, *frame.camera, config_.display.aspect(), config_.occluder_budget, ranked_, rank_scratch_,
+                   config_.lods);
+    // Cross-object flags also need every neighbour drawn as itself, not as an LOD.
+    bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0;
+    for (std::size_t i = 0; i < ranked_.size() && every_candidate_in_frustum; ++i)
+        every_candidate_in_frustum = !draws_lod(ranked_[i], *frame.camera);
     const std::vector<std::uint8_t>& flags = every_candidate_in_frustum ? occluders_.shared_edges : own_shared_edges_;
-    for (std::uint32_t id : ranked_) append_occluder(id, flags);
+    for (std::uint32_t id : ranked_) append_occluder(id, *frame.camera, flags);
     timings_.select_ms += ms_since(start);
 }
 
-void SceneCuller::append_occluder(std::uint32_t id, const std::vector<std::uint8_t>& shared_edges) {
-    const std::uint32_t k = candidate_of_[id];
-    frame_occluders_.push_back(id);
-    for (std::uint32_t t = first_triangle_[k]; t < first_triangle_[k + 1]; ++t) {
-        frame_indices_.insert(frame_indices_.end(), occluders_.indices.begin() + 3 * t, occluders_.indices.begin() + 3 * t + 3);
-        frame_shared_.push_back(shared_edges[t]);
+// The LODs' triangles in world space, after the candidates' own vertices, placed exactly as the
+// originals are (transform_point), with shared-edge flags within each LOD.
+void SceneCuller::gather_lods() {
+    lod_first_.assign(occluder_ids_.size() + 1, 0);
+    if (!config_.lods) return;
+    if (config_.lods->lod_of_mesh.size() != scene_->meshes.size())
+        throw Error("the occluder LODs were built for another scene (" + std::to_string(config_.lods->lod_of_mesh.size()) +
+                    " meshes, " + scene_->source + " has " + std::to_string(scene_->meshes.size()) + ")");
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+        const Object& object = scene_->objects[occluder_ids_[k]];
+        lod_first_[k + 1] = lod_first_[k];
+        const OccluderLod* lod = config_.lods->lod_of(object.mesh);
+        if (!lod || lod->mesh.triangle_count() == 0) continue;
+        const auto base = std::uint32_t(occluders_.positions.size() / 3);
+        for (const glm::vec3& p : lod->mesh.positions) {
+            const glm::vec3 w = transform_point(object.world, p);
+            occluders_.positions.insert(occluders_.positions.end(), {w.x, w.y, w.z});
+        }
+        for (std::uint32_t index : lod->mesh.indices) lod_indices_.push_back(base + index);
+        lod_first_[k + 1] += std::uint32_t(lod->mesh.triangle_count());
     }
+    lod_shared_edges_.resize(lod_indices_.size() / 3);
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+        const std::size_t first = lod_first_[k], count = lod_first_[k + 1] - first;
+        if (count == 0) continue;
+        compute_shared_edges(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
+                             lod_indices_.data() + 3 * first, count, lod_shared_edges_.data() + first);
+    }
+}
+
+bool SceneCuller::draws_lod(std::uint32_t id, const Camera& camera) const {
+    const std::uint32_t k = candidate_of_[id];
+    return lod_first_[k] < lod_first_[k + 1] && lod_usable(scene_->objects[id].world_bounds, camera);
+}
+
+void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, const std::vector<std::uint8_t>& shared_edges) {
+    const std::uint32_t k = candidate_of_[id];
+    const bool lod = draws_lod(id, camera);
+    const std::vector<std::uint32_t>& indices = lod ? lod_indices_ : occluders_.indices;
+    const std::vector<std::uint8_t>& flags = lod ? lod_shared_edges_ : shared_edges;
+    const std::uint32_t first = lod ? lod_first_[k] : first_triangle_[k], last = lod ? lod_first_[k + 1] : first_triangle_[k + 1];
+    frame_occluders_.push_back(id);
+    frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::size_t(first), indices.begin() + 3 * std::size_t(last));
+    frame_shared_.insert(frame_shared_.end(), flags.begin() + first, flags.begin() + last);
     ++work_.occluder_objects;
-    work_.occluder_triangles += first_triangle_[k + 1] - first_triangle_[k];
+    work_.occluder_triangles += last - first;
+    work_.occluder_lods += lod;
 }
 
 // The triangles of frame_indices_ not rendered yet.

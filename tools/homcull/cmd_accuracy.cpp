@@ -29,7 +29,7 @@ template <class Options>
 void run_scene_accuracy(const Options& o) {
     SceneCullerConfig config = scene_culler_config(o.cull);
     const Scene scene = load_scene(o.scene);
-    const auto grid = attach_visibility_grid(o.cull, scene, config);
+    const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const RayScene rays(scene);
     CameraPath views;
     if (!o.path.empty()) views = read_camera_path(o.path);
@@ -44,7 +44,7 @@ void run_scene_accuracy(const Options& o) {
     } else {
         throw Error("accuracy --scene needs views: --path P, --walk N or --orbit N");
     }
-    SceneCuller culler(scene, choose_occluders(scene, o.cull.occluders), config);
+    SceneCuller culler(scene, resources.occluders, config);
     const Resolution display = config.display;
     const BufferConfig& buffer = culler.buffer().config();
     CullingTally tally;
@@ -106,7 +106,7 @@ void register_accuracy(CLI::App& app) {
     cmd->callback([o, cmd] {
         if (o->scene.empty())  // S1 has its own buffer and no scene: these would be silently ignored
             for (const char* name : {"--path", "--walk", "--orbit", "--buffer", "--mode", "--hole", "--distribution", "--transparency",
-                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--strategy", "--rank", "--grid", "--budget", "--batch",
+                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--strategy", "--rank", "--grid", "--lod", "--budget", "--batch",
                                      "--hierarchy"})
                 if (cmd->get_option(name)->count() > 0) throw Error(std::string("accuracy: ") + name + " needs --scene");
         if (!o->scene.empty()) {

@@ -34,10 +34,10 @@ void run_cull(const CullCommandOptions& o) {
     SceneCullerConfig config = scene_culler_config(o.cull);
     long long start = now_ns();
     const Scene scene = load_scene(o.scene);
-    const auto grid = attach_visibility_grid(o.cull, scene, config);
     const double load_ms = elapsed_ms(start);
     start = now_ns();
-    const std::vector<std::uint32_t> occluders = choose_occluders(scene, o.cull.occluders);
+    const CullResources resources = prepare_cull_resources(o.cull, scene, config);
+    const std::vector<std::uint32_t>& occluders = resources.occluders;
     SceneCuller culler(scene, occluders, config);
     const double setup_ms = elapsed_ms(start);
     std::vector<OccludeeAnswer> answers;

@@ -72,10 +72,10 @@ void run_walk(const WalkCommandOptions& o) {
     select_isa(o.isa);
     SceneCullerConfig config = scene_culler_config(o.cull);
     const Scene scene = load_scene(o.scene);
-    const auto grid = attach_visibility_grid(o.cull, scene, config);
+    const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const CameraPath path = read_camera_path(o.path);
     if (path.frames.empty()) throw Error("camera path " + o.path + " has no frames");
-    SceneCuller culler(scene, choose_occluders(scene, o.cull.occluders), config);
+    SceneCuller culler(scene, resources.occluders, config);
     std::unique_ptr<RayScene> rays;
     if (o.truth == "on") rays = std::make_unique<RayScene>(scene);
     TruthOptions truth_options;
@@ -145,6 +145,7 @@ void run_walk(const WalkCommandOptions& o) {
                                     {"strategy", o.cull.strategy},
                                     {"rank", o.cull.rank},
                                     {"grid", o.cull.grid},
+                                    {"lod", o.cull.lod},
                                     {"budget", o.cull.budget},
                                     {"hierarchy", o.cull.hierarchy},
                                     {"display", {config.display.width, config.display.height}},

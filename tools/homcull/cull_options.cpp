@@ -4,6 +4,7 @@
 
 #include <homcull/error.hpp>
 #include <homcull/io/visibility_grid_io.hpp>
+#include <homcull/truth/occluder_lod_build.hpp>
 
 #include <cstdio>
 
@@ -47,6 +48,9 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                                      "baked (the --grid point nearest the eye)")
         ->capture_default_str()->check(CLI::IsMember({"none", "distance", "area", "baked"}));
     app.add_option("--grid", o.grid, "Visibility grid for --rank baked (homcull bake)");
+    app.add_option("--lod", o.lod, "on: draw occluders with simplified, verified-inner LODs (meshoptimizer) where their box lies "
+                                   "beyond the near plane; never hides more than the originals")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--budget", o.budget, "Occluder triangles per frame at most (0: no limit)")->capture_default_str();
     app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
         ->capture_default_str()->check(CLI::PositiveNumber);
@@ -91,14 +95,21 @@ std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::strin
     return occluder_candidates(scene, choice == "all" ? OccluderFilter::all : choice == "auto" ? OccluderFilter::size : OccluderFilter::role);
 }
 
-std::unique_ptr<VisibilityGrid> attach_visibility_grid(const CullOptions& o, const Scene& scene, SceneCullerConfig& config) {
-    if (o.rank != "baked") return nullptr;
-    auto grid = std::make_unique<VisibilityGrid>(read_visibility_grid(o.grid, scene));
-    if (grid->header.occluders != o.occluders)
-        std::fprintf(stderr, "homcull: warning: %s was baked for --occluders %s, ranking --occluders %s\n", o.grid.c_str(),
-                     grid->header.occluders.c_str(), o.occluders.c_str());
-    config.occluder_budget.grid = grid.get();
-    return grid;
+CullResources prepare_cull_resources(const CullOptions& o, const Scene& scene, SceneCullerConfig& config) {
+    CullResources r;
+    r.occluders = choose_occluders(scene, o.occluders);
+    if (o.rank == "baked") {
+        r.grid = std::make_unique<VisibilityGrid>(read_visibility_grid(o.grid, scene));
+        if (r.grid->header.occluders != o.occluders)
+            std::fprintf(stderr, "homcull: warning: %s was baked for --occluders %s, ranking --occluders %s\n", o.grid.c_str(),
+                         r.grid->header.occluders.c_str(), o.occluders.c_str());
+        config.occluder_budget.grid = r.grid.get();
+    }
+    if (o.lod == "on") {
+        r.lods = std::make_unique<OccluderLods>(build_occluder_lods(scene, r.occluders));
+        config.lods = r.lods.get();
+    }
+    return r;
 }
 
 const char* visibility_name(Visibility v) {

@@ -18,7 +18,7 @@ struct CullOptions {
     double hole = 0.0, distribution = 1.0, transparency = 0.0;
     int finest_level = 0, coarsest_level = -1;
     std::string deb = "64x64", occludees = "auto", sample_depth = "on";
-    std::string strategy = "one-pass", rank = "none", hierarchy = "on", grid;
+    std::string strategy = "one-pass", rank = "none", hierarchy = "on", grid, lod = "off";
     std::size_t budget = 0, batch = 1024;
 };
 
@@ -31,9 +31,15 @@ SceneCullerConfig scene_culler_config(const CullOptions& options);
 // marks occluders, otherwise objects whose box diagonal is at least 2 % of the scene's
 // (Zhang's static size filter).
 std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice);
-// --rank baked: reads --grid for this scene and points config.occluder_budget.grid at it (the
-// returned grid must outlive the culler). Otherwise returns null.
-std::unique_ptr<VisibilityGrid> attach_visibility_grid(const CullOptions& options, const Scene& scene, SceneCullerConfig& config);
+// What a culler's configuration points at, loaded or built for one scene: it must outlive the culler.
+struct CullResources {
+    std::vector<std::uint32_t> occluders;  // the candidates (--occluders)
+    std::unique_ptr<VisibilityGrid> grid;  // --rank baked: --grid, read for this scene
+    std::unique_ptr<OccluderLods> lods;    // --lod on: built for the candidates
+};
+// Chooses the candidates, reads the grid and builds the LODs the options ask for, and points
+// `config` at them.
+CullResources prepare_cull_resources(const CullOptions& options, const Scene& scene, SceneCullerConfig& config);
 
 const char* visibility_name(Visibility v);
 const char* overlap_exit_name(OverlapExit e);

@@ -8,6 +8,7 @@
 // Selection decides only how much is hidden, never correctness: whatever is drawn is real
 // geometry, so every answer stays conservative.
 #include <homcull/camera.hpp>
+#include <homcull/occluder_lod.hpp>
 #include <homcull/scene.hpp>
 #include <homcull/visibility_grid.hpp>
 
@@ -31,8 +32,9 @@ enum class OccluderRanking : std::uint8_t {
     none,      // every candidate, every frame (no per-frame work)
     distance,  // nearest box first (Zhang's distance-based selection under a polygon budget)
     area,      // largest projected size first: box diagonal over distance, squared
-    baked,     // the order of the visibility grid's point nearest to the eye (Zhang 7.5), then
-               // the candidates that point does not list, nearest first
+    baked,     // the visibility grid's point nearest to the eye (Zhang 7.5): the occluders it
+               // lists by score per triangle (greedy knapsack order: the most hidden for the
+               // budget), then the candidates it does not list, nearest first
 };
 
 struct OccluderBudget {
@@ -47,9 +49,15 @@ struct OccluderBudget {
 
 // Per frame: the candidates whose box meets the camera's frustum (plane test), in rank
 // order, within the budget, into `chosen` (cleared first). `scratch` is reused across frames;
-// neither allocates once it has grown to the candidate count.
+// neither allocates once it has grown to the candidate count. With `lods`, an object counts
+// against the budget with the triangles it is drawn with: its LOD's where
+// occluder_triangles_drawn says so.
 void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candidates, const Camera& camera, double aspect,
                     const OccluderBudget& budget, std::vector<std::uint32_t>& chosen,
-                    std::vector<std::pair<float, std::uint32_t>>& scratch);
+                    std::vector<std::pair<float, std::uint32_t>>& scratch, const OccluderLods* lods = nullptr);
+
+// The triangles an occluder is drawn with this frame: its LOD's when it has one and
+// lod_usable() allows it, else its mesh's. `lods` may be null.
+std::size_t occluder_triangles_drawn(const Scene& scene, std::uint32_t id, const Camera& camera, const OccluderLods* lods);
 
 }  // namespace homcull

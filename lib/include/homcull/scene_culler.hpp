@@ -6,6 +6,7 @@
 // candidate occluders' triangles are set up once, and a frame allocates nothing once its
 // scratch has grown (the first frames).
 #include <homcull/object_hierarchy.hpp>
+#include <homcull/occluder_lod.hpp>
 #include <homcull/occluder_selection.hpp>
 #include <homcull/occlusion_maps.hpp>
 #include <homcull/scene.hpp>
@@ -67,6 +68,10 @@ struct SceneCullerConfig {
     // Test the hierarchy's inner nodes (off: only objects are tested, still front to back).
     bool hierarchy = true;
     int hierarchy_leaf_size = 4;
+    // Occluder LODs (not owned; build_occluder_lods in homcull/truth/occluder_lod_build.hpp,
+    // for this scene's candidates): an occluder is drawn with its LOD whenever lod_usable()
+    // allows it, which keeps every answer conservative (see occluder_lod.hpp). Null: never.
+    const OccluderLods* lods = nullptr;
 };
 
 // The shape `automatic` stands for with this configuration.
@@ -82,7 +87,8 @@ struct SceneCullTimings {
 // What the last cull() did.
 struct SceneCullWork {
     std::size_t occluder_objects = 0;    // objects rendered into the buffer
-    std::size_t occluder_triangles = 0;  // their triangles
+    std::size_t occluder_triangles = 0;  // their triangles (as drawn: LODs' where used)
+    std::size_t occluder_lods = 0;       // occluders drawn with their LOD
     std::size_t renders = 0;             // render calls (progressive: batches)
     std::size_t nodes_tested = 0;        // inner hierarchy nodes tested
     std::size_t objects_tested = 0;      // objects tested on their own (the rest answered by a node)
@@ -130,6 +136,11 @@ private:
     // Shared-edge flags within each object only: right for any subset of the candidates (an edge
     // shared with an object that is not drawn is a silhouette and needs its margin).
     std::vector<std::uint8_t> own_shared_edges_;
+    // Per candidate k: its LOD's triangles (indices into occluders_.positions, which hold the
+    // LODs' vertices after the originals') are lod_indices_[3 * lod_first_[k] .. 3 * lod_first_[k + 1]),
+    // with shared-edge flags within the LOD; an empty range when it has none.
+    std::vector<std::uint32_t> lod_first_, lod_indices_;
+    std::vector<std::uint8_t> lod_shared_edges_;
     ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
@@ -151,7 +162,10 @@ private:
     static constexpr std::uint32_t kNone = ~std::uint32_t(0);
     struct Frame;
     void select_occluders(const Frame& frame);
-    void append_occluder(std::uint32_t id, const std::vector<std::uint8_t>& shared_edges);
+    // Appends an occluder's triangles, its LOD's when it has one usable from this camera.
+    void append_occluder(std::uint32_t id, const Camera& camera, const std::vector<std::uint8_t>& shared_edges);
+    bool draws_lod(std::uint32_t id, const Camera& camera) const;
+    void gather_lods();
     void render_pending(const Frame& frame, const ParallelFor& parallel);
     void build_maps(const Frame& frame);
     void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
