@@ -78,6 +78,23 @@ TEST(Cli, CullJsonHasEveryObjectStagesAndTruth) {
     EXPECT_TRUE(j["overlap_exits"].contains("predictive_rejection"));
 }
 
+TEST(Cli, SoupCellsSplitLargeObjectsForEveryCommand) {
+    // The city's objects hold 12 to a few hundred triangles: at 8, the larger ones split.
+    CliRun r = run_cli("info --scene gen:city:seed=2,blocks=3 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::size_t whole = nlohmann::json::parse(r.out)["objects"].size();
+    r = run_cli("info --scene gen:city:seed=2,blocks=3 --soup-cells 8 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::size_t cells = nlohmann::json::parse(r.out)["objects"].size();
+    EXPECT_GT(cells, whole);
+    r = run_cli("cull " + kCityCamera + " --soup-cells 8 --truth --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["objects"].size(), cells);
+    EXPECT_EQ(j["truth"]["false_culls"], 0);
+    EXPECT_MENTIONS(j["scene"].get<std::string>(), "soup cells");
+}
+
 TEST(Cli, CullRejectsInconsistentOptions) {
     CliRun r = run_cli("cull " + kCityCamera + " --buffer 40x20");
     EXPECT_EQ(r.exit_code, 1);

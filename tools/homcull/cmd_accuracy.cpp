@@ -28,7 +28,7 @@ namespace {
 template <class Options>
 void run_scene_accuracy(const Options& o) {
     SceneCullerConfig config = scene_culler_config(o.cull);
-    const Scene scene = load_scene(o.scene);
+    const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const RayScene rays(scene);
     CameraPath views;
@@ -86,7 +86,8 @@ void run_scene_accuracy(const Options& o) {
 void register_accuracy(CLI::App& app) {
     struct Options {
         std::string resolution = "1920x1080", s1_folder = "../shared/workloads/s1";
-        std::string scene, path;
+        SceneChoice scene;
+        std::string path;
         int samples = 1, walk = 0, orbit = 0;
         CullOptions cull;  // --scene
         bool json = false;
@@ -97,19 +98,19 @@ void register_accuracy(CLI::App& app) {
     cmd->add_option("--samples", o->samples, "S x S samples per buffer pixel (1, 2 or 4); with --scene the buffer is display / S")
         ->capture_default_str();
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
-    cmd->add_option("--scene", o->scene, "Measure on a scene against Embree ground truth instead of S1");
+    add_scene_option(*cmd, o->scene, /*required=*/false, "Measure on a scene against Embree ground truth instead of S1");
     cmd->add_option("--path", o->path, "--scene: camera path whose frames are the views");
     cmd->add_option("--walk", o->walk, "--scene: views from a generated walk (N views, every 10th frame)");
     cmd->add_option("--orbit", o->orbit, "--scene: N views on an orbit");
     add_cull_options(*cmd, o->cull, /*with_display=*/false);  // --scene: --buffer, --mode, --hole, --depth, --occluders, ...
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o, cmd] {
-        if (o->scene.empty())  // S1 has its own buffer and no scene: these would be silently ignored
+        if (o->scene.file.empty())  // S1 has its own buffer and no scene: these would be silently ignored
             for (const char* name : {"--path", "--walk", "--orbit", "--buffer", "--mode", "--hole", "--distribution", "--transparency",
-                                     "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--strategy", "--rank", "--grid", "--lod", "--budget", "--batch",
+                                     "--soup-cells", "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--strategy", "--rank", "--grid", "--lod", "--budget", "--batch",
                                      "--hierarchy"})
                 if (cmd->get_option(name)->count() > 0) throw Error(std::string("accuracy: ") + name + " needs --scene");
-        if (!o->scene.empty()) {
+        if (!o->scene.file.empty()) {
             o->cull.resolution = o->resolution;
             o->cull.samples = o->samples;
             run_scene_accuracy(*o);

@@ -22,7 +22,8 @@ namespace homcull::cli {
 namespace {
 
 struct BakeCommandOptions {
-    std::string scene, occluders = "role", layout = "floors", shard = "0/1", out;
+    SceneChoice scene;
+    std::string occluders = "role", layout = "floors", shard = "0/1", out;
     double spacing = 0.0, eye_height = 0.0;
     std::uint32_t rays = 4096, keep = 128;
     int threads = 0;
@@ -58,14 +59,14 @@ void run_merge(const BakeCommandOptions& o) {
 
 void run_bake(const BakeCommandOptions& o) {
     if (!o.merge.empty()) {
-        if (!o.scene.empty()) throw Error("--merge takes the shards' files, not --scene");
+        if (!o.scene.file.empty()) throw Error("--merge takes the shards' files, not --scene");
         run_merge(o);
         return;
     }
-    if (o.scene.empty()) throw Error("bake needs --scene (or --merge with the shards' files)");
+    if (o.scene.file.empty()) throw Error("bake needs --scene (or --merge with the shards' files)");
     std::optional<tbb::global_control> limit;
     if (o.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
-    const Scene scene = load_scene(o.scene);
+    const Scene scene = load_chosen_scene(o.scene);
     BakeOptions b;
     b.candidates = choose_occluders(scene, o.occluders);
     b.candidates_name = o.occluders;
@@ -93,7 +94,7 @@ void register_bake(CLI::App& app) {
     auto o = std::make_shared<BakeCommandOptions>();
     CLI::App* cmd = app.add_subcommand("bake", "Bake a visibility grid: sample points in free space with the occluders seen from each, "
                                                "ranked by what they hide (for --rank baked)");
-    cmd->add_option("--scene", o->scene, "Scene file (glTF/GLB, OBJ, ...) or gen:city / gen:forest[:options]");
+    add_scene_option(*cmd, o->scene, /*required=*/false);
     cmd->add_option("--occluders", o->occluders, "Occluder candidates: role, all, or auto (as for cull)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
     cmd->add_option("--layout", o->layout, "floors: points at eye height above each floor (walkthroughs); volume: a 3D lattice of "

@@ -20,7 +20,7 @@ namespace homcull::cli {
 namespace {
 
 struct CullCommandOptions {
-    std::string scene;
+    SceneChoice scene;
     CameraOptions camera;
     CullOptions cull;
     std::string isa = "best";
@@ -33,7 +33,7 @@ void run_cull(const CullCommandOptions& o) {
     const Camera camera = resolve_camera(o.camera);
     SceneCullerConfig config = scene_culler_config(o.cull);
     long long start = now_ns();
-    const Scene scene = load_scene(o.scene);
+    const Scene scene = load_chosen_scene(o.scene);
     const double load_ms = elapsed_ms(start);
     start = now_ns();
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);

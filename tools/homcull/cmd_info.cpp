@@ -13,7 +13,7 @@ namespace homcull::cli {
 namespace {
 
 struct InfoOptions {
-    std::string scene;
+    SceneChoice scene;
     bool json = false;
 };
 
@@ -21,7 +21,7 @@ nlohmann::json vec3_json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 
 void run_info(const InfoOptions& o) {
     const long long start = now_ns();
-    const Scene scene = load_scene(o.scene);
+    const Scene scene = load_chosen_scene(o.scene);
     const double load_ms = elapsed_ms(start);
     const Aabb bounds = scene.bounds();
     if (o.json) {

@@ -15,7 +15,8 @@ namespace homcull::cli {
 
 void register_path(CLI::App& app) {
     struct Options {
-        std::string scene, kind = "walk", out;
+        SceneChoice scene;
+        std::string kind = "walk", out;
         int frames = 200;
         std::uint64_t seed = 1;
         double eye_height = 0.0, step = 0.0, fov_y = 60.0;
@@ -32,7 +33,7 @@ void register_path(CLI::App& app) {
     cmd->add_option("--fov-y", o->fov_y, "Vertical field of view, degrees")->capture_default_str()->check(CLI::Range(1.0, 179.0));
     cmd->add_option("--out", o->out, "Output path file (JSON); stdout when left out");
     cmd->callback([o] {
-        const Scene scene = load_scene(o->scene);
+        const Scene scene = load_chosen_scene(o->scene);
         CameraPath path;
         if (o->kind == "orbit") {
             const Aabb b = scene.bounds();

@@ -16,7 +16,7 @@ namespace homcull::cli {
 namespace {
 
 struct TruthCommandOptions {
-    std::string scene;
+    SceneChoice scene;
     CameraOptions camera;
     std::string resolution = "1280x720";
     int samples = 1;
@@ -32,7 +32,7 @@ void run_truth(const TruthCommandOptions& o) {
     options.keep_sample_ids = !o.id_image.empty();
 
     long long start = now_ns();
-    const Scene scene = load_scene(o.scene);
+    const Scene scene = load_chosen_scene(o.scene);
     const double load_ms = elapsed_ms(start);
     start = now_ns();
     const RayScene rays(scene);

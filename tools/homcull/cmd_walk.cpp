@@ -25,7 +25,8 @@ namespace homcull::cli {
 namespace {
 
 struct WalkCommandOptions {
-    std::string scene, path;
+    SceneChoice scene;
+    std::string path;
     CullOptions cull;
     std::string isa = "best", truth = "on";
     int threads = 1;
@@ -71,7 +72,7 @@ void print_progress(std::size_t done, std::size_t total) {
 void run_walk(const WalkCommandOptions& o) {
     select_isa(o.isa);
     SceneCullerConfig config = scene_culler_config(o.cull);
-    const Scene scene = load_scene(o.scene);
+    const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const CameraPath path = read_camera_path(o.path);
     if (path.frames.empty()) throw Error("camera path " + o.path + " has no frames");

@@ -2,6 +2,8 @@
 
 #include <homcull/error.hpp>
 #include <homcull/io/camera_path.hpp>
+#include <homcull/io/scene_io.hpp>
+#include <homcull/soup_subdivision.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -9,11 +11,19 @@
 
 namespace homcull::cli {
 
-void add_scene_option(CLI::App& app, std::string& scene) {
-    app.add_option("--scene", scene,
-                   "Scene file (glTF/GLB, OBJ, PLY, IFC, ... anything assimp reads) or a generated "
-                   "scene: gen:city, gen:forest, with options such as gen:city:seed=3,blocks=10")
-        ->required();
+void add_scene_option(CLI::App& app, SceneChoice& scene, bool required, const std::string& help) {
+    auto* option = app.add_option("--scene", scene.file, help);
+    if (required) option->required();
+    app.add_option("--soup-cells", scene.soup_cells,
+                   "Split objects with more than T triangles into cells of at most T (Zhang's subdivision of polygon soups); "
+                   "object ids then refer to the cells. 0: objects as the scene has them")
+        ->capture_default_str();
+}
+
+Scene load_chosen_scene(const SceneChoice& scene) {
+    Scene loaded = load_scene(scene.file);
+    if (scene.soup_cells == 0) return loaded;
+    return subdivide_polygon_soups(loaded, SoupSubdivision{scene.soup_cells});
 }
 
 void add_camera_options(CLI::App& app, CameraOptions& o) {

@@ -2,6 +2,7 @@
 // Options several subcommands share: the scene, the camera, the display resolution.
 #include <homcull/camera.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/scene.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -17,8 +18,20 @@ struct CameraOptions {
     int frame = 0;
 };
 
-// --scene F: a file (glTF/GLB, OBJ, PLY, IFC, ...) or gen:city / gen:forest[:options].
-void add_scene_option(CLI::App& app, std::string& scene);
+// --scene F: a file (glTF/GLB, OBJ, PLY, IFC, ...) or gen:city / gen:forest[:options]; and
+// --soup-cells T: objects with more than T triangles split into cells (Zhang's subdivision of
+// polygon soups, soup_subdivision.hpp). Every command that names objects takes both, so that
+// object ids agree between them.
+struct SceneChoice {
+    std::string file;
+    std::size_t soup_cells = 0;  // 0: objects as the file has them
+};
+// required: --scene must be given (commands that can run without a scene pass false).
+void add_scene_option(CLI::App& app, SceneChoice& scene, bool required = true,
+                      const std::string& help = "Scene file (glTF/GLB, OBJ, PLY, IFC, ... anything assimp reads) or a generated "
+                                                "scene: gen:city, gen:forest, with options such as gen:city:seed=3,blocks=10");
+// Loads the scene, then splits its polygon soups when asked. Throws homcull::Error.
+Scene load_chosen_scene(const SceneChoice& scene);
 // --eye x,y,z --target x,y,z [--up x,y,z --fov-y D --near N --far F], or --path P [--frame K].
 void add_camera_options(CLI::App& app, CameraOptions& options);
 // Throws homcull::Error when the options do not make a valid camera.
