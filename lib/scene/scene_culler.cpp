@@ -79,6 +79,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
                              occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first);
     }
     gather_lods();
+    drawn_.assign(occluders.size(), 0);
     frame_occluders_.reserve(occluders.size());
     frame_indices_.reserve(occluders_.indices.size());
     frame_shared_.reserve(occluders_.triangle_count());
@@ -107,6 +108,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
     timings_ = {};
     work_ = {};
     exits_ = {};
+    for (std::uint32_t id : frame_occluders_) drawn_[candidate_of_[id]] = 0;
     frame_occluders_.clear();
     frame_indices_.clear();
     frame_shared_.clear();
@@ -121,6 +123,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
     }
     build_maps(frame);
     traverse(frame, answers, parallel);
+    if (config_.strategy == CullStrategy::temporal && has_history_) draw_newly_visible(frame, answers, parallel);
 
     if (config_.strategy == CullStrategy::temporal) {
         for (std::size_t id = 0; id < answers.size(); ++id) last_visibility_[id] = answers[id].visibility;
@@ -201,11 +204,42 @@ void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, const 
     const std::vector<std::uint8_t>& flags = lod ? lod_shared_edges_ : shared_edges;
     const std::uint32_t first = lod ? lod_first_[k] : first_triangle_[k], last = lod ? lod_first_[k + 1] : first_triangle_[k + 1];
     frame_occluders_.push_back(id);
+    drawn_[k] = 1;
     frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::size_t(first), indices.begin() + 3 * std::size_t(last));
     frame_shared_.insert(frame_shared_.end(), flags.begin() + first, flags.begin() + last);
     ++work_.occluder_objects;
     work_.occluder_triangles += last - first;
     work_.occluder_lods += lod;
+}
+
+// temporal's second pass. Last frame's answers leave out the candidates that were hidden; one
+// that has come into view this frame is found visible without having been drawn, and what it
+// hides is missed (a frame late, as Zhang's eq. 7.1 set alone would have it). Such candidates
+// are drawn now (within what the budget leaves), the maps rebuilt, and the objects found
+// visible tested again. Hidden answers stay: drawing more only hides more. This is the second
+// phase of two-phase temporal occlusion culling (Haar and Aaltonen, "GPU-driven rendering
+// pipelines", SIGGRAPH 2015 course), here run only in frames where some candidate came into view.
+void SceneCuller::draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+    auto start = Clock::now();
+    const std::size_t budget = config_.occluder_budget.triangles;
+    std::size_t left = budget == 0 ? ~std::size_t(0) : budget - std::min(budget, work_.occluder_triangles);
+    const std::size_t drawn_before = frame_occluders_.size();
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+        const std::uint32_t id = occluder_ids_[k];
+        if (drawn_[k] || answers[id].visibility != Visibility::visible) continue;
+        const std::size_t n = occluder_triangles_drawn(*scene_, id, *frame.camera, config_.lods);
+        if (n > left) continue;
+        append_occluder(id, *frame.camera, own_shared_edges_);
+        left -= n;
+    }
+    timings_.select_ms += ms_since(start);
+    if (frame_occluders_.size() == drawn_before) return;
+    render_pending(frame, parallel);
+    build_maps(frame);
+    start = Clock::now();
+    for (std::size_t id = 0; id < answers.size(); ++id)
+        if (answers[id].visibility == Visibility::visible) answers[id] = test_object(frame, std::uint32_t(id));
+    timings_.test_ms += ms_since(start);
 }
 
 // The triangles of frame_indices_ not rendered yet.

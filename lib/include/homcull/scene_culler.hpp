@@ -34,7 +34,9 @@ enum class CullStrategy : std::uint8_t {
     progressive,
     // Last frame's visible set, plus the candidates that have just entered the frustum (Zhang's
     // eq. 7.1 candidate set), are this frame's occluders (Yoon, Salomon and Manocha). The first
-    // frame, or the first after reset_history(), works as one_pass.
+    // frame, or the first after reset_history(), works as one_pass. Candidates that come into
+    // view (found visible though left out) are then drawn too, and the objects found visible
+    // tested again: a second pass, only in frames where that happens.
     temporal,
 };
 
@@ -157,6 +159,7 @@ private:
     std::vector<std::uint32_t> ranked_;           // rank_occluders' choice
     std::vector<std::pair<float, std::uint32_t>> rank_scratch_, node_heap_;
     std::vector<Visibility> last_visibility_;
+    std::vector<std::uint8_t> drawn_;  // per candidate k: drawn this frame
     bool has_history_ = false;
 
     static constexpr std::uint32_t kNone = ~std::uint32_t(0);
@@ -168,6 +171,7 @@ private:
     void gather_lods();
     void render_pending(const Frame& frame, const ParallelFor& parallel);
     void build_maps(const Frame& frame);
+    void draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     OccludeeAnswer test_object(const Frame& frame, std::uint32_t id);
     // Occludee triangles in world space (transformed as ground truth transforms them) for the
