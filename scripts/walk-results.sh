@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The results table of docs/scene-culling.md: every strategy of `homcull walk` on generated
 # walkthroughs of the shared scenes, with Embree ground truth, as a Markdown table on stdout.
+# Also one-pass under a 4,000-triangle budget ranked by distance and by a baked visibility
+# grid (baked here, per scene), and one-pass with occluder LODs.
 #   bash scripts/walk-results.sh [FRAMES] [RESOLUTION]      (defaults: 120 frames, 1280x720)
 # Needs a build (scripts/build.sh) and ../shared/scenes beside the repository. HOMCULL may
 # name another binary. Progress goes to stderr; each walk's JSON is kept in $OUT (a temp dir).
@@ -24,12 +26,18 @@ for scene in intel_castle crytek_sponza openarena_oa_thor openarena_pul1duel-oa;
   # The castle marks its occluders; the other scenes get Zhang's size filter.
   candidates=auto
   [ "$scene" = intel_castle ] && candidates=role
+  echo "walk-results: $scene, baking its visibility grid" >&2
+  "$homcull" bake --scene "$file" --occluders "$candidates" --quiet --out "$out/$scene.grid.json" >&2
   runs=("one-pass|$candidates|" "temporal|$candidates|" "progressive|$candidates|"
-        "one-pass|$candidates|--rank distance --budget 4000" "one-pass|all|")
+        "one-pass|$candidates|--rank distance --budget 4000"
+        "one-pass|$candidates|--rank baked --grid $out/$scene.grid.json --budget 4000"
+        "one-pass|$candidates|--lod on" "one-pass|all|")
   for run in "${runs[@]}"; do
     IFS='|' read -r strategy occluders extra <<<"$run"
     name="$strategy${extra:+ ($extra)}"
-    json=$out/$scene.$strategy.$occluders.${extra// /_}.json
+    name=${name/ --grid $out\/$scene.grid.json/}
+    tag=${extra// /_}
+    json=$out/$scene.$strategy.$occluders.${tag//\//_}.json
     echo "walk-results: $scene, $name, occluders $occluders" >&2
     # shellcheck disable=SC2086
     "$homcull" walk --scene "$file" --path "$out/$scene.path.json" --resolution "$resolution" --strategy "$strategy" \
