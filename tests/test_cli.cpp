@@ -214,12 +214,14 @@ TEST(Cli, BakeInShardsMergeAndWalkWithTheBakedRanking) {
     EXPECT_LE(j["summary"]["occluder_triangles"]["max"].get<double>(), 500.0);
 
     // Bad input: a shard beyond its count, a missing shard, a ranking without its grid, a shard as a grid.
-    r = run_cli("bake " + scene + " --shard 2/2 --out " + dir + "/x.json");
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_MENTIONS(r.err, "--shard");
+    for (const char* bad : {"2/2", "1/-3", "4294967297/4294967298", "1/", "x/2", "0/2/"}) {
+        r = run_cli("bake " + scene + " --shard " + bad + " --out " + dir + "/x.json");
+        EXPECT_EQ(r.exit_code, 1) << bad;
+        EXPECT_MENTIONS(r.err, "--shard");
+    }
     r = run_cli("bake --merge " + dir + "/part0.json --out " + dir + "/x.json");
     EXPECT_EQ(r.exit_code, 1);
-    EXPECT_MENTIONS(r.err, "shard 1 of 2 is missing");
+    EXPECT_MENTIONS(r.err, "shard files are missing");
     r = run_cli("walk " + scene + " --path " + dir + "/walk.json --rank baked");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_MENTIONS(r.err, "--grid");

@@ -4,6 +4,8 @@
 // meets the LOD, it meets the original mesh no farther.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <glm/gtc/matrix_transform.hpp>
@@ -482,6 +484,17 @@ TEST(OccluderLod, CastleOccluderLodsNeverHideMore) {
                 placed_before, placed_after);
     EXPECT_GT(lods.meshes_with_lod, 0u);
     expect_scene_lods_never_hide_more(scene, occluders, lods, 32, 64);
+    // Only the objects the build was given may use the LODs (their transforms' rounding is
+    // what the margins cover), even where another object places the same mesh.
+    for (std::uint32_t id = 0; id < scene.objects.size(); ++id) {
+        const bool given = std::find(occluders.begin(), occluders.end(), id) != occluders.end();
+        const OccluderLod* lod = lods.lod_for(id, scene.objects[id].mesh);
+        if (!given) {
+            EXPECT_EQ(lod, nullptr) << scene.objects[id].name;
+        } else {
+            EXPECT_EQ(lod, lods.lod_of(scene.objects[id].mesh)) << scene.objects[id].name;
+        }
+    }
 
     // Every mesh of the castle, as a stronger test of the guarantee (the occluders are few).
     const std::vector<std::uint32_t> all = objects_with_role(scene, "");

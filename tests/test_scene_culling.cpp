@@ -105,6 +105,28 @@ TEST(OccluderSelection, RankingKeepsTheFrustumOrderAndTheBudget) {
     EXPECT_EQ(chosen.size(), in_frustum);
 }
 
+TEST(OccluderSelection, ComplexityFilterDropsObjectsDenseForTheirSize) {
+    Scene scene;
+    for (int k = 0; k < 5; ++k) test::add_box(scene, "box", {float(3 * k), 0, 0}, {float(3 * k + 2), 2, 2});
+    // A small object of 600 sliver triangles: 50 times the boxes' triangles per unit of surface.
+    Mesh dense{"dense", {}, {}};
+    for (int t = 0; t < 600; ++t) {
+        const float x = float(t) / 600.0f;
+        dense.positions.insert(dense.positions.end(), {{x, 0, 0}, {x, 1, 0}, {x, 0, 1}});
+        dense.indices.insert(dense.indices.end(), {std::uint32_t(3 * t), std::uint32_t(3 * t + 1), std::uint32_t(3 * t + 2)});
+    }
+    scene.meshes.push_back(dense);
+    scene.objects.push_back({"dense", std::uint32_t(scene.meshes.size() - 1), glm::dmat4(1.0), {}, {}});
+    scene.finalize();
+    const std::vector<std::uint32_t> all = occluder_candidates(scene, OccluderFilter::all);
+    ASSERT_EQ(all.size(), 6u);
+    EXPECT_EQ(filter_by_complexity(scene, all, 0.0), all);  // off
+    EXPECT_EQ(filter_by_complexity(scene, all, 1000.0), all);
+    const std::vector<std::uint32_t> kept = filter_by_complexity(scene, all, 16.0);
+    EXPECT_EQ(kept, std::vector<std::uint32_t>(all.begin(), all.begin() + 5));
+    EXPECT_TRUE(filter_by_complexity(scene, {}, 16.0).empty());
+}
+
 struct StrategyCase {
     const char* name;
     CullStrategy strategy;

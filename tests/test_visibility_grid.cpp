@@ -139,11 +139,16 @@ TEST(VisibilityGrid, MalformedFilesAreClearErrors) {
     EXPECT_NE(message("{" + header + "}").find("points"), std::string::npos);
     EXPECT_NE(message("{" + header + R"(,"points":[{"column":9,"position":[0,0,0],"occluders":[]}]})").find("outside the grid"),
               std::string::npos);
-    EXPECT_NE(message("{" + header + R"(,"points":[{"column":1,"position":[0,0,0],"occluders":[[99999,1]]}]})").find("names object"),
+    EXPECT_NE(message("{" + header + R"(,"points":[{"column":1,"position":[3,0,1],"occluders":[[99999,1]]}]})").find("names object"),
               std::string::npos);
-    EXPECT_NE(message("{" + header + R"(,"points":[{"column":1,"position":[0,0,0],"occluders":[[1,1],[1,2]]}]})").find("twice"),
+    EXPECT_NE(message("{" + header + R"(,"points":[{"column":1,"position":[3,0,1],"occluders":[[1,1],[1,2]]}]})").find("twice"),
               std::string::npos);
-    EXPECT_EQ(message("{" + header + R"(,"points":[{"column":1,"position":[0,0,0],"occluders":[[1,3]]}]})"), "no error");
+    EXPECT_EQ(message("{" + header + R"(,"points":[{"column":1,"position":[3,0,1],"occluders":[[1,3]]}]})"), "no error");
+    EXPECT_NE(message("{" + header + R"(,"points":[{"column":1,"position":[0,0,0],"occluders":[]}]})").find("outside its column"),
+              std::string::npos);
+    EXPECT_NE(message("{" + header + R"(,"points":[{"column":1,"position":[3,0,1],"occluders":[[4294967298,1]]}]})").find("below 2^32"),
+              std::string::npos);
+    EXPECT_NE(message(R"({"format":5})").find("not a homcull visibility grid"), std::string::npos);
     try {
         read_visibility_grid(dir + "/missing.json", scene);
         FAIL() << "no error for a missing file";

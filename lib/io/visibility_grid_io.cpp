@@ -40,9 +40,16 @@ const nlohmann::json& field(const nlohmann::json& j, const char* key, nlohmann::
 
 using T = nlohmann::json::value_t;
 
+// An unsigned JSON number that fits in 32 bits (nlohmann's get<uint32_t> would wrap).
+std::uint32_t u32(const nlohmann::json& value, const char* what, const std::string& where) {
+    if (!value.is_number_unsigned() || value.get<std::uint64_t>() > 0xFFFFFFFFull)
+        throw Error(where + ": " + what + " must be a count below 2^32");
+    return std::uint32_t(value.get<std::uint64_t>());
+}
+
 VisibilityGridHeader parse_header(const nlohmann::json& j, const std::string& where) {
-    if (!j.is_object() || j.value("format", "") != kFormat) throw Error(where + ": not a homcull visibility grid");
-    if (j.value("version", 0) != 1) throw Error(where + ": unsupported visibility grid version");
+    if (!j.is_object() || !j.contains("format") || j["format"] != kFormat) throw Error(where + ": not a homcull visibility grid");
+    if (!j.contains("version") || j["version"] != 1) throw Error(where + ": unsupported visibility grid version");
     VisibilityGridHeader h;
     h.scene = field(j, "scene", T::string, where).get<std::string>();
     h.scene_objects = field(j, "scene_objects", T::number_unsigned, where).get<std::size_t>();
@@ -56,17 +63,16 @@ VisibilityGridHeader parse_header(const nlohmann::json& j, const std::string& wh
     const auto& columns = field(j, "columns", T::array, where);
     if (origin.size() != 3 || !origin[0].is_number() || !origin[1].is_number() || !origin[2].is_number())
         throw Error(where + ": \"origin\" must be three numbers");
-    if (columns.size() != 2 || !columns[0].is_number_unsigned() || !columns[1].is_number_unsigned())
-        throw Error(where + ": \"columns\" must be two counts");
+    if (columns.size() != 2) throw Error(where + ": \"columns\" must be two counts");
     h.origin_x = origin[0].get<double>();
     h.origin_y = origin[1].get<double>();
     h.origin_z = origin[2].get<double>();
-    h.columns_x = columns[0].get<std::uint32_t>();
-    h.columns_z = columns[1].get<std::uint32_t>();
+    h.columns_x = u32(columns[0], "a column count", where);
+    h.columns_z = u32(columns[1], "a column count", where);
     if (std::uint64_t(h.columns_x) * h.columns_z > (1u << 26)) throw Error(where + ": too many columns");
     h.eye_height = field(j, "eye_height", T::number_float, where).get<double>();
-    h.rays = field(j, "rays", T::number_unsigned, where).get<std::uint32_t>();
-    h.keep = field(j, "keep", T::number_unsigned, where).get<std::uint32_t>();
+    h.rays = u32(field(j, "rays", T::number_unsigned, where), "\"rays\"", where);
+    h.keep = u32(field(j, "keep", T::number_unsigned, where), "\"keep\"", where);
     return h;
 }
 
@@ -110,10 +116,9 @@ VisibilityGridPart read_visibility_grid_part(const std::string& file) {
     grid.header = parse_header(j, file);
     if (j.contains("shard")) {
         const auto& s = j["shard"];
-        if (!s.is_array() || s.size() != 2 || !s[0].is_number_unsigned() || !s[1].is_number_unsigned() ||
-            s[0].get<std::uint32_t>() >= s[1].get<std::uint32_t>())
-            throw Error(file + ": \"shard\" must be [index, count] with index < count");
-        part.shard = {s[0].get<std::uint32_t>(), s[1].get<std::uint32_t>()};
+        if (!s.is_array() || s.size() != 2) throw Error(file + ": \"shard\" must be [index, count] with index < count");
+        part.shard = {u32(s[0], "a shard index", file), u32(s[1], "a shard count", file)};
+        if (part.shard.index >= part.shard.count) throw Error(file + ": \"shard\" must be [index, count] with index < count");
     }
     // Points grouped by column, in file order within a column.
     const auto& points = field(j, "points", T::array, file);
@@ -134,7 +139,7 @@ VisibilityGridPart read_visibility_grid_part(const std::string& file) {
         for (const auto& o : field(p, "occluders", T::array, where)) {
             if (!o.is_array() || o.size() != 2 || !o[0].is_number_unsigned() || !o[1].is_number_unsigned())
                 throw Error(where + ": an occluder must be [object id, score]");
-            point.occluders.emplace_back(o[0].get<std::uint32_t>(), o[1].get<std::uint32_t>());
+            point.occluders.emplace_back(u32(o[0], "an object id", where), u32(o[1], "a score", where));
         }
         order.emplace_back(column, k);
         read.push_back(std::move(point));
@@ -153,6 +158,10 @@ VisibilityGridPart read_visibility_grid_part(const std::string& file) {
 VisibilityGrid merge_visibility_grid_parts(const std::vector<VisibilityGridPart>& parts) {
     if (parts.empty()) throw Error("merge: no visibility grid parts given");
     const std::uint32_t count = parts.front().shard.count;
+    if (count != parts.size())
+        throw Error("merge: " + parts.front().source + " is one of " + std::to_string(count) + " shards, but " +
+                    std::to_string(parts.size()) + " files were given" +
+                    (count > parts.size() ? ": shard files are missing" : ": some are given twice or come from another bake"));
     std::vector<const VisibilityGridPart*> by_index(count, nullptr);
     for (const VisibilityGridPart& part : parts) {
         if (part.shard.count != count)

@@ -27,6 +27,30 @@ std::vector<std::uint32_t> occluder_candidates(const Scene& scene, OccluderFilte
 
 namespace {
 
+// Triangles per unit of box surface (a flat box counts its two faces).
+double triangle_density(const Scene& scene, std::uint32_t id) {
+    const glm::dvec3 e(scene.objects[id].world_bounds.extent());
+    const double surface = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+    return double(scene.triangle_count(scene.objects[id])) / std::max(surface, 1e-30);
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> filter_by_complexity(const Scene& scene, const std::vector<std::uint32_t>& candidates, double factor) {
+    if (!(factor > 0.0) || candidates.empty()) return candidates;
+    std::vector<double> densities;
+    for (std::uint32_t id : candidates) densities.push_back(triangle_density(scene, id));
+    std::vector<double> sorted = densities;
+    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+    const double limit = factor * sorted[sorted.size() / 2];
+    std::vector<std::uint32_t> kept;
+    for (std::size_t k = 0; k < candidates.size(); ++k)
+        if (densities[k] <= limit) kept.push_back(candidates[k]);
+    return kept;
+}
+
+namespace {
+
 // Distance from a point to a box (0 inside it).
 double distance_to_box(const glm::dvec3& p, const Aabb& box) {
     const glm::dvec3 nearest = glm::clamp(p, glm::dvec3(box.min), glm::dvec3(box.max));
@@ -74,7 +98,7 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
 std::size_t occluder_triangles_drawn(const Scene& scene, std::uint32_t id, const Camera& camera, const OccluderLods* lods) {
     const Object& object = scene.objects[id];
     if (lods)
-        if (const OccluderLod* lod = lods->lod_of(object.mesh); lod && lod_usable(object.world_bounds, camera))
+        if (const OccluderLod* lod = lods->lod_for(id, object.mesh); lod && lod_usable(object.world_bounds, camera))
             return lod->mesh.triangle_count();
     return scene.triangle_count(object);
 }

@@ -64,6 +64,11 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
       maps_(buffer_, maps_config(config)) {
     if (config.strategy == CullStrategy::progressive && config.progressive_batch_triangles == 0)
         throw Error("progressive culling needs a batch of at least one triangle");
+    if (config.occluder_budget.ranking == OccluderRanking::baked && !config.occluder_budget.grid)
+        throw Error("baked occluder ranking needs a visibility grid");
+    temporal_pool_.reserve(occluders.size());
+    ranked_.reserve(occluders.size());
+    rank_scratch_.reserve(occluders.size());
     // Where each candidate's triangles are, and their shared edges within the object alone.
     candidate_of_.assign(scene.objects.size(), kNone);
     first_triangle_.push_back(0);
@@ -173,7 +178,7 @@ void SceneCuller::gather_lods() {
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         const Object& object = scene_->objects[occluder_ids_[k]];
         lod_first_[k + 1] = lod_first_[k];
-        const OccluderLod* lod = config_.lods->lod_of(object.mesh);
+        const OccluderLod* lod = config_.lods->lod_for(occluder_ids_[k], object.mesh);
         if (!lod || lod->mesh.triangle_count() == 0) continue;
         const auto base = std::uint32_t(occluders_.positions.size() / 3);
         for (const glm::vec3& p : lod->mesh.positions) {

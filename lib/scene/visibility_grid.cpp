@@ -65,8 +65,17 @@ void VisibilityGrid::index(std::size_t object_count, const std::string& source) 
     if (!std::is_sorted(column_first.begin(), column_first.end())) throw Error(source + ": the grid's columns are out of order");
     by_id_first_.assign(1, 0);
     by_id_.clear();
+    std::size_t column = 0;
     for (std::size_t p = 0; p < points.size(); ++p) {
         const GridPoint& point = points[p];
+        // nearest() finds a point only in its own column's x-z square (a little slack for rounding).
+        while (column_first[column + 1] <= p) ++column;
+        const double x0 = h.origin_x + double(column % h.columns_x) * h.spacing;
+        const double z0 = h.origin_z + double(column / h.columns_x) * h.spacing;
+        const double slack = 1e-3 * h.spacing;
+        const double px = double(point.position.x), pz = double(point.position.z);
+        if (!(px >= x0 - slack && px <= x0 + h.spacing + slack && pz >= z0 - slack && pz <= z0 + h.spacing + slack))
+            throw Error(source + ": point " + std::to_string(p) + " lies outside its column " + std::to_string(column));
         for (const auto& [id, score] : point.occluders)
             if (id >= object_count)
                 throw Error(source + ": point " + std::to_string(p) + " names object " + std::to_string(id) + ", but the scene has " +

@@ -280,6 +280,8 @@ OccluderLods build_occluder_lods(const Scene& scene, const std::vector<std::uint
     OccluderLods lods;
     lods.lod_of_mesh.assign(scene.meshes.size(), -1);
     lods.status_of_mesh.assign(scene.meshes.size(), LodStatus::not_requested);
+    lods.built_for_object.assign(scene.objects.size(), 0);
+    for (std::uint32_t id : objects) lods.built_for_object[id] = 1;
     lods.meshes_considered = meshes.size();
     for (std::size_t i = 0; i < meshes.size(); ++i) {
         MeshResult& r = results[i];

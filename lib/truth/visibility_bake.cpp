@@ -6,7 +6,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -124,11 +123,12 @@ VisibilityGridHeader bake_header(const Scene& scene, const BakeOptions& o) {
     h.spacing = o.spacing > 0.0 ? o.spacing : std::max({extent.x, extent.z, 1e-6}) / 64.0;
     auto columns = [&](double length) {
         const double n = std::ceil(length / h.spacing);
-        if (n > 16384.0) throw Error("bake: the spacing is too small for the scene (more than 16,384 columns per axis)");
+        if (n > 16384.0) throw Error("bake: the spacing is too small for the scene (more than 16,384 lattice steps per axis)");
         return std::uint32_t(std::max(1.0, n));
     };
     h.columns_x = columns(extent.x);
     h.columns_z = columns(extent.z);
+    if (o.layout == GridLayout::volume) columns(extent.y);  // the same limit on the points per column
     h.origin_x = b.min.x;
     h.origin_z = b.min.z;
     h.origin_y = double(b.min.y) + 0.5 * h.spacing;
@@ -158,7 +158,7 @@ VisibilityGrid bake_visibility_grid(const RayScene& rays, const Scene& scene, co
         if (o.shard.holds(c)) columns.push_back(c);
     std::vector<std::vector<GridPoint>> baked(columns.size());
     std::mutex progress_mutex;
-    std::atomic<std::size_t> done{0};
+    std::size_t done = 0;  // under progress_mutex
     tbb::parallel_for(std::size_t(0), columns.size(), [&](std::size_t k) {
         const std::size_t c = columns[k];
         const double x = h.origin_x + (double(c % h.columns_x) + 0.5) * h.spacing;
@@ -178,7 +178,8 @@ VisibilityGrid bake_visibility_grid(const RayScene& rays, const Scene& scene, co
             const glm::vec3 top(float(x), bounds.max.y + float(0.01 * diagonal), float(z));
             const glm::vec3 down(0.0f, -1.0f, 0.0f);
             float t = 0.0f;
-            for (int floor = 0; floor < o.max_floors; ++floor) {
+            int floors = 0;
+            for (int hits = 0; hits < 8 * o.max_floors && floors < o.max_floors; ++hits) {
                 const RayHit hit = rays.intersect(top, down, t, kFar);
                 if (!hit.hit()) break;
                 t = hit.t + float(1e-4 * diagonal);
@@ -187,13 +188,13 @@ VisibilityGrid bake_visibility_grid(const RayScene& rays, const Scene& scene, co
                 const glm::vec3 up(0.0f, 1.0f, 0.0f);
                 const float headroom = float(0.3 * h.eye_height);
                 if (rays.intersect(glm::vec3(eye), up, 0.0f, headroom).hit()) continue;
-                if (eye.y - h.eye_height < double(bounds.max.y)) try_point(eye);
+                ++floors;
+                try_point(eye);
             }
         }
         if (progress) {
-            const std::size_t n = ++done;
             std::lock_guard<std::mutex> lock(progress_mutex);
-            progress(n, columns.size());
+            progress(++done, columns.size());
         }
     });
 

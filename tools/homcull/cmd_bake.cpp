@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 #include <tbb/global_control.h>
 
+#include <charconv>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -32,10 +33,16 @@ struct BakeCommandOptions {
 };
 
 GridShard parse_shard(const std::string& text) {
-    unsigned index = 0, count = 0;
-    char slash = 0, extra = 0;
-    if (std::sscanf(text.c_str(), "%u%c%u%c", &index, &slash, &count, &extra) != 3 || slash != '/' || count == 0 || index >= count)
-        throw Error("--shard must be i/N with 0 <= i < N, got \"" + text + "\"");
+    // Digits only (from_chars takes no sign), both within 32 bits, i < N.
+    std::uint32_t index = 0, count = 0;
+    const char* end = text.data() + text.size();
+    const auto [after_index, e1] = std::from_chars(text.data(), end, index);
+    bool ok = e1 == std::errc() && after_index < end && *after_index == '/';
+    if (ok) {
+        const auto [after_count, e2] = std::from_chars(after_index + 1, end, count);
+        ok = e2 == std::errc() && after_count == end && index < count;
+    }
+    if (!ok) throw Error("--shard must be i/N with 0 <= i < N, got \"" + text + "\"");
     return {index, count};
 }
 

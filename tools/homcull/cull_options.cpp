@@ -40,6 +40,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--occluders", o.occluders, "Occluder candidates: role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
+    app.add_option("--complexity", o.complexity,
+                   "Drop candidates with more than F times the median triangles per unit of box surface (Zhang's complexity "
+                   "filter); 0: keep all")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
     app.add_option("--strategy", o.strategy,
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
                    "to back) or temporal (last frame's visible candidates plus those new in the frustum)")
@@ -91,13 +95,14 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     return c;
 }
 
-std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice) {
-    return occluder_candidates(scene, choice == "all" ? OccluderFilter::all : choice == "auto" ? OccluderFilter::size : OccluderFilter::role);
+std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice, double complexity) {
+    const OccluderFilter filter = choice == "all" ? OccluderFilter::all : choice == "auto" ? OccluderFilter::size : OccluderFilter::role;
+    return filter_by_complexity(scene, occluder_candidates(scene, filter), complexity);
 }
 
 CullResources prepare_cull_resources(const CullOptions& o, const Scene& scene, SceneCullerConfig& config) {
     CullResources r;
-    r.occluders = choose_occluders(scene, o.occluders);
+    r.occluders = choose_occluders(scene, o.occluders, o.complexity);
     if (o.rank == "baked") {
         r.grid = std::make_unique<VisibilityGrid>(read_visibility_grid(o.grid, scene));
         if (r.grid->header.occluders != o.occluders)

@@ -12,6 +12,7 @@
 
 namespace homcull::cli {
 
+// --complexity F: Zhang's complexity filter on the candidates (filter_by_complexity).
 struct CullOptions {
     std::string resolution = "1280x720", buffer, mode = "conservative", depth = "masked", occluders = "role";
     int samples = 1;
@@ -20,6 +21,7 @@ struct CullOptions {
     std::string deb = "64x64", occludees = "auto", sample_depth = "on";
     std::string strategy = "one-pass", rank = "none", hierarchy = "on", grid, lod = "off";
     std::size_t budget = 0, batch = 1024;
+    double complexity = 0.0;
 };
 
 // with_display: also --resolution and --samples (commands that define their own leave them out
@@ -30,7 +32,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& options);
 // role: objects with role=occluder (all when none has a role); all; auto: role when the scene
 // marks occluders, otherwise objects whose box diagonal is at least 2 % of the scene's
 // (Zhang's static size filter).
-std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice);
+std::vector<std::uint32_t> choose_occluders(const Scene& scene, const std::string& choice, double complexity = 0.0);
 // What a culler's configuration points at, loaded or built for one scene: it must outlive the culler.
 struct CullResources {
     std::vector<std::uint32_t> occluders;  // the candidates (--occluders)

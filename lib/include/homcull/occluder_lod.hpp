@@ -30,7 +30,11 @@
 //   coordinate (times sqrt 3). Copies are shrunk inward by a margin (by default 1e-3 of the
 //   part's box diagonal) that the build raises, where needed, to 16 times that rounding for
 //   every object it was given, and to 16 times the rounding of the model positions
-//   themselves. The LOD is meant for those objects.
+//   themselves. The LOD is meant for those objects (OccluderLods::lod_for enforces it).
+//   Caveat: the margin is how far the vertices moved inward; the Embree check proves that the
+//   surfaces do not cross, not how far apart they stay. A part of S within rounding of O's
+//   surface (away from S's vertices) could in principle slip through; the tests' ray checks
+//   (millions of rays on the shared scenes, no tolerance) have found none.
 // - The eye sees the object without near-plane clipping: ground truth starts its rays at the
 //   near plane, so O's entry point could be cut away while S's hit is kept. lod_usable()
 //   asks that the object's world box lie wholly beyond the near plane. That also puts the
@@ -77,6 +81,9 @@ struct OccluderLods {
     std::vector<std::int32_t> lod_of_mesh;  // per scene mesh: index into lods, or -1
     std::vector<LodStatus> status_of_mesh;  // per scene mesh
     std::vector<OccluderLod> lods;
+    // Per scene object: 1 when the build was given it, so that its LOD's margin covers the
+    // rounding of its transform. Only those objects may be drawn with an LOD (lod_for).
+    std::vector<std::uint8_t> built_for_object;
 
     // Meshes used by the objects given to the build; how many of them are closed as a whole
     // (every part closed); how many got an LOD, and their triangles before and after (each
@@ -92,6 +99,11 @@ struct OccluderLods {
     const OccluderLod* lod_of(std::uint32_t mesh) const {
         if (mesh >= lod_of_mesh.size() || lod_of_mesh[mesh] < 0) return nullptr;
         return &lods[std::size_t(lod_of_mesh[mesh])];
+    }
+    // The LOD an object may be drawn with: its mesh's, if the build was given the object.
+    const OccluderLod* lod_for(std::uint32_t object, std::uint32_t mesh) const {
+        if (object >= built_for_object.size() || !built_for_object[object]) return nullptr;
+        return lod_of(mesh);
     }
 };
 

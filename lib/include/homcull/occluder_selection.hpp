@@ -28,6 +28,13 @@ enum class OccluderFilter : std::uint8_t {
 // The objects a filter keeps, in id order. Objects without geometry are never kept.
 std::vector<std::uint32_t> occluder_candidates(const Scene& scene, OccluderFilter filter);
 
+// Zhang's complexity filter: an occluder should hide much for few triangles. Keeps the
+// candidates whose triangles per unit of box surface are at most `factor` times the median
+// of the candidates' (railings, spiral stairs and finely tessellated patches cover little for
+// their cost). factor <= 0 keeps every candidate. Spatial locality, Zhang's third static
+// criterion, is applied per frame instead: distance ranking and the baked grid.
+std::vector<std::uint32_t> filter_by_complexity(const Scene& scene, const std::vector<std::uint32_t>& candidates, double factor);
+
 enum class OccluderRanking : std::uint8_t {
     none,      // every candidate, every frame (no per-frame work)
     distance,  // nearest box first (Zhang's distance-based selection under a polygon budget)

@@ -68,8 +68,9 @@ public:
     // id-sorted copy, built by index().
     std::uint32_t score(const GridPoint& point, std::uint32_t object) const;
 
-    // Checks the layout (column_first consistent, every point's occluders valid ids below
-    // object_count and sorted) and builds the per-point id index score() uses. Throws
+    // Checks the layout (column_first consistent, every point inside its column's x-z square,
+    // every point's occluders valid ids below object_count, none twice) and builds the
+    // per-point id index score() uses. Throws
     // homcull::Error with `source` in the message. Readers and bakers call it last.
     void index(std::size_t object_count, const std::string& source);
 

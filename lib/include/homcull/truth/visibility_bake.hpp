@@ -30,7 +30,7 @@ struct BakeOptions {
     double eye_height = 0.0;  // floors: 0 = default_eye_height(scene) (walk_path's)
     std::uint32_t rays = 4096;
     std::uint32_t keep = 128;  // occluders kept per point, best first
-    int max_floors = 8;        // floors: storeys looked for per column
+    int max_floors = 8;        // floors: floors kept per column, from at most 8 times as many surface hits
     GridShard shard;           // bake only this shard's columns
 };
 
