@@ -242,6 +242,41 @@ TEST(SceneCulling, EveryStrategyOnSharedScenesHasNoFalseCulls) {
     if (found == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
 }
 
+// Temporal's second pass: an occluder hidden last frame that comes into view is drawn in the
+// same frame, so what it hides is culled at once, as one-pass culls it.
+TEST(SceneCulling, TemporalDrawsAnOccluderThatComesIntoViewAtOnce) {
+    Scene scene;
+    const std::uint32_t near_wall = test::add_quad(scene, "near wall", {-1, -1, -5}, {1, -1, -5}, {1, 1, -5}, {-1, 1, -5});
+    const std::uint32_t far_wall = test::add_quad(scene, "far wall", {-1.8f, -1.8f, -10}, {1.8f, -1.8f, -10}, {1.8f, 1.8f, -10},
+                                                  {-1.8f, 1.8f, -10});
+    const std::uint32_t box = test::add_box(scene, "box", {-0.5f, -0.5f, -15.5f}, {0.5f, 0.5f, -14.5f});
+    scene.finalize();
+    const std::vector<std::uint32_t> candidates = {near_wall, far_wall};
+    SceneCullerConfig config;
+    config.display = {128, 128};
+    SceneCuller one_pass(scene, candidates, config);
+    config.strategy = CullStrategy::temporal;
+    SceneCuller temporal(scene, candidates, config);
+    // Frame a: the near wall hides the far wall and the box. Frame b: a step to the side
+    // uncovers part of the far wall, which alone hides the box.
+    const Camera a = test::camera_down_minus_z(60.0);
+    Camera b = a;
+    b.eye = {3.0, 0.0, 0.0};
+    b.target = {3.0, 0.0, -1.0};
+    std::vector<OccludeeAnswer> answers, expected;
+    temporal.cull(a, answers);
+    ASSERT_EQ(answers[far_wall].visibility, Visibility::occluded);
+    ASSERT_EQ(answers[box].visibility, Visibility::occluded);
+    one_pass.cull(b, expected);
+    ASSERT_EQ(expected[far_wall].visibility, Visibility::visible);
+    ASSERT_EQ(expected[box].visibility, Visibility::occluded);
+    temporal.cull(b, answers);
+    EXPECT_EQ(answers[far_wall].visibility, Visibility::visible);
+    EXPECT_EQ(answers[box].visibility, Visibility::occluded) << "the far wall, hidden last frame, was not drawn";
+    EXPECT_EQ(temporal.work().occluder_objects, 2u);
+    EXPECT_EQ(temporal.work().renders, 2u);  // the second pass
+}
+
 TEST(SceneCulling, TemporalFirstFrameIsOnePassAndResetForgets) {
     const Scene scene = generate_scene("city:seed=3,blocks=5");
     const std::vector<std::uint32_t> candidates = occluder_candidates(scene, OccluderFilter::role);

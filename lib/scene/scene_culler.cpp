@@ -220,7 +220,7 @@ void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, const 
 // temporal's second pass. Last frame's answers leave out the candidates that were hidden; one
 // that has come into view this frame is found visible without having been drawn, and what it
 // hides is missed (a frame late, as Zhang's eq. 7.1 set alone would have it). Such candidates
-// are drawn now (within what the budget leaves), the maps rebuilt, and the objects found
+// are drawn now (nearest first, within what the budget leaves), the maps rebuilt, and the objects found
 // visible tested again. Hidden answers stay: drawing more only hides more. This is the second
 // phase of two-phase temporal occlusion culling (Haar and Aaltonen, "GPU-driven rendering
 // pipelines", SIGGRAPH 2015 course), here run only in frames where some candidate came into view.
@@ -229,9 +229,18 @@ void SceneCuller::draw_newly_visible(const Frame& frame, std::vector<OccludeeAns
     const std::size_t budget = config_.occluder_budget.triangles;
     std::size_t left = budget == 0 ? ~std::size_t(0) : budget - std::min(budget, work_.occluder_triangles);
     const std::size_t drawn_before = frame_occluders_.size();
+    // Nearest first, so that a budget goes to the occluders most likely to hide much.
+    rank_scratch_.clear();
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         const std::uint32_t id = occluder_ids_[k];
         if (drawn_[k] || answers[id].visibility != Visibility::visible) continue;
+        const Aabb& box = scene_->objects[id].world_bounds;
+        const glm::dvec3 eye = frame.camera->eye;
+        rank_scratch_.emplace_back(float(glm::length(eye - glm::clamp(eye, glm::dvec3(box.min), glm::dvec3(box.max)))), id);
+    }
+    std::sort(rank_scratch_.begin(), rank_scratch_.end());
+    for (const auto& [distance, id] : rank_scratch_) {
+        (void)distance;
         const std::size_t n = occluder_triangles_drawn(*scene_, id, *frame.camera, config_.lods);
         if (n > left) continue;
         append_occluder(id, *frame.camera, own_shared_edges_);
