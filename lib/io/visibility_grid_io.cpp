@@ -159,8 +159,8 @@ VisibilityGrid merge_visibility_grid_parts(const std::vector<VisibilityGridPart>
     if (parts.empty()) throw Error("merge: no visibility grid parts given");
     const std::uint32_t count = parts.front().shard.count;
     if (count != parts.size())
-        throw Error("merge: " + parts.front().source + " is one of " + std::to_string(count) + " shards, but " +
-                    std::to_string(parts.size()) + " files were given" +
+        throw Error("merge: " + parts.front().source + " is one of " + std::to_string(count) + " shards, but the files given number " +
+                    std::to_string(parts.size()) +
                     (count > parts.size() ? ": shard files are missing" : ": some are given twice or come from another bake"));
     std::vector<const VisibilityGridPart*> by_index(count, nullptr);
     for (const VisibilityGridPart& part : parts) {
