@@ -7,7 +7,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libglm-dev                      # math vocabulary (the only dependency of the core library)
   libembree-dev libtbb-dev        # ground truth ray casts; TBB drives the tools' parallel-for
-  libopenimageio-dev openimageio-tools  # image dumps (id images, later pyramids)
+  libopenimageio-dev openimageio-tools  # image dumps (id images, buffer and pyramid EXR/PNG dumps)
+  fonts-dejavu-core               # the legend text of the PNG dumps (OIIO render_text; its default font is not packaged)
   libassimp-dev zlib1g-dev        # scene import; assimp's CMake target links libz.so but does not depend on it
   libhwy-dev                      # SIMD with runtime dispatch (rasterizer)
   libmeshoptimizer-dev            # occluder simplification

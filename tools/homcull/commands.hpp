@@ -13,5 +13,6 @@ void register_accuracy(CLI::App& app);
 void register_cull(CLI::App& app);
 void register_walk(CLI::App& app);
 void register_bake(CLI::App& app);
+void register_dump(CLI::App& app);
 
 }  // namespace homcull::cli

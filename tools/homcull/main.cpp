@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
     homcull::cli::register_cull(app);
     homcull::cli::register_walk(app);
     homcull::cli::register_bake(app);
+    homcull::cli::register_dump(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

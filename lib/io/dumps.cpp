@@ -1,0 +1,330 @@
+#include <homcull/error.hpp>
+#include <homcull/io/dumps.hpp>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+
+namespace homcull {
+namespace {
+
+DumpPart make_part(std::string name, std::string quantity, int width, int height, DumpColormap colormap, bool larger_is_nearer) {
+    DumpPart p;
+    p.name = std::move(name);
+    p.quantity = std::move(quantity);
+    p.width = width;
+    p.height = height;
+    p.values.reserve(std::size_t(width) * std::size_t(height));
+    p.colormap = colormap;
+    p.larger_is_nearer = larger_is_nearer;
+    return p;
+}
+
+// The colormaps as degree-6 polynomial fits of matplotlib's viridis and magma (Matt Zucker's
+// CC0 fits, within about 1/255 of the tables): 14 numbers per map instead of two 256-entry
+// tables, and the same colours on every machine.
+using Poly = std::array<std::array<double, 3>, 7>;
+constexpr Poly kViridis = {{{0.2777273272234177, 0.005407344544966578, 0.3340998053353061},
+                            {0.1050930431085774, 1.404613529898575, 1.384590162594685},
+                            {-0.3308618287255563, 0.214847559468213, 0.09509516302823659},
+                            {-4.634230498983486, -5.799100973351585, -19.33244095627987},
+                            {6.228269936347081, 14.17993336680509, 56.69055260068105},
+                            {4.776384997670288, -13.74514537774601, -65.35303263337234},
+                            {-5.435455855934631, 4.645852612178535, 26.3124352495832}}};
+constexpr Poly kMagma = {{{-0.002136485053939582, -0.000749655052795221, -0.005386127855323933},
+                          {0.2516605407371642, 0.6775232436837668, 2.494026599312351},
+                          {8.353717279216625, -3.577719514958484, 0.3144679030132573},
+                          {-27.66873308576866, 14.26473078096533, -13.64921318813922},
+                          {52.17613981234068, -27.94360607168351, 12.94416944238394},
+                          {-50.76852536473588, 29.04658282127291, 4.23415299384598},
+                          {18.65570506591883, -11.48977351997711, -5.601961508734096}}};
+
+std::array<std::uint8_t, 3> colormap_rgb(DumpColormap map, double t) {
+    const Poly& c = map == DumpColormap::viridis ? kViridis : kMagma;
+    t = std::clamp(t, 0.0, 1.0);
+    std::array<std::uint8_t, 3> rgb{};
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+        double v = c[6][ch];
+        for (std::size_t i = 6; i-- > 0;) v = v * t + c[i][ch];  // Horner
+        rgb[ch] = std::uint8_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+    }
+    return rgb;
+}
+
+std::string number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.5g", v);
+    return text;
+}
+
+// The legend font, found once: OIIO's default (DroidSans) ships with OIIO's own font folder,
+// which Debian's package does not install, so DejaVu Sans (fonts-dejavu-core) is tried first.
+// Empty name and a reason when neither renders.
+struct LegendFont {
+    bool found = false;
+    std::string name, reason;
+};
+
+const LegendFont& legend_font() {
+    static const LegendFont font = [] {
+        LegendFont f;
+        for (const char* name : {"DejaVuSans", ""}) {
+            OIIO::ImageBuf probe(OIIO::ImageSpec(64, 24, 3, OIIO::TypeDesc::UINT8));
+            if (OIIO::ImageBufAlgo::render_text(probe, 2, 16, "0.5", 13, name)) {
+                f.found = true;
+                f.name = name;
+                return f;
+            }
+            f.reason += std::string(*name ? name : "OIIO's default font") + ": " + probe.geterror() + "; ";
+        }
+        f.reason = "no TrueType font could be rendered (" + f.reason.substr(0, f.reason.size() - 2) +
+                   "); install fonts-dejavu-core for the legend text";
+        return f;
+    }();
+    return font;
+}
+
+}  // namespace
+
+std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionMaps& maps) {
+    if (maps.levels() < 1 || maps.level_width(0) != buffer.config().width || maps.level_height(0) != buffer.config().height)
+        throw Error("dumps: the occlusion maps were not made for this buffer");
+    std::vector<DumpPart> parts;
+    const int sw = buffer.sample_width(), sh = buffer.sample_height();
+    {
+        std::vector<std::uint8_t> covered;
+        buffer.read_coverage(covered);
+        DumpPart p = make_part("buffer.coverage", "per sample: 1 covered by an occluder, 0 not", sw, sh, DumpColormap::viridis, false);
+        for (std::uint8_t c : covered) p.values.push_back(float(c));
+        parts.push_back(std::move(p));
+    }
+    {
+        DumpPart p = make_part("buffer.depth", "per sample: conservative occluder depth as clip w (larger is farther), +inf no occluder",
+                               sw, sh, DumpColormap::magma, false);
+        buffer.read_depth(p.values);
+        parts.push_back(std::move(p));
+    }
+    for (int k = 0; k < maps.levels(); ++k) {
+        const int w = maps.level_width(k), h = maps.level_height(k);
+        const std::string level = ".L" + std::to_string(k);
+        DumpPart opacity = make_part("opacity" + level,
+                                     "opacity pyramid level " + std::to_string(k) + ": covered samples / samples per cell", w, h,
+                                     DumpColormap::viridis, false);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) opacity.values.push_back(maps.opacity(k, x, y));
+        parts.push_back(std::move(opacity));
+        const std::size_t n = std::size_t(w) * std::size_t(h);
+        DumpPart maxz = make_part("maxz" + level,
+                                  "max-Z (hzb) pyramid level " + std::to_string(k) +
+                                      ": farthest depth of the covered samples as 1/w (larger is nearer), +inf no occluder",
+                                  w, h, DumpColormap::magma, true);
+        maxz.values.assign(maps.farthest_depth(k), maps.farthest_depth(k) + n);
+        parts.push_back(std::move(maxz));
+        DumpPart nbz = make_part("nbz" + level,
+                                 "no-background Z-buffer pyramid level " + std::to_string(k) +
+                                     ": nearest depth of the covered samples as 1/w (larger is nearer), +inf no occluder",
+                                 w, h, DumpColormap::magma, true);
+        nbz.values.assign(maps.nearest_depth(k), maps.nearest_depth(k) + n);
+        parts.push_back(std::move(nbz));
+    }
+    // Only filled (add_occluder_box) when the maps answer with it: otherwise all +inf, noise.
+    if (maps.config().depth == DepthTest::deb) {
+        DumpPart deb = make_part("deb", "depth estimation buffer: farthest depth of the occluder boxes as 1/w (larger is nearer), +inf none",
+                                 maps.config().deb_width, maps.config().deb_height, DumpColormap::magma, true);
+        deb.values = maps.depth_estimation();
+        parts.push_back(std::move(deb));
+    }
+    return parts;
+}
+
+void write_maps_exr(const OcclusionBuffer& buffer, const OcclusionMaps& maps, const std::string& path) {
+    write_maps_exr(dump_parts(buffer, maps), path);
+}
+
+void write_maps_exr(const std::vector<DumpPart>& parts, const std::string& path) {
+    if (parts.empty()) throw Error(path + ": no parts to write");
+    // OpenEXR requires the parts of one file to share the display window: the largest part.
+    int full_w = 0, full_h = 0;
+    for (const DumpPart& p : parts) {
+        if (p.width < 1 || p.height < 1 || p.values.size() != std::size_t(p.width) * std::size_t(p.height))
+            throw Error(path + ": part " + p.name + " does not match its size");
+        full_w = std::max(full_w, p.width);
+        full_h = std::max(full_h, p.height);
+    }
+    std::vector<OIIO::ImageSpec> specs;
+    for (const DumpPart& p : parts) {
+        OIIO::ImageSpec spec(p.width, p.height, 1, OIIO::TypeDesc::FLOAT);
+        spec.full_x = spec.full_y = 0;
+        spec.full_width = full_w;
+        spec.full_height = full_h;
+        spec.channelnames = {"Y"};
+        // The EXR part name ("name" in the header): OIIO's openexr writer takes it from here.
+        spec.attribute("oiio:subimagename", p.name);
+        spec.attribute("homcull:quantity", p.quantity);
+        spec.attribute("compression", "zip");  // lossless
+        specs.push_back(std::move(spec));
+    }
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw Error(path + ": cannot write an image of this type (" + OIIO::geterror() + ")");
+    if (!out->supports("multiimage")) throw Error(path + ": the " + std::string(out->format_name()) + " format holds one image, not a dump");
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        // The first open declares every part (multi-part EXR writes its headers up front); the
+        // others append, in the same order.
+        const bool opened = i == 0 ? out->open(path, int(specs.size()), specs.data())
+                                   : out->open(path, specs[i], OIIO::ImageOutput::AppendSubimage);
+        if (!opened || !out->write_image(OIIO::TypeDesc::FLOAT, parts[i].values.data())) {
+            const std::string why = out->geterror();
+            out->close();
+            throw Error(path + ": " + (why.empty() ? "cannot write part " + parts[i].name : why));
+        }
+    }
+    if (!out->close()) throw Error(path + ": " + out->geterror());
+}
+
+ColormapPng colormap_png_size(int width, int height) {
+    ColormapPng r;
+    r.scale = std::max(1, (kMinPngWidth + width - 1) / std::max(width, 1));
+    r.width = width * r.scale;
+    r.height = height * r.scale + kLegendHeight;
+    return r;
+}
+
+ColormapPng write_colormap_png(const DumpPart& part, const std::string& path) {
+    if (part.width < 1 || part.height < 1 || part.values.size() != std::size_t(part.width) * std::size_t(part.height))
+        throw Error(path + ": part " + part.name + " does not match its size");
+    ColormapPng r = colormap_png_size(part.width, part.height);
+    r.path = path;
+    const bool depth = part.colormap == DumpColormap::magma;
+    // Depths span their finite values (+inf is "no occluder", drawn apart); coverage and
+    // opacity the fixed [0, 1], so that levels and frames compare by colour.
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (float v : part.values) {
+        if (!std::isfinite(v)) {
+            ++r.no_occluder;
+            continue;
+        }
+        lo = std::min(lo, double(v));
+        hi = std::max(hi, double(v));
+    }
+    r.finite = lo <= hi;
+    if (!depth) {
+        lo = 0.0;
+        hi = 1.0;
+    }
+    r.range_min = r.finite ? lo : 0.0;
+    r.range_max = r.finite ? hi : 0.0;
+    // t in [0, 1] along the colormap; depths drawn near = bright whichever way they are stored.
+    auto t_of = [&](double v) {
+        if (!depth) return v;
+        if (hi <= lo) return 1.0;
+        const double t = (v - lo) / (hi - lo);
+        return part.larger_is_nearer ? t : 1.0 - t;
+    };
+
+    OIIO::ImageBuf image(OIIO::ImageSpec(r.width, r.height, 3, OIIO::TypeDesc::UINT8));
+    auto* pixels = static_cast<std::uint8_t*>(image.localpixels());
+    if (!pixels) throw Error(path + ": cannot allocate the image");
+    auto put = [&](int x, int y, const std::uint8_t* rgb) {
+        std::uint8_t* p = pixels + (std::size_t(y) * std::size_t(r.width) + std::size_t(x)) * 3;
+        p[0] = rgb[0];
+        p[1] = rgb[1];
+        p[2] = rgb[2];
+    };
+    for (int y = 0; y < part.height; ++y)
+        for (int x = 0; x < part.width; ++x) {
+            const float v = part.values[std::size_t(y) * std::size_t(part.width) + std::size_t(x)];
+            const std::array<std::uint8_t, 3> c = std::isfinite(v) ? colormap_rgb(part.colormap, t_of(double(v)))
+                                                                   : std::array<std::uint8_t, 3>{kNoOccluderRgb[0], kNoOccluderRgb[1],
+                                                                                                 kNoOccluderRgb[2]};
+            for (int sy = 0; sy < r.scale; ++sy)
+                for (int sx = 0; sx < r.scale; ++sx) put(x * r.scale + sx, y * r.scale + sy, c.data());
+        }
+
+    // The legend strip: dark background, a colour bar from the range's low end (left) to its
+    // high end (right), the values at its ends and what the colours mean.
+    const int y0 = part.height * r.scale;
+    const std::uint8_t background[3] = {24, 24, 24};
+    for (int y = y0; y < r.height; ++y)
+        for (int x = 0; x < r.width; ++x) put(x, y, background);
+    const int bar_x0 = 8, bar_x1 = r.width - 8;
+    for (int x = bar_x0; x < bar_x1; ++x) {
+        const double t = double(x - bar_x0) / double(std::max(1, bar_x1 - bar_x0 - 1));
+        const std::array<std::uint8_t, 3> c = colormap_rgb(part.colormap, t);
+        for (int y = y0 + 4; y < y0 + 16; ++y) put(x, y, c.data());
+    }
+    std::string left, right, second_left, second_right;
+    if (!depth) {
+        left = "0";
+        right = "1";
+        second_left = part.name + (r.finite ? " (values " + number(lo) + " .. " + number(hi) + ")" : "");
+    } else {
+        const char* unit = part.larger_is_nearer ? "1/w" : "w";
+        // Far at the left, near at the right, whichever end of the stored range that is.
+        const double far = part.larger_is_nearer ? lo : hi, near = part.larger_is_nearer ? hi : lo;
+        left = r.finite ? "far " + std::string(unit) + " = " + number(far) : "no finite depth";
+        right = r.finite ? "near " + std::string(unit) + " = " + number(near) : "";
+        second_left = part.name;
+        second_right = "green: no occluder (" + std::to_string(r.no_occluder) + " px)";
+    }
+    const LegendFont& font = legend_font();
+    r.text_drawn = font.found;
+    if (font.found) {
+        const float white[3] = {0.92f, 0.92f, 0.92f}, green[3] = {0.0f, 200.0f / 255.0f, 90.0f / 255.0f};
+        bool ok = OIIO::ImageBufAlgo::render_text(image, bar_x0, y0 + 31, left, 13, font.name, white);
+        if (!right.empty())
+            ok = ok && OIIO::ImageBufAlgo::render_text(image, bar_x1, y0 + 31, right, 13, font.name, white, OIIO::ImageBufAlgo::TextAlignX::Right);
+        ok = ok && OIIO::ImageBufAlgo::render_text(image, bar_x0, y0 + 45, second_left, 12, font.name, white);
+        if (!second_right.empty())
+            ok = ok && OIIO::ImageBufAlgo::render_text(image, bar_x1, y0 + 45, second_right, 12, font.name, green,
+                                                      OIIO::ImageBufAlgo::TextAlignX::Right);
+        if (!ok) {
+            r.text_drawn = false;
+            r.note = "legend text failed: " + image.geterror();
+        }
+    } else {
+        r.note = font.reason;
+    }
+    if (!image.write(path, OIIO::TypeDesc::UINT8, "png")) throw Error(path + ": " + image.geterror());
+    return r;
+}
+
+std::vector<ColormapPng> write_colormap_pngs(const std::vector<DumpPart>& parts, const std::string& dir) {
+    std::vector<ColormapPng> written;
+    nlohmann::json index = nlohmann::json::array();
+    for (const DumpPart& part : parts) {
+        const std::string file = part.name + ".png";
+        written.push_back(write_colormap_png(part, dir + "/" + file));
+        const ColormapPng& r = written.back();
+        nlohmann::json entry = {{"part", part.name},
+                                {"file", file},
+                                {"quantity", part.quantity},
+                                {"colormap", part.colormap == DumpColormap::viridis ? "viridis" : "magma"},
+                                {"size", {r.width, r.height}},
+                                {"scale", r.scale},
+                                {"text_drawn", r.text_drawn}};
+        // JSON has no infinity: a part without finite values has no range.
+        entry["range"] = r.finite ? nlohmann::json{r.range_min, r.range_max} : nlohmann::json(nullptr);
+        if (part.colormap == DumpColormap::magma) {
+            entry["no_occluder_pixels"] = r.no_occluder;
+            entry["no_occluder_rgb"] = {kNoOccluderRgb[0], kNoOccluderRgb[1], kNoOccluderRgb[2]};
+            entry["near_is_bright"] = true;
+        }
+        if (!r.note.empty()) entry["note"] = r.note;
+        index.push_back(std::move(entry));
+    }
+    const std::string path = dir + "/colormaps.json";
+    std::ofstream out(path);
+    out << index.dump(1) << '\n';
+    if (!out.flush()) throw Error(path + ": cannot write");
+    return written;
+}
+
+}  // namespace homcull

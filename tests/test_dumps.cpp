@@ -1,0 +1,284 @@
+// Debug dumps (homcull/io/dumps.hpp, `homcull dump`): the multi-part EXR holds every buffer
+// and pyramid level under its name, bit for bit as the library reports them; the PNGs have
+// the promised size, colours and legend; errors name the file.
+#include "support.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/generate.hpp>
+#include <homcull/io/dumps.hpp>
+#include <homcull/occluder_selection.hpp>
+#include <homcull/scene_culler.hpp>
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+namespace homcull {
+namespace {
+
+// The view of tests/test_cli.cpp's city: streets with buildings in front of others and sky
+// above, so the depth parts have both finite values and "no occluder".
+Camera city_camera() {
+    Camera c;
+    c.eye = {-1.0, 1.7, -30.0};
+    c.target = {20.0, 3.0, 10.0};
+    return c;
+}
+constexpr int kDisplayW = 96, kDisplayH = 54;
+const std::string kCityArguments = "--scene gen:city:seed=2,blocks=3 --eye -1,1.7,-30 --target 20,3,10 --resolution 96x54";
+
+// One culled frame of the city, configured as `homcull dump` does with default options.
+struct CityFrame {
+    Scene scene = generate_scene("city:seed=2,blocks=3");
+    std::vector<std::uint32_t> occluders = filter_by_complexity(scene, occluder_candidates(scene, OccluderFilter::role), 0.0);
+    SceneCuller culler;
+    explicit CityFrame(const SceneCullerConfig& config) : culler(scene, occluders, config) {
+        std::vector<OccludeeAnswer> answers;
+        culler.cull(city_camera(), answers);
+    }
+};
+
+SceneCullerConfig city_config(int samples = 1, DepthTest depth = DepthTest::masked) {
+    SceneCullerConfig config;
+    config.display = {kDisplayW, kDisplayH};
+    config.samples = samples;
+    config.maps.depth = depth;
+    config.maps.deb_width = 24;  // a deb smaller than the buffer, to see its own size
+    config.maps.deb_height = 12;
+    return config;
+}
+
+struct ExrPart {
+    std::string name;
+    int width, height, channels;
+    OIIO::TypeDesc format;
+    std::vector<float> values;
+};
+
+std::vector<ExrPart> read_exr(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(path + ": " + OIIO::geterror());
+    std::vector<ExrPart> parts;
+    for (int i = 0; in->seek_subimage(i, 0); ++i) {
+        const OIIO::ImageSpec& spec = in->spec();
+        ExrPart p{spec.get_string_attribute("oiio:subimagename"), spec.width, spec.height, spec.nchannels, spec.format, {}};
+        p.values.resize(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+        if (!in->read_image(i, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, p.values.data())) throw Error(path + ": " + in->geterror());
+        parts.push_back(std::move(p));
+    }
+    return parts;
+}
+
+// What the buffer and the maps report, read through their own accessors (not dump_parts),
+// in the documented part order.
+std::vector<std::pair<std::string, std::vector<float>>> expected_parts(const OcclusionBuffer& buffer, const OcclusionMaps& maps) {
+    std::vector<std::pair<std::string, std::vector<float>>> out;
+    std::vector<std::uint8_t> covered;
+    buffer.read_coverage(covered);
+    out.emplace_back("buffer.coverage", std::vector<float>(covered.begin(), covered.end()));
+    std::vector<float> depth;
+    buffer.read_depth(depth);
+    out.emplace_back("buffer.depth", depth);
+    for (int k = 0; k < maps.levels(); ++k) {
+        const std::size_t n = std::size_t(maps.level_width(k)) * std::size_t(maps.level_height(k));
+        std::vector<float> opacity;
+        for (int y = 0; y < maps.level_height(k); ++y)
+            for (int x = 0; x < maps.level_width(k); ++x) opacity.push_back(maps.opacity(k, x, y));
+        out.emplace_back("opacity.L" + std::to_string(k), opacity);
+        out.emplace_back("maxz.L" + std::to_string(k), std::vector<float>(maps.farthest_depth(k), maps.farthest_depth(k) + n));
+        out.emplace_back("nbz.L" + std::to_string(k), std::vector<float>(maps.nearest_depth(k), maps.nearest_depth(k) + n));
+    }
+    if (maps.config().depth == DepthTest::deb) out.emplace_back("deb", maps.depth_estimation());
+    return out;
+}
+
+// Every part present in order, one FLOAT channel, and the same bits (memcmp: +inf and -0 too).
+void expect_exr_matches(const std::string& path, const OcclusionBuffer& buffer, const OcclusionMaps& maps) {
+    const std::vector<ExrPart> parts = read_exr(path);
+    const auto expected = expected_parts(buffer, maps);
+    const std::size_t count = 2 + 3 * std::size_t(maps.levels()) + (maps.config().depth == DepthTest::deb ? 1 : 0);
+    ASSERT_EQ(expected.size(), count);
+    ASSERT_EQ(parts.size(), count);
+    for (std::size_t i = 0; i < count; ++i) {
+        SCOPED_TRACE(expected[i].first);
+        EXPECT_EQ(parts[i].name, expected[i].first);
+        EXPECT_EQ(parts[i].channels, 1);
+        EXPECT_EQ(parts[i].format, OIIO::TypeDesc::FLOAT);
+        ASSERT_EQ(parts[i].values.size(), expected[i].second.size());
+        EXPECT_EQ(std::memcmp(parts[i].values.data(), expected[i].second.data(), parts[i].values.size() * sizeof(float)), 0);
+    }
+    // Sizes: samples for the buffer, the pyramid's cells per level.
+    EXPECT_EQ(parts[0].width, buffer.sample_width());
+    EXPECT_EQ(parts[0].height, buffer.sample_height());
+    EXPECT_EQ(parts[2].width, maps.level_width(0));
+    EXPECT_EQ(parts[2].height, maps.level_height(0));
+}
+
+TEST(Dumps, ExrHasEveryPartBitForBitWithTwoSamples) {
+    const CityFrame frame(city_config(2));
+    const std::string dir = test::temp_dir("dumps_exr_samples");
+    write_maps_exr(frame.culler.buffer(), frame.culler.maps(), dir + "/maps.exr");
+    expect_exr_matches(dir + "/maps.exr", frame.culler.buffer(), frame.culler.maps());
+    // The view shows occluders and sky: depth parts hold finite values and +inf.
+    std::vector<float> depth;
+    frame.culler.buffer().read_depth(depth);
+    EXPECT_GT(std::count_if(depth.begin(), depth.end(), [](float w) { return std::isfinite(w); }), 0);
+    EXPECT_GT(std::count_if(depth.begin(), depth.end(), [](float w) { return std::isinf(w); }), 0);
+}
+
+TEST(Dumps, ExrHasTheDepthEstimationBufferWhenTheMapsUseIt) {
+    const CityFrame frame(city_config(1, DepthTest::deb));
+    const std::string dir = test::temp_dir("dumps_exr_deb");
+    write_maps_exr(frame.culler.buffer(), frame.culler.maps(), dir + "/maps.exr");
+    expect_exr_matches(dir + "/maps.exr", frame.culler.buffer(), frame.culler.maps());
+    const std::vector<ExrPart> parts = read_exr(dir + "/maps.exr");
+    EXPECT_EQ(parts.back().name, "deb");
+    EXPECT_EQ(parts.back().width, 24);
+    EXPECT_EQ(parts.back().height, 12);
+    // Filled by the occluder boxes, not left at "nothing".
+    EXPECT_TRUE(std::any_of(parts.back().values.begin(), parts.back().values.end(), [](float d) { return std::isfinite(d); }));
+}
+
+bool have_legend_font() {
+    for (const char* f : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"})
+        if (std::filesystem::exists(f)) return true;
+    return false;
+}
+
+TEST(Dumps, PngsHaveTheExpectedSizeColoursAndRanges) {
+    const CityFrame frame(city_config(2));
+    const std::string dir = test::temp_dir("dumps_png");
+    const std::vector<DumpPart> parts = dump_parts(frame.culler.buffer(), frame.culler.maps());
+    const std::vector<ColormapPng> pngs = write_colormap_pngs(parts, dir);
+    ASSERT_EQ(pngs.size(), parts.size());
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        SCOPED_TRACE(parts[i].name);
+        const ColormapPng size = colormap_png_size(parts[i].width, parts[i].height);
+        EXPECT_EQ(pngs[i].path, dir + "/" + parts[i].name + ".png");
+        EXPECT_EQ(pngs[i].width, size.width);
+        EXPECT_EQ(pngs[i].height, size.height);
+        EXPECT_GE(pngs[i].width, kMinPngWidth);
+        EXPECT_EQ(pngs[i].height, parts[i].height * pngs[i].scale + kLegendHeight);
+        auto in = OIIO::ImageInput::open(pngs[i].path);
+        ASSERT_TRUE(in) << OIIO::geterror();
+        EXPECT_EQ(in->spec().width, size.width);
+        EXPECT_EQ(in->spec().height, size.height);
+        EXPECT_EQ(in->spec().nchannels, 3);
+        // Infinite depths are drawn in the no-occluder colour and left out of the range.
+        const auto inf = std::find_if(parts[i].values.begin(), parts[i].values.end(), [](float v) { return std::isinf(v); });
+        if (inf != parts[i].values.end()) {
+            const std::size_t at = std::size_t(inf - parts[i].values.begin());
+            const int x = int(at % std::size_t(parts[i].width)) * pngs[i].scale, y = int(at / std::size_t(parts[i].width)) * pngs[i].scale;
+            std::vector<std::uint8_t> image(std::size_t(size.width) * std::size_t(size.height) * 3);
+            ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, image.data())) << in->geterror();
+            std::array<std::uint8_t, 3> rgb{};
+            std::memcpy(rgb.data(), image.data() + (std::size_t(y) * std::size_t(size.width) + std::size_t(x)) * 3, 3);
+            EXPECT_EQ(rgb, (std::array<std::uint8_t, 3>{kNoOccluderRgb[0], kNoOccluderRgb[1], kNoOccluderRgb[2]}));
+            EXPECT_GT(pngs[i].no_occluder, 0u);
+            EXPECT_TRUE(std::isfinite(pngs[i].range_min) && std::isfinite(pngs[i].range_max));
+        }
+        if (parts[i].colormap == DumpColormap::viridis) {
+            EXPECT_EQ(pngs[i].range_min, 0.0);
+            EXPECT_EQ(pngs[i].range_max, 1.0);
+        }
+        if (have_legend_font()) {
+            EXPECT_TRUE(pngs[i].text_drawn) << pngs[i].note;
+        }
+        if (!pngs[i].text_drawn) {
+            EXPECT_FALSE(pngs[i].note.empty());
+        }
+    }
+    std::ifstream index_file(dir + "/colormaps.json");
+    ASSERT_TRUE(index_file) << "colormaps.json missing";
+    const auto index = nlohmann::json::parse(index_file);
+    ASSERT_EQ(index.size(), parts.size());
+    EXPECT_EQ(index[1]["part"], "buffer.depth");
+    EXPECT_EQ(index[1]["colormap"], "magma");
+    EXPECT_EQ(index[1]["range"][0].get<double>(), pngs[1].range_min);
+    EXPECT_EQ(index[1]["no_occluder_pixels"].get<std::uint64_t>(), pngs[1].no_occluder);
+}
+
+TEST(Dumps, UnwritablePathsThrowNamingTheFile) {
+    const CityFrame frame(city_config());
+    const std::string missing = test::temp_dir("dumps_errors") + "/no/such/folder";
+    for (const std::string& path : {missing + "/maps.exr", missing + "/part.png"}) {
+        try {
+            if (path.find(".exr") != std::string::npos)
+                write_maps_exr(frame.culler.buffer(), frame.culler.maps(), path);
+            else
+                write_colormap_png(dump_parts(frame.culler.buffer(), frame.culler.maps())[0], path);
+            ADD_FAILURE() << "no error for " << path;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        }
+    }
+    // A format that holds one image cannot hold a dump.
+    EXPECT_THROW(write_maps_exr(frame.culler.buffer(), frame.culler.maps(), missing + "/maps.png"), Error);
+}
+
+// Runs `homcull <arguments>` (as tests/test_cli.cpp does), stdout and stderr into `dir`.
+struct CliRun {
+    int exit_code;
+    std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+CliRun run_command(const std::string& command, const std::string& dir) {
+    const int status = std::system((command + " >" + dir + "/stdout 2>" + dir + "/stderr").c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir + "/stdout"), slurp(dir + "/stderr")};
+}
+
+TEST(Dumps, CliDumpWritesTheSameExrAndThePngs) {
+    const std::string dir = test::temp_dir("dumps_cli");
+    const std::string out = dir + "/dump";  // created by the command
+    const CliRun r = run_command(std::string(HOMCULL_CLI_PATH) + " dump " + kCityArguments + " --samples 2 --out " + out, dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find(out + "/maps.exr"), std::string::npos) << r.out;
+    // The command's frame, bit for bit: the same frame culled here with the same settings.
+    const CityFrame frame(city_config(2));
+    expect_exr_matches(out + "/maps.exr", frame.culler.buffer(), frame.culler.maps());
+    for (const DumpPart& part : dump_parts(frame.culler.buffer(), frame.culler.maps())) {
+        SCOPED_TRACE(part.name);
+        const std::string png = out + "/" + part.name + ".png";
+        ASSERT_TRUE(std::filesystem::exists(png));
+        EXPECT_NE(r.out.find(png), std::string::npos);
+        auto in = OIIO::ImageInput::open(png);
+        ASSERT_TRUE(in) << OIIO::geterror();
+        const ColormapPng size = colormap_png_size(part.width, part.height);
+        EXPECT_EQ(in->spec().width, size.width);
+        EXPECT_EQ(in->spec().height, size.height);
+    }
+    EXPECT_TRUE(std::filesystem::exists(out + "/colormaps.json"));
+
+    // oiiotool lists every part by name (-a: all subimages; without it, only the first's
+    // metadata is printed).
+    if (std::system("command -v oiiotool >/dev/null 2>&1") != 0) GTEST_SKIP() << "oiiotool not installed (openimageio-tools)";
+    const CliRun info = run_command("oiiotool -a --info -v " + out + "/maps.exr", dir);
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    for (const DumpPart& part : dump_parts(frame.culler.buffer(), frame.culler.maps()))
+        EXPECT_NE(info.out.find("name: \"" + part.name + "\""), std::string::npos) << part.name << "\n" << info.out;
+}
+
+TEST(Dumps, CliDumpFailsNamingAnUnusableFolder) {
+    const std::string dir = test::temp_dir("dumps_cli_error");
+    test::write_text(dir + "/file", "not a folder");
+    const CliRun r = run_command(std::string(HOMCULL_CLI_PATH) + " dump " + kCityArguments + " --out " + dir + "/file/sub", dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(dir + "/file/sub"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace homcull
