@@ -8,6 +8,7 @@
 #include <homcull/io/dumps.hpp>
 #include <homcull/occluder_selection.hpp>
 #include <homcull/scene_culler.hpp>
+#include <homcull/truth/answer_overlay.hpp>
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
@@ -270,6 +271,60 @@ TEST(Dumps, CliDumpWritesTheSameExrAndThePngs) {
     ASSERT_EQ(info.exit_code, 0) << info.err;
     for (const DumpPart& part : dump_parts(frame.culler.buffer(), frame.culler.maps()))
         EXPECT_NE(info.out.find("name: \"" + part.name + "\""), std::string::npos) << part.name << "\n" << info.out;
+}
+
+TEST(Dumps, OverlayColoursEachAnswerAndShowsFalseCullsInMagenta) {
+    const Scene scene = generate_scene("city:seed=2,blocks=3");
+    const std::vector<std::uint32_t> occluders = occluder_candidates(scene, OccluderFilter::role);
+    SceneCuller culler(scene, occluders, city_config());
+    std::vector<OccludeeAnswer> answers;
+    culler.cull(city_camera(), answers);
+    const RayScene rays(scene);
+    const Resolution display{kDisplayW, kDisplayH};
+    // The culler's own answers: conservative, so nothing seen is culled.
+    const AnswerOverlay right = render_answer_overlay(rays, city_camera(), display, answers, culler.drawn_occluders());
+    ASSERT_EQ(right.rgb.size(), std::size_t(3 * kDisplayW * kDisplayH));
+    EXPECT_EQ(right.false_cull_pixels, 0u);
+    std::size_t blue = 0, grey = 0;
+    for (std::size_t i = 0; i < right.rgb.size(); i += 3) {
+        const int r = right.rgb[i], g = right.rgb[i + 1], b = right.rgb[i + 2];
+        blue += b > r + 40 && b > g;
+        grey += r == g && g == b && r > 0;
+    }
+    EXPECT_GT(blue, 0u) << "drawn occluders";
+    EXPECT_GT(grey, 0u) << "kept objects";
+    // Cull one object that is seen: it turns up as a false cull, in magenta.
+    std::uint32_t seen = kNoObject;
+    for (std::uint32_t id = 0; id < answers.size() && seen == kNoObject; ++id)
+        if (answers[id].visibility == Visibility::visible &&
+            std::find(culler.drawn_occluders().begin(), culler.drawn_occluders().end(), id) == culler.drawn_occluders().end())
+            seen = id;
+    ASSERT_NE(seen, kNoObject);
+    std::vector<OccludeeAnswer> wrong = answers;
+    wrong[seen].visibility = Visibility::occluded;
+    const AnswerOverlay loud = render_answer_overlay(rays, city_camera(), display, wrong, culler.drawn_occluders());
+    if (loud.false_cull_pixels == 0) GTEST_SKIP() << "object " << seen << " is visible to the culler but no pixel centre sees it";
+    EXPECT_EQ(loud.false_culls, std::vector<std::uint32_t>{seen});
+    std::size_t magenta = 0;
+    for (std::size_t i = 0; i < loud.rgb.size(); i += 3) magenta += loud.rgb[i] == 255 && loud.rgb[i + 1] == 0 && loud.rgb[i + 2] == 255;
+    EXPECT_EQ(magenta, loud.false_cull_pixels);
+    EXPECT_THROW(render_answer_overlay(rays, city_camera(), display, {}, {}), Error);
+}
+
+TEST(Dumps, CullDumpWritesTheMapsAndTheOverlay) {
+    const std::string dir = test::temp_dir("dumps_cull");
+    const CliRun r =
+        run_command(std::string(HOMCULL_CLI_PATH) + " cull " + kCityArguments + " --truth --json --dump " + dir + "/frame", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
+    EXPECT_FALSE(j.is_discarded()) << "the dump's lines go to stderr with --json:\n" << r.out;
+    EXPECT_NE(r.err.find("0 false-cull pixels"), std::string::npos) << r.err;
+    for (const char* file : {"maps.exr", "overlay.png", "colormaps.json", "opacity.L0.png"})
+        EXPECT_TRUE(std::filesystem::exists(dir + "/frame/" + file)) << file;
+    auto in = OIIO::ImageInput::open(dir + "/frame/overlay.png");
+    ASSERT_TRUE(in) << OIIO::geterror();
+    EXPECT_EQ(in->spec().width, kDisplayW);
+    EXPECT_EQ(in->spec().height, kDisplayH);
 }
 
 TEST(Dumps, CliDumpFailsNamingAnUnusableFolder) {

@@ -19,6 +19,16 @@ std::uint32_t id_color(std::uint32_t id) {
     return x | 0x404040u;
 }
 
+void write_rgb_image(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
+    if (width < 1 || height < 1 || rgb.size() != 3 * std::size_t(width) * std::size_t(height))
+        throw Error(path + ": pixel buffer does not match the image size");
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw Error(path + ": cannot write an image of this type (" + OIIO::geterror() + ")");
+    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+    if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
+        throw Error(path + ": " + out->geterror());
+}
+
 void write_id_image(const std::string& path, int width, int height, const std::vector<std::uint32_t>& ids) {
     if (width < 1 || height < 1 || ids.size() != std::size_t(width) * std::size_t(height))
         throw Error(path + ": id buffer does not match the image size");
@@ -28,16 +38,14 @@ void write_id_image(const std::string& path, int width, int height, const std::v
     const bool eight_bit = format == "png" || format == "jpeg" || format == "bmp" || format == "targa" ||
                            format == "gif" || format == "webp" || format == "pnm";
     if (eight_bit) {
-        std::vector<unsigned char> rgb(ids.size() * 3);
+        std::vector<std::uint8_t> rgb(ids.size() * 3);
         for (std::size_t i = 0; i < ids.size(); ++i) {
             const std::uint32_t c = ids[i] == kNoObject ? 0u : id_color(ids[i]);
-            rgb[3 * i + 0] = (c >> 16) & 0xFF;
-            rgb[3 * i + 1] = (c >> 8) & 0xFF;
-            rgb[3 * i + 2] = c & 0xFF;
+            rgb[3 * i + 0] = std::uint8_t((c >> 16) & 0xFF);
+            rgb[3 * i + 1] = std::uint8_t((c >> 8) & 0xFF);
+            rgb[3 * i + 2] = std::uint8_t(c & 0xFF);
         }
-        OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-        if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
-            throw Error(path + ": " + out->geterror());
+        write_rgb_image(path, width, height, rgb);
         return;
     }
     std::vector<std::uint32_t> stored(ids.size());

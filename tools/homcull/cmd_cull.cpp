@@ -2,6 +2,7 @@
 #include "commands.hpp"
 #include "cull_options.hpp"
 #include "cull_report.hpp"
+#include "frame_dump.hpp"
 #include "options.hpp"
 
 #include <homcull/io/scene_io.hpp>
@@ -23,7 +24,7 @@ struct CullCommandOptions {
     SceneChoice scene;
     CameraOptions camera;
     CullOptions cull;
-    std::string isa = "best";
+    std::string isa = "best", dump;
     bool json = false, truth = false;
     int threads = 1, repeat = 1;
 };
@@ -32,6 +33,7 @@ void run_cull(const CullCommandOptions& o) {
     select_isa(o.isa);
     const Camera camera = resolve_camera(o.camera);
     SceneCullerConfig config = scene_culler_config(o.cull);
+    if (!o.dump.empty()) prepare_dump_folder(o.dump);
     long long start = now_ns();
     const Scene scene = load_chosen_scene(o.scene);
     const double load_ms = elapsed_ms(start);
@@ -54,14 +56,16 @@ void run_cull(const CullCommandOptions& o) {
     // Optional ground truth at the display's pixel centres.
     TruthResult truth;
     double truth_ms = 0.0;
+    start = now_ns();
+    std::unique_ptr<RayScene> rays;
+    if (o.truth || !o.dump.empty()) rays = std::make_unique<RayScene>(scene);
     if (o.truth) {
-        start = now_ns();
-        const RayScene rays(scene);
         TruthOptions truth_options;
         truth_options.resolution = config.display;
-        truth = compute_ground_truth(rays, scene, camera, truth_options);
+        truth = compute_ground_truth(*rays, scene, camera, truth_options);
         truth_ms = elapsed_ms(start);
     }
+    if (!o.dump.empty()) write_frame_dump(culler, *rays, camera, answers, o.dump, /*print_to_stderr=*/o.json);
 
     CullingTally tally;
     if (o.truth) tally_answers(scene, truth, answers, camera, tally);
@@ -147,6 +151,7 @@ void register_cull(CLI::App& app) {
         ->capture_default_str()->check(CLI::Range(1, 1000));
     cmd->add_flag("--truth", o->truth, "Also cast Embree ground truth at the display's pixel centres and count false culls");
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
+    cmd->add_option("--dump", o->dump, "Also write the frame's debug dump into this folder (as homcull dump: maps.exr, PNGs, overlay.png)");
     cmd->callback([o] { run_cull(*o); });
 }
 

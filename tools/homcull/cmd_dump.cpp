@@ -1,19 +1,18 @@
 // homcull dump: one culled frame's occlusion buffer and hierarchical occlusion maps as a
-// multi-part EXR (DIR/maps.exr) and colormapped PNGs (DIR/<part>.png, DIR/colormaps.json).
+// multi-part EXR (DIR/maps.exr) and colormapped PNGs (DIR/<part>.png, DIR/colormaps.json), and
+// the scene coloured by the answers (DIR/overlay.png, false culls in magenta).
 #include "commands.hpp"
 #include "cull_options.hpp"
+#include "frame_dump.hpp"
 #include "options.hpp"
 
 #include <homcull/error.hpp>
-#include <homcull/io/dumps.hpp>
 #include <homcull/io/scene_io.hpp>
 #include <homcull/tbb_parallel_for.hpp>
 
 #include <fmt/core.h>
 
-#include <filesystem>
 #include <memory>
-#include <system_error>
 
 namespace homcull::cli {
 namespace {
@@ -29,40 +28,16 @@ struct DumpCommandOptions {
 void run_dump(const DumpCommandOptions& o) {
     const Camera camera = resolve_camera(o.camera);
     SceneCullerConfig config = scene_culler_config(o.cull);
-    // Fail on the output folder before spending time on the scene.
-    std::error_code ec;
-    std::filesystem::create_directories(o.out, ec);
-    if (ec || !std::filesystem::is_directory(o.out)) throw Error(o.out + ": cannot create the output folder" + (ec ? " (" + ec.message() + ")" : ""));
-
+    prepare_dump_folder(o.out);  // fail on the folder before spending time on the scene
     const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     SceneCuller culler(scene, resources.occluders, config);
     std::vector<OccludeeAnswer> answers;
     const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
     culler.cull(camera, answers, parallel);
-
-    // The parts are read once and written twice, so the EXR and the PNGs show the same frame.
-    long long start = now_ns();
-    const std::vector<DumpPart> parts = dump_parts(culler.buffer(), culler.maps());
-    const std::string exr = o.out + "/maps.exr";
-    write_maps_exr(parts, exr);
-    const double exr_ms = elapsed_ms(start);
-    start = now_ns();
-    const std::vector<ColormapPng> pngs = write_colormap_pngs(parts, o.out);
-    const double png_ms = elapsed_ms(start);
-
-    const OcclusionBuffer& buffer = culler.buffer();
-    fmt::print("scene      {} ({} objects)\n", scene.source, scene.objects.size());
-    fmt::print("buffer     {}x{} pixels of {}x{} samples; {} pyramid levels; depth {}\n", buffer.config().width,
-               buffer.config().height, config.samples, config.samples, culler.maps().levels(), o.cull.depth);
-    fmt::print("wrote      {} ({} parts, {} bytes, {:.0f} ms)\n", exr, parts.size(), std::filesystem::file_size(exr), exr_ms);
-    for (const ColormapPng& p : pngs) {
-        const std::string range = p.finite ? fmt::format("[{:.5g}, {:.5g}]", p.range_min, p.range_max) : "no finite values";
-        fmt::print("wrote      {} ({}x{}, range {}{})\n", p.path, p.width, p.height, range,
-                   p.no_occluder ? fmt::format(", {} px no occluder", p.no_occluder) : "");
-    }
-    fmt::print("wrote      {}/colormaps.json (every PNG's range; {:.0f} ms for the PNGs)\n", o.out, png_ms);
-    if (!pngs.empty() && !pngs.front().text_drawn) fmt::print("note       legend text not drawn: {}\n", pngs.front().note);
+    fmt::print("scene      {} ({} objects); depth {}\n", scene.source, scene.objects.size(), o.cull.depth);
+    const RayScene rays(scene);
+    write_frame_dump(culler, rays, camera, answers, o.out, /*print_to_stderr=*/false);
 }
 
 }  // namespace
@@ -73,7 +48,7 @@ void register_dump(CLI::App& app) {
     add_scene_option(*cmd, o->scene);
     add_camera_options(*cmd, o->camera);
     add_cull_options(*cmd, o->cull);
-    cmd->add_option("--out", o->out, "Output folder (created if missing): maps.exr, <part>.png, colormaps.json")->required();
+    cmd->add_option("--out", o->out, "Output folder (created if missing): maps.exr, <part>.png, colormaps.json, overlay.png")->required();
     cmd->add_option("--threads", o->threads, "Render with this many threads (TBB); 1 = the calling thread")
         ->capture_default_str()->check(CLI::Range(1, 256));
     cmd->callback([o] { run_dump(*o); });

@@ -122,6 +122,8 @@ public:
     const SceneCullTimings& timings() const { return timings_; }
     const SceneCullWork& work() const { return work_; }
     const OverlapExitCounts& overlap_exits() const { return exits_; }
+    // The objects the last cull() drew as occluders (object ids, in drawing order).
+    const std::vector<std::uint32_t>& drawn_occluders() const { return frame_occluders_; }
     const ObjectHierarchy& hierarchy() const { return hierarchy_; }
     // The occluder candidates, and their triangles.
     std::size_t occluder_objects() const { return occluder_ids_.size(); }

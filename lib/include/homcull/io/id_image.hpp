@@ -14,6 +14,10 @@ namespace homcull {
 void write_id_image(const std::string& path, int width, int height,
                     const std::vector<std::uint32_t>& ids);
 
+// Writes 8-bit RGB pixels (3 bytes each, rows top to bottom) in the format the extension
+// names. Throws homcull::Error naming the file.
+void write_rgb_image(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
+
 // The colour write_id_image gives an object id, as 0xRRGGBB.
 std::uint32_t id_color(std::uint32_t id);
 
