@@ -327,6 +327,38 @@ TEST(Dumps, CullDumpWritesTheMapsAndTheOverlay) {
     EXPECT_EQ(in->spec().height, kDisplayH);
 }
 
+TEST(Dumps, WalkReportShowsThePlotsTheSummaryAndTheFirstFrame) {
+    const std::string dir = test::temp_dir("dumps_walk");
+    const std::string cli = std::string(HOMCULL_CLI_PATH);
+    CliRun r = run_command(cli + " path --scene gen:city:seed=2,blocks=3 --frames 5 --out " + dir + "/walk.json", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_command(cli + " walk --scene gen:city:seed=2,blocks=3 --path " + dir + "/walk.json --resolution 96x54 --quiet --dump " +
+                        dir + "/report",
+                    dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string html = slurp(dir + "/report/report.html");
+    ASSERT_FALSE(html.empty());
+    for (const char* text : {"Culling graph", "Time per frame", "false culls", "efficiency"})
+        EXPECT_NE(html.find(text), std::string::npos) << text;
+    // Every image and link the page names exists.
+    std::size_t images = 0;
+    for (const char* attribute : {"src=\"", "href=\""}) {
+        for (std::size_t at = html.find(attribute); at != std::string::npos; at = html.find(attribute, at + 1)) {
+            const std::size_t begin = at + std::strlen(attribute), end = html.find('"', begin);
+            const std::string file = html.substr(begin, end - begin);
+            EXPECT_TRUE(std::filesystem::exists(dir + "/report/" + file)) << file;
+            images += file.size() > 4 && file.compare(file.size() - 4, 4, ".png") == 0;
+        }
+    }
+    EXPECT_GE(images, 4u);  // three plots and the overlay at least
+    for (const char* plot : {"culling_graph.png", "objects_graph.png", "frame_ms.png"}) {
+        auto in = OIIO::ImageInput::open(dir + "/report/" + plot);
+        ASSERT_TRUE(in) << plot << ": " << OIIO::geterror();
+        EXPECT_EQ(in->spec().width, 960);
+        EXPECT_EQ(in->spec().height, 360);
+    }
+}
+
 TEST(Dumps, CliDumpFailsNamingAnUnusableFolder) {
     const std::string dir = test::temp_dir("dumps_cli_error");
     test::write_text(dir + "/file", "not a folder");

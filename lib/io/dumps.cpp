@@ -1,6 +1,8 @@
 #include <homcull/error.hpp>
 #include <homcull/io/dumps.hpp>
 
+#include "io/legend_font.hpp"
+
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -63,33 +65,6 @@ std::string number(double v) {
     char text[32];
     std::snprintf(text, sizeof text, "%.5g", v);
     return text;
-}
-
-// The legend font, found once: OIIO's default (DroidSans) ships with OIIO's own font folder,
-// which Debian's package does not install, so DejaVu Sans (fonts-dejavu-core) is tried first.
-// Empty name and a reason when neither renders.
-struct LegendFont {
-    bool found = false;
-    std::string name, reason;
-};
-
-const LegendFont& legend_font() {
-    static const LegendFont font = [] {
-        LegendFont f;
-        for (const char* name : {"DejaVuSans", ""}) {
-            OIIO::ImageBuf probe(OIIO::ImageSpec(64, 24, 3, OIIO::TypeDesc::UINT8));
-            if (OIIO::ImageBufAlgo::render_text(probe, 2, 16, "0.5", 13, name)) {
-                f.found = true;
-                f.name = name;
-                return f;
-            }
-            f.reason += std::string(*name ? name : "OIIO's default font") + ": " + probe.geterror() + "; ";
-        }
-        f.reason = "no TrueType font could be rendered (" + f.reason.substr(0, f.reason.size() - 2) +
-                   "); install fonts-dejavu-core for the legend text";
-        return f;
-    }();
-    return font;
 }
 
 }  // namespace
@@ -274,7 +249,7 @@ ColormapPng write_colormap_png(const DumpPart& part, const std::string& path) {
         second_left = part.name;
         second_right = "green: no occluder (" + std::to_string(r.no_occluder) + " px)";
     }
-    const LegendFont& font = legend_font();
+    const detail::LegendFont& font = detail::legend_font();
     r.text_drawn = font.found;
     if (font.found) {
         const float white[3] = {0.92f, 0.92f, 0.92f}, green[3] = {0.0f, 200.0f / 255.0f, 90.0f / 255.0f};

@@ -4,7 +4,9 @@
 #include "commands.hpp"
 #include "cull_options.hpp"
 #include "cull_report.hpp"
+#include "frame_dump.hpp"
 #include "options.hpp"
+#include "walk_report.hpp"
 
 #include <homcull/error.hpp>
 #include <homcull/io/camera_path.hpp>
@@ -28,7 +30,7 @@ struct WalkCommandOptions {
     SceneChoice scene;
     std::string path;
     CullOptions cull;
-    std::string isa = "best", truth = "on";
+    std::string isa = "best", truth = "on", dump;
     int threads = 1;
     bool json = false, quiet = false;
 };
@@ -72,6 +74,7 @@ void print_progress(std::size_t done, std::size_t total) {
 void run_walk(const WalkCommandOptions& o) {
     select_isa(o.isa);
     SceneCullerConfig config = scene_culler_config(o.cull);
+    if (!o.dump.empty()) prepare_dump_folder(o.dump);
     const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const CameraPath path = read_camera_path(o.path);
@@ -92,6 +95,12 @@ void run_walk(const WalkCommandOptions& o) {
         if (rays) truth = compute_ground_truth(*rays, scene, camera, truth_options);
         const WalkFrame f = measure_walk_frame(scene, culler, camera, rays ? &truth : nullptr, answers, parallel);
         measured.push_back(f);
+        if (k == 0 && !o.dump.empty()) {
+            // The first frame's buffer, maps and overlay, for the report.
+            std::unique_ptr<RayScene> own;
+            if (!rays) own = std::make_unique<RayScene>(scene);
+            write_frame_dump(culler, rays ? *rays : *own, camera, answers, o.dump + "/frame0", /*print_to_stderr=*/true);
+        }
         if (o.json) {
             nlohmann::json objects = nlohmann::json::array();
             for (std::size_t id = 0; id < scene.objects.size(); ++id)
@@ -139,6 +148,19 @@ void run_walk(const WalkCommandOptions& o) {
         summary["total_false_culls"] = false_culls;
         summary["total_robust_false_culls"] = robust_false_culls;
         summary["efficiency"] = efficiency;
+    }
+    if (!o.dump.empty()) {
+        const std::vector<std::pair<std::string, std::string>> settings = {
+            {"scene", scene.source},
+            {"path", o.path + " (" + std::to_string(measured.size()) + " frames)"},
+            {"strategy", o.cull.strategy},
+            {"occluders", o.cull.occluders + ", rank " + o.cull.rank + ", budget " + std::to_string(o.cull.budget) + ", LOD " + o.cull.lod},
+            {"display", std::to_string(config.display.width) + "x" + std::to_string(config.display.height) + ", " + o.cull.mode +
+                            ", depth " + o.cull.depth},
+            {"efficiency", rays ? fmt::format("{:.1f} % of the hidden objects culled, {} false culls", 100.0 * efficiency, false_culls)
+                                : "no ground truth (--truth off)"}};
+        for (const std::string& file : write_walk_report(o.dump, "homcull walk: " + scene.source, settings, measured, summary, "frame0"))
+            fmt::print(stderr, "wrote      {}\n", file);
     }
     if (o.json) {
         const nlohmann::json out = {{"scene", scene.source},
@@ -190,6 +212,8 @@ void register_walk(CLI::App& app) {
     cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
         ->capture_default_str();
     cmd->add_flag("--quiet", o->quiet, "No progress bar on stderr");
+    cmd->add_option("--dump", o->dump, "Write a report into this folder: report.html with the culling graph and time plots "
+                                       "(PNG), the summary, and the first frame's dump (frame0/: maps.exr, PNGs, overlay.png)");
     cmd->add_flag("--json", o->json, "Print JSON on stdout: {\"frames\":[{\"objects\":[...], figures...}], \"summary\":{...}}");
     cmd->callback([o] { run_walk(*o); });
 }

@@ -26,6 +26,7 @@ std::vector<std::uint32_t> write_frame_dump(const SceneCuller& culler, const Ray
                                             const std::vector<OccludeeAnswer>& answers, const std::string& dir,
                                             bool print_to_stderr) {
     std::FILE* to = print_to_stderr ? stderr : stdout;
+    prepare_dump_folder(dir);
     // The parts are read once and written twice, so the EXR and the PNGs show the same frame.
     long long start = now_ns();
     const std::vector<DumpPart> parts = dump_parts(culler.buffer(), culler.maps());

@@ -14,7 +14,7 @@ namespace homcull::cli {
 // the expensive work, so that a bad folder fails first.
 void prepare_dump_folder(const std::string& dir);
 
-// Writes the dump of the culler's last frame and prints what it wrote (on stdout, or on
+// Writes the dump of the culler's last frame (creating `dir` when missing) and prints what it wrote (on stdout, or on
 // stderr when stdout carries JSON). Returns the objects the overlay found culled yet seen.
 std::vector<std::uint32_t> write_frame_dump(const SceneCuller& culler, const RayScene& rays, const Camera& camera,
                                             const std::vector<OccludeeAnswer>& answers, const std::string& dir,
