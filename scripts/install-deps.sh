@@ -9,6 +9,7 @@ packages=(
   libembree-dev libtbb-dev        # ground truth ray casts; TBB drives the tools' parallel-for
   libopenimageio-dev openimageio-tools  # image dumps (id images, buffer and pyramid EXR/PNG dumps)
   fonts-dejavu-core               # the legend text of the PNG dumps (OIIO render_text; its default font is not packaged)
+  chromium                        # the test that walk's HTML report renders with every image (headless)
   libassimp-dev zlib1g-dev        # scene import; assimp's CMake target links libz.so but does not depend on it
   libhwy-dev                      # SIMD with runtime dispatch (rasterizer)
   libmeshoptimizer-dev            # occluder simplification

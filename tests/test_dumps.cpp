@@ -10,6 +10,8 @@
 #include <homcull/scene_culler.hpp>
 #include <homcull/truth/answer_overlay.hpp>
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -357,6 +359,55 @@ TEST(Dumps, WalkReportShowsThePlotsTheSummaryAndTheFirstFrame) {
         EXPECT_EQ(in->spec().width, 960);
         EXPECT_EQ(in->spec().height, 360);
     }
+}
+
+// The report renders in a real browser and every image on it loads: headless Chromium
+// (Debian's chromium package, installed by scripts/install-deps.sh) runs the page's own
+// image check and prints the DOM after it.
+std::string chromium_command() {
+    for (const char* name : {"chromium", "chromium-browser", "google-chrome"})
+        if (std::system((std::string("command -v ") + name + " >/dev/null 2>&1").c_str()) == 0) return name;
+    return "";
+}
+
+TEST(Dumps, WalkReportRendersInHeadlessChromiumWithEveryImage) {
+    const std::string browser = chromium_command();
+    if (browser.empty()) GTEST_SKIP() << "no chromium (bash scripts/install-deps.sh installs it)";
+    const std::string dir = test::temp_dir("dumps_chromium");
+    const std::string cli = std::string(HOMCULL_CLI_PATH);
+    CliRun r = run_command(cli + " path --scene gen:city:seed=2,blocks=3 --frames 4 --out " + dir + "/walk.json", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_command(cli + " walk --scene gen:city:seed=2,blocks=3 --path " + dir + "/walk.json --resolution 96x54 --quiet --dump " +
+                        dir + "/report",
+                    dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string page = "file://" + std::filesystem::absolute(dir + "/report/report.html").string();
+    const std::string headless = "timeout 120 " + browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + dir +
+                                 "/profile --virtual-time-budget=5000 ";
+    auto image_check = [&] {
+        const CliRun dom = run_command(headless + "--dump-dom " + page, dir);
+        EXPECT_EQ(dom.exit_code, 0) << dom.err;
+        const std::size_t at = dom.out.find("id=\"image-check\">");
+        if (at == std::string::npos) return std::string("no image check in the DOM:\n") + dom.out.substr(0, 2000);
+        const std::size_t begin = at + std::strlen("id=\"image-check\">");
+        return dom.out.substr(begin, dom.out.find('<', begin) - begin);
+    };
+    const std::string all = image_check();
+    int loaded = -1, total = -2;
+    ASSERT_EQ(std::sscanf(all.c_str(), "%d of %d images loaded", &loaded, &total), 2) << all;
+    EXPECT_GE(total, 4);
+    EXPECT_EQ(loaded, total) << all;
+    // It renders: a screenshot of the page, not blank.
+    const CliRun shot = run_command(headless + "--window-size=1000,1400 --screenshot=" + dir + "/shot.png " + page, dir);
+    ASSERT_EQ(shot.exit_code, 0) << shot.err;
+    OIIO::ImageBuf screenshot(dir + "/shot.png");
+    ASSERT_TRUE(screenshot.read()) << screenshot.geterror();
+    EXPECT_EQ(screenshot.spec().width, 1000);
+    const auto stats = OIIO::ImageBufAlgo::computePixelStats(screenshot);
+    EXPECT_GT(stats.max[0] - stats.min[0], 0.5f) << "a blank page";
+    // The check can fail: a missing image is counted.
+    std::filesystem::remove(dir + "/report/frame_ms.png");
+    EXPECT_EQ(image_check(), std::to_string(total - 1) + " of " + std::to_string(total) + " images loaded");
 }
 
 TEST(Dumps, CliDumpFailsNamingAnUnusableFolder) {

@@ -99,6 +99,13 @@ std::vector<std::string> write_walk_report(const std::string& dir, const std::st
                 html += "<img src=\"" + d + "/" + part + ".png\" alt=\"" + part + "\">\n";
         html += "</div>\n";
     }
+    // A self-check a headless browser can read back (--dump-dom): how many images loaded.
+    html += "<p id=\"image-check\">images not checked yet</p>\n"
+            "<script>window.addEventListener('load', function () {\n"
+            "  var images = Array.from(document.images);\n"
+            "  var loaded = images.filter(function (i) { return i.complete && i.naturalWidth > 0; }).length;\n"
+            "  document.getElementById('image-check').textContent = loaded + ' of ' + images.length + ' images loaded';\n"
+            "});</script>\n";
     html += "</body></html>\n";
     const std::string page = dir + "/report.html";
     std::ofstream out(page);
