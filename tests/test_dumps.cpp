@@ -273,6 +273,12 @@ TEST(Dumps, CliDumpWritesTheSameExrAndThePngs) {
     ASSERT_EQ(info.exit_code, 0) << info.err;
     for (const DumpPart& part : dump_parts(frame.culler.buffer(), frame.culler.maps()))
         EXPECT_NE(info.out.find("name: \"" + part.name + "\""), std::string::npos) << part.name << "\n" << info.out;
+    // Without -a, the first part's homcull:parts lists them all.
+    const CliRun first = run_command("oiiotool --info -v " + out + "/maps.exr", dir);
+    ASSERT_EQ(first.exit_code, 0) << first.err;
+    for (const DumpPart& part : dump_parts(frame.culler.buffer(), frame.culler.maps()))
+        EXPECT_NE(first.out.find(part.name), std::string::npos) << part.name << "\n" << first.out;
+    EXPECT_NE(first.out.find("homcull:parts"), std::string::npos) << first.out;
 }
 
 TEST(Dumps, OverlayColoursEachAnswerAndShowsFalseCullsInMagenta) {

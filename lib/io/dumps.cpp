@@ -147,6 +147,13 @@ void write_maps_exr(const std::vector<DumpPart>& parts, const std::string& path)
         spec.attribute("compression", "zip");  // lossless
         specs.push_back(std::move(spec));
     }
+    // `oiiotool --info -v` prints the metadata of the first part only (`-a` prints all): the
+    // first part also lists every part's name, so that one look shows them all.
+    if (!specs.empty()) {
+        std::string names;
+        for (const DumpPart& p : parts) names += (names.empty() ? "" : ", ") + p.name;
+        specs.front().attribute("homcull:parts", names);
+    }
     auto out = OIIO::ImageOutput::create(path);
     if (!out) throw Error(path + ": cannot write an image of this type (" + OIIO::geterror() + ")");
     if (!out->supports("multiimage")) throw Error(path + ": the " + std::string(out->format_name()) + " format holds one image, not a dump");

@@ -46,7 +46,9 @@ struct DumpPart {
 // The parts of a dump, in file order (see above). The maps must have been built from `buffer`.
 std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionMaps& maps);
 
-// Writes every part into one multi-part OpenEXR file (FLOAT channel "Y", zip compression).
+// Writes every part into one multi-part OpenEXR file (FLOAT channel "Y", zip compression). The
+// first part's header also lists every part's name ("homcull:parts"), which plain
+// `oiiotool --info -v` prints (it shows the first part's metadata only; `-a` shows each part's).
 // Throws homcull::Error naming the file when it cannot be written.
 void write_maps_exr(const OcclusionBuffer& buffer, const OcclusionMaps& maps, const std::string& path);
 void write_maps_exr(const std::vector<DumpPart>& parts, const std::string& path);
