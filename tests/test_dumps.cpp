@@ -317,6 +317,20 @@ TEST(Dumps, OverlayColoursEachAnswerAndShowsFalseCullsInMagenta) {
     for (std::size_t i = 0; i < loud.rgb.size(); i += 3) magenta += loud.rgb[i] == 255 && loud.rgb[i + 1] == 0 && loud.rgb[i + 2] == 255;
     EXPECT_EQ(magenta, loud.false_cull_pixels);
     EXPECT_THROW(render_answer_overlay(rays, city_camera(), display, {}, {}), Error);
+
+    // From above: every kind of answer shows, and the frustum.
+    const AnswerOverlay map =
+        render_answer_map(rays, scene.bounds(), city_camera(), display, wrong, culler.drawn_occluders(), loud.false_culls, 400);
+    EXPECT_EQ(map.width, 400);
+    auto count = [&](auto is) {
+        std::size_t n = 0;
+        for (std::size_t i = 0; i < map.rgb.size(); i += 3) n += is(map.rgb[i], map.rgb[i + 1], map.rgb[i + 2]);
+        return n;
+    };
+    EXPECT_GT(count([](int r, int g, int b) { return r > g + 40 && g > 40 && b == 0; }), 0u) << "occluded, orange";
+    EXPECT_GT(count([](int r, int g, int b) { return r == 255 && g == 224 && b == 0; }), 0u) << "the frustum, yellow";
+    EXPECT_GT(count([](int r, int g, int b) { return b > r + 40 && b > g; }), 0u) << "occluders, blue";
+    EXPECT_GT(count([](int r, int g, int b) { return r > 100 && g == 0 && r == b; }), 0u) << "the false cull, magenta";
 }
 
 TEST(Dumps, CullDumpWritesTheMapsAndTheOverlay) {
@@ -327,7 +341,7 @@ TEST(Dumps, CullDumpWritesTheMapsAndTheOverlay) {
     const nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
     EXPECT_FALSE(j.is_discarded()) << "the dump's lines go to stderr with --json:\n" << r.out;
     EXPECT_NE(r.err.find("0 false-cull pixels"), std::string::npos) << r.err;
-    for (const char* file : {"maps.exr", "overlay.png", "colormaps.json", "opacity.L0.png"})
+    for (const char* file : {"maps.exr", "overlay.png", "overlay_top.png", "colormaps.json", "opacity.L0.png"})
         EXPECT_TRUE(std::filesystem::exists(dir + "/frame/" + file)) << file;
     auto in = OIIO::ImageInput::open(dir + "/frame/overlay.png");
     ASSERT_TRUE(in) << OIIO::geterror();

@@ -40,6 +40,10 @@ std::vector<std::uint32_t> write_frame_dump(const SceneCuller& culler, const Ray
     const AnswerOverlay overlay = render_answer_overlay(rays, camera, culler.config().display, answers, culler.drawn_occluders());
     const std::string overlay_png = dir + "/overlay.png";
     write_rgb_image(overlay_png, overlay.width, overlay.height, overlay.rgb);
+    const AnswerOverlay map = render_answer_map(rays, culler.scene().bounds(), camera, culler.config().display, answers,
+                                                culler.drawn_occluders(), overlay.false_culls);
+    const std::string map_png = dir + "/overlay_top.png";
+    write_rgb_image(map_png, map.width, map.height, map.rgb);
     const double overlay_ms = elapsed_ms(start);
 
     const OcclusionBuffer& buffer = culler.buffer();
@@ -56,6 +60,8 @@ std::vector<std::uint32_t> write_frame_dump(const SceneCuller& culler, const Ray
     fmt::print(to, "wrote      {} ({}x{}: occluders drawn blue, kept grey, culled yet seen magenta: {} false-cull pixels, "
                    "{} objects; {:.0f} ms)\n",
                overlay_png, overlay.width, overlay.height, overlay.false_cull_pixels, overlay.false_culls.size(), overlay_ms);
+    fmt::print(to, "wrote      {} ({}x{}: the answers from above; also occluded orange, view-culled slate, the frustum yellow)\n",
+               map_png, map.width, map.height);
     return overlay.false_culls;
 }
 

@@ -117,6 +117,7 @@ public:
     void reset_history() { has_history_ = false; }
 
     const SceneCullerConfig& config() const { return config_; }
+    const Scene& scene() const { return *scene_; }
     const OcclusionBuffer& buffer() const { return buffer_; }
     const OcclusionMaps& maps() const { return maps_; }
     const SceneCullTimings& timings() const { return timings_; }

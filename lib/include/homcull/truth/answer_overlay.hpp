@@ -9,6 +9,7 @@
 //   - nothing hit: black.
 // Surfaces are shaded by the angle between their normal and the ray, and object outlines are
 // darkened, so that the picture reads as geometry.
+#include <homcull/aabb.hpp>
 #include <homcull/camera.hpp>
 #include <homcull/occlusion_maps.hpp>
 #include <homcull/truth/ray_scene.hpp>
@@ -30,5 +31,14 @@ struct AnswerOverlay {
 // invalid camera or resolution. Uses TBB's threads.
 AnswerOverlay render_answer_overlay(const RayScene& rays, const Camera& camera, Resolution resolution,
                                     const std::vector<OccludeeAnswer>& answers, const std::vector<std::uint32_t>& drawn);
+
+// The same answers seen from above (Zhang 1998, Fig. 1.1 style): an orthographic view down
+// the y axis over the scene's x-z extent, `width` pixels wide, each pixel coloured by the
+// answer of the object on top there: drawn occluder blue, kept grey, occluded orange,
+// view-culled dark slate, and the objects in `false_culls` magenta. The camera's frustum is
+// drawn in yellow from the eye. Objects hidden under a roof in this view are not shown.
+AnswerOverlay render_answer_map(const RayScene& rays, const Aabb& scene_bounds, const Camera& camera, Resolution display,
+                                const std::vector<OccludeeAnswer>& answers, const std::vector<std::uint32_t>& drawn,
+                                const std::vector<std::uint32_t>& false_culls, int width = 800);
 
 }  // namespace homcull
