@@ -1,6 +1,7 @@
 // Debug dumps (homcull/io/dumps.hpp, `homcull dump`): the multi-part EXR holds every buffer
 // and pyramid level under its name, bit for bit as the library reports them; the PNGs have
 // the promised size, colours and legend; errors name the file.
+#include "exr_parts.hpp"
 #include "support.hpp"
 
 #include <homcull/error.hpp>
@@ -60,26 +61,7 @@ SceneCullerConfig city_config(int samples = 1, DepthTest depth = DepthTest::mask
     return config;
 }
 
-struct ExrPart {
-    std::string name;
-    int width, height, channels;
-    OIIO::TypeDesc format;
-    std::vector<float> values;
-};
-
-std::vector<ExrPart> read_exr(const std::string& path) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path + ": " + OIIO::geterror());
-    std::vector<ExrPart> parts;
-    for (int i = 0; in->seek_subimage(i, 0); ++i) {
-        const OIIO::ImageSpec& spec = in->spec();
-        ExrPart p{spec.get_string_attribute("oiio:subimagename"), spec.width, spec.height, spec.nchannels, spec.format, {}};
-        p.values.resize(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
-        if (!in->read_image(i, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, p.values.data())) throw Error(path + ": " + in->geterror());
-        parts.push_back(std::move(p));
-    }
-    return parts;
-}
+using test::ExrPart;
 
 // What the buffer and the maps report, read through their own accessors (not dump_parts),
 // in the documented part order.
@@ -106,7 +88,7 @@ std::vector<std::pair<std::string, std::vector<float>>> expected_parts(const Occ
 
 // Every part present in order, one FLOAT channel, and the same bits (memcmp: +inf and -0 too).
 void expect_exr_matches(const std::string& path, const OcclusionBuffer& buffer, const OcclusionMaps& maps) {
-    const std::vector<ExrPart> parts = read_exr(path);
+    const std::vector<ExrPart> parts = test::read_exr_parts(path);
     const auto expected = expected_parts(buffer, maps);
     const std::size_t count = 2 + 3 * std::size_t(maps.levels()) + (maps.config().depth == DepthTest::deb ? 1 : 0);
     ASSERT_EQ(expected.size(), count);
@@ -115,7 +97,7 @@ void expect_exr_matches(const std::string& path, const OcclusionBuffer& buffer, 
         SCOPED_TRACE(expected[i].first);
         EXPECT_EQ(parts[i].name, expected[i].first);
         EXPECT_EQ(parts[i].channels, 1);
-        EXPECT_EQ(parts[i].format, OIIO::TypeDesc::FLOAT);
+        EXPECT_TRUE(parts[i].stored_as_float);
         ASSERT_EQ(parts[i].values.size(), expected[i].second.size());
         EXPECT_EQ(std::memcmp(parts[i].values.data(), expected[i].second.data(), parts[i].values.size() * sizeof(float)), 0);
     }
@@ -143,7 +125,7 @@ TEST(Dumps, ExrHasTheDepthEstimationBufferWhenTheMapsUseIt) {
     const std::string dir = test::temp_dir("dumps_exr_deb");
     write_maps_exr(frame.culler.buffer(), frame.culler.maps(), dir + "/maps.exr");
     expect_exr_matches(dir + "/maps.exr", frame.culler.buffer(), frame.culler.maps());
-    const std::vector<ExrPart> parts = read_exr(dir + "/maps.exr");
+    const std::vector<ExrPart> parts = test::read_exr_parts(dir + "/maps.exr");
     EXPECT_EQ(parts.back().name, "deb");
     EXPECT_EQ(parts.back().width, 24);
     EXPECT_EQ(parts.back().height, 12);
@@ -349,15 +331,23 @@ TEST(Dumps, CullDumpWritesTheMapsAndTheOverlay) {
     EXPECT_EQ(in->spec().height, kDisplayH);
 }
 
-TEST(Dumps, WalkReportShowsThePlotsTheSummaryAndTheFirstFrame) {
-    const std::string dir = test::temp_dir("dumps_walk");
+// A walk report of the city (`homcull path`, then `walk --dump DIR/report`); fails the test
+// when a command fails.
+void write_city_walk_report(const std::string& dir, int frames) {
     const std::string cli = std::string(HOMCULL_CLI_PATH);
-    CliRun r = run_command(cli + " path --scene gen:city:seed=2,blocks=3 --frames 5 --out " + dir + "/walk.json", dir);
+    CliRun r = run_command(cli + " path --scene gen:city:seed=2,blocks=3 --frames " + std::to_string(frames) + " --out " + dir +
+                               "/walk.json",
+                           dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     r = run_command(cli + " walk --scene gen:city:seed=2,blocks=3 --path " + dir + "/walk.json --resolution 96x54 --quiet --dump " +
                         dir + "/report",
                     dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST(Dumps, WalkReportShowsThePlotsTheSummaryAndTheFirstFrame) {
+    const std::string dir = test::temp_dir("dumps_walk");
+    ASSERT_NO_FATAL_FAILURE(write_city_walk_report(dir, 5));
     const std::string html = slurp(dir + "/report/report.html");
     ASSERT_FALSE(html.empty());
     for (const char* text : {"Culling graph", "Time per frame", "false culls", "efficiency"})
@@ -394,13 +384,7 @@ TEST(Dumps, WalkReportRendersInHeadlessChromiumWithEveryImage) {
     const std::string browser = chromium_command();
     if (browser.empty()) GTEST_SKIP() << "no chromium (bash scripts/install-deps.sh installs it)";
     const std::string dir = test::temp_dir("dumps_chromium");
-    const std::string cli = std::string(HOMCULL_CLI_PATH);
-    CliRun r = run_command(cli + " path --scene gen:city:seed=2,blocks=3 --frames 4 --out " + dir + "/walk.json", dir);
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    r = run_command(cli + " walk --scene gen:city:seed=2,blocks=3 --path " + dir + "/walk.json --resolution 96x54 --quiet --dump " +
-                        dir + "/report",
-                    dir);
-    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_NO_FATAL_FAILURE(write_city_walk_report(dir, 4));
     const std::string page = "file://" + std::filesystem::absolute(dir + "/report/report.html").string();
     const std::string headless = "timeout 120 " + browser + " --headless --no-sandbox --disable-gpu --user-data-dir=" + dir +
                                  "/profile --virtual-time-budget=5000 ";

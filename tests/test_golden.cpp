@@ -6,6 +6,7 @@
 // After an intended change, regenerate the references (scalar reference path) and review
 // them before committing:
 //   HOMCULL_UPDATE_GOLDENS=1 build/tests/homcull_tests --gtest_filter='Golden.*'
+#include "exr_parts.hpp"
 #include "support.hpp"
 
 #include <homcull/error.hpp>
@@ -97,35 +98,14 @@ struct Comparison {
     std::vector<std::string> diff_images;  // written for the differing parts
 };
 
-// The parts of a multi-part EXR: name, spec and float pixels.
-struct ExrPart {
-    std::string name;
-    OIIO::ImageSpec spec;
-    std::vector<float> pixels;
-};
-
-std::vector<ExrPart> read_parts(const std::string& path) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path + ": " + OIIO::geterror());
-    std::vector<ExrPart> parts;
-    for (int sub = 0; in->seek_subimage(sub, 0); ++sub) {
-        ExrPart part;
-        part.spec = in->spec();
-        part.name = part.spec.get_string_attribute("oiio:subimagename");
-        part.pixels.resize(std::size_t(part.spec.image_pixels()) * std::size_t(part.spec.nchannels));
-        if (!in->read_image(sub, 0, 0, part.spec.nchannels, OIIO::TypeDesc::FLOAT, part.pixels.data()))
-            throw Error(path + ": " + in->geterror());
-        parts.push_back(std::move(part));
-    }
-    return parts;
-}
+using test::ExrPart;
 
 // Compares every part of `current` with the part at the same place in `reference` (names must
 // agree) with ImageBufAlgo::compare; writes |current - reference| as
 // <diff_prefix>.<part>.exr where they differ.
 Comparison compare_exr(const std::string& reference, const std::string& current, const std::string& diff_prefix) {
     Comparison result;
-    std::vector<ExrPart> ref = read_parts(reference), now = read_parts(current);
+    std::vector<ExrPart> ref = test::read_exr_parts(reference), now = test::read_exr_parts(current);
     if (ref.size() != now.size()) {
         result.same = false;
         result.report += "the reference has " + std::to_string(ref.size()) + " parts, the dump " + std::to_string(now.size()) + "\n";
@@ -133,18 +113,17 @@ Comparison compare_exr(const std::string& reference, const std::string& current,
     for (std::size_t k = 0; k < std::min(ref.size(), now.size()); ++k) {
         ExrPart& a = now[k];
         ExrPart& b = ref[k];
-        if (a.name != b.name || a.spec.width != b.spec.width || a.spec.height != b.spec.height ||
-            a.spec.nchannels != b.spec.nchannels) {
+        if (a.name != b.name || a.width != b.width || a.height != b.height || a.channels != b.channels) {
             result.same = false;
             result.report += "part " + std::to_string(k) + ": " + a.name + " against the reference's " + b.name + " (name or size differs)\n";
             continue;
         }
-        OIIO::ImageSpec spec(a.spec.width, a.spec.height, a.spec.nchannels, OIIO::TypeDesc::FLOAT);
-        const OIIO::ImageBuf image_now(spec, a.pixels.data()), image_ref(spec, b.pixels.data());
+        OIIO::ImageSpec spec(a.width, a.height, a.channels, OIIO::TypeDesc::FLOAT);
+        const OIIO::ImageBuf image_now(spec, a.values.data()), image_ref(spec, b.values.data());
         const OIIO::ImageBufAlgo::CompareResults r = OIIO::ImageBufAlgo::compare(image_now, image_ref, kFailThreshold, kWarnThreshold);
         // compare() finds inf - inf = NaN "equal"; the culler's +inf ("no occluder") must match
         // as exactly as any value, so the bits are compared too.
-        const bool bits = std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)) == 0;
+        const bool bits = std::memcmp(a.values.data(), b.values.data(), a.values.size() * sizeof(float)) == 0;
         if (r.nfail == 0 && r.nwarn == 0 && bits) continue;
         result.same = false;
         const std::string diff = diff_prefix + "." + a.name + ".exr";
