@@ -96,19 +96,18 @@ std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionM
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) opacity.values.push_back(maps.opacity(k, x, y));
         parts.push_back(std::move(opacity));
+        // The two depth pyramids: 1/w per cell, one level's cells contiguous.
         const std::size_t n = std::size_t(w) * std::size_t(h);
-        DumpPart maxz = make_part("maxz" + level,
-                                  "max-Z (hzb) pyramid level " + std::to_string(k) +
-                                      ": farthest depth of the covered samples as 1/w (larger is nearer), +inf no occluder",
-                                  w, h, DumpColormap::magma, true);
-        maxz.values.assign(maps.farthest_depth(k), maps.farthest_depth(k) + n);
-        parts.push_back(std::move(maxz));
-        DumpPart nbz = make_part("nbz" + level,
-                                 "no-background Z-buffer pyramid level " + std::to_string(k) +
-                                     ": nearest depth of the covered samples as 1/w (larger is nearer), +inf no occluder",
-                                 w, h, DumpColormap::magma, true);
-        nbz.values.assign(maps.nearest_depth(k), maps.nearest_depth(k) + n);
-        parts.push_back(std::move(nbz));
+        const auto depth_part = [&](const char* stem, const char* what, const float* cells) {
+            DumpPart part = make_part(stem + level,
+                                      std::string(what) + " pyramid level " + std::to_string(k) +
+                                          " as 1/w (larger is nearer), +inf no occluder",
+                                      w, h, DumpColormap::magma, true);
+            part.values.assign(cells, cells + n);
+            parts.push_back(std::move(part));
+        };
+        depth_part("maxz", "max-Z (hzb), the farthest depth of the covered samples:", maps.farthest_depth(k));
+        depth_part("nbz", "no-background Z-buffer, the nearest depth of the covered samples:", maps.nearest_depth(k));
     }
     // Only filled (add_occluder_box) when the maps answer with it: otherwise all +inf, noise.
     if (maps.config().depth == DepthTest::deb) {
