@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <random>
 
@@ -167,6 +168,93 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
     }
     select_isa("best");
     EXPECT_THROW(select_isa("mmx"), Error);
+}
+
+}  // namespace
+}  // namespace homcull
+
+namespace homcull {
+namespace {
+
+bool same_stats(const RasterStats& a, const RasterStats& b) {
+    return a.triangles_in == b.triangles_in && a.invalid == b.invalid && a.outside == b.outside && a.near_clipped == b.near_clipped &&
+           a.too_large == b.too_large && a.backface_culled == b.backface_culled && a.degenerate == b.degenerate &&
+           a.rasterized == b.rasterized && a.subtiles_touched == b.subtiles_touched;
+}
+
+// The setup front end decides batches of triangles in SIMD lanes (invalid, outside,
+// degenerate, backfacing) and hands the rest to the one-triangle setup: every instruction
+// set counts every statistic as the scalar reference does and gives its bits, on input that
+// reaches every fate: vertices behind the eye, beyond the guard band and far outside, huge,
+// collinear, NaN and Inf, indices out of range, 16- and 32-bit indices, 4 components with a
+// padded stride, each backface mode, and counts that are not a multiple of the batch.
+TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
+    std::mt19937_64 rng(77);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), w(0.2f, 40.0f);
+    constexpr std::size_t kVertices = 3001, kStride = 6;  // x, y, z, w and two floats of padding
+    std::vector<float> vertices(kVertices * kStride, 0.0f);
+    for (std::size_t v = 0; v < kVertices; ++v) {
+        const float wv = (v % 97 == 0) ? -w(rng) : w(rng);  // some behind the eye
+        const float spread = v % 13 == 0 ? 200.0f : v % 29 == 0 ? 1e12f : 1.3f;  // beyond the guard band, too large
+        float* p = &vertices[v * kStride];
+        p[0] = unit(rng) * spread * wv, p[1] = unit(rng) * spread * wv, p[2] = 0.0f, p[3] = wv;
+        if (v % 211 == 0) p[v % 2] = std::numeric_limits<float>::quiet_NaN();
+        if (v % 223 == 0) p[3] = std::numeric_limits<float>::infinity();
+    }
+    // Triangles of nearby vertices (small, some collinear), with indices out of range now and then.
+    std::vector<std::uint32_t> indices32;
+    for (std::size_t t = 0; t < 20011; ++t) {
+        const std::uint32_t a = std::uint32_t(rng() % (kVertices - 2));
+        std::uint32_t tri[3] = {a, a + 1 + std::uint32_t(t % 2), a + 2 - std::uint32_t(t % 2)};
+        if (t % 101 == 0) tri[t % 3] = std::uint32_t(kVertices + t);  // out of range
+        if (t % 89 == 0) tri[2] = tri[1];                             // zero area
+        indices32.insert(indices32.end(), tri, tri + 3);
+    }
+    std::vector<std::uint16_t> indices16;
+    for (std::uint32_t i : indices32) indices16.push_back(std::uint16_t(std::min<std::uint32_t>(i, 65535u)));
+
+    TriangleInput in;
+    in.positions = vertices.data();
+    in.position_components = 4;
+    in.position_stride = kStride * sizeof(float);
+    in.vertex_count = kVertices;
+    in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    auto render_all = [&](std::vector<OcclusionBuffer>& out) {
+        for (const Backface backface : {Backface::none, Backface::cw, Backface::ccw})
+            for (const bool sixteen : {false, true})
+                for (const std::size_t count : {std::size_t(20011), std::size_t(7)}) {
+                    TriangleInput input = in;
+                    input.backface = backface;
+                    input.indices_16bit = sixteen;
+                    input.indices = sixteen ? static_cast<const void*>(indices16.data()) : indices32.data();
+                    input.triangle_count = count;
+                    out.emplace_back(test::buffer_config(203, 117, 2, 0.5f));
+                    out.back().render(input);
+                }
+    };
+    select_isa("scalar");
+    std::vector<OcclusionBuffer> reference;
+    render_all(reference);
+    RasterStats all;
+    for (const OcclusionBuffer& b : reference) all += b.stats();
+    // Every fate is reached.
+    EXPECT_GT(all.invalid, 0u);
+    EXPECT_GT(all.outside, 0u);
+    EXPECT_GT(all.near_clipped, 0u);
+    EXPECT_GT(all.too_large, 0u);
+    EXPECT_GT(all.backface_culled, 0u);
+    EXPECT_GT(all.degenerate, 0u);
+    EXPECT_GT(all.rasterized, 1000u);
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        std::vector<OcclusionBuffer> buffers;
+        render_all(buffers);
+        for (std::size_t k = 0; k < buffers.size(); ++k) {
+            EXPECT_TRUE(same_stats(reference[k].stats(), buffers[k].stats())) << isa << ", buffer " << k;
+            EXPECT_TRUE(same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
+        }
+    }
+    select_isa("best");
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include "raster/rasterize.hpp"
-#include "raster/triangle_setup.hpp"
+#include "raster/triangle_batch.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -106,15 +106,11 @@ detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) 
     return {planes, sample_width_, sample_height_, row_begin, row_end, detail::selected_rows_kernel()};
 }
 
-// Sets up triangle t of the input and hands each triangle of its clipped fan that covers a
-// sample's bounding box to `emit`.
+// Sets up triangles [begin, end) of the input and hands each triangle of their clipped fans
+// that covers a sample's bounding box to `emit`, in input order.
 template <typename Emit>
-void OcclusionBuffer::setup_for_raster(const TriangleInput& in, std::size_t t, RasterStats& stats, Emit&& emit) const {
-    const detail::SetupResult setup = detail::setup_triangle(in, t, config_.near_w, sample_width_, sample_height_, stats);
-    for (int k = 0; k < setup.count; ++k) {
-        detail::RasterTriangle tri;
-        if (detail::setup_raster_triangle(setup.triangles[k], config_.edge_margin, sample_width_, sample_height_, tri)) emit(tri);
-    }
+void OcclusionBuffer::setup_for_raster(const TriangleInput& in, std::size_t begin, std::size_t end, RasterStats& stats, Emit&& emit) const {
+    detail::setup_triangle_range(in, begin, end, config_.near_w, config_.edge_margin, sample_width_, sample_height_, stats, emit);
 }
 
 void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& parallel) {
@@ -136,8 +132,7 @@ void OcclusionBuffer::render_serial(const TriangleInput& in) {
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t touched = 0;
     RasterStats stats;
-    for (std::size_t t = 0; t < in.triangle_count; ++t)
-        setup_for_raster(in, t, stats, [&](const detail::RasterTriangle& tri) { touched += target.kernel(target, tri); });
+    setup_for_raster(in, 0, in.triangle_count, stats, [&](const detail::RasterTriangle& tri) { touched += target.kernel(target, tri); });
     stats.subtiles_touched = touched;
     stats_ += stats;
 }
@@ -162,11 +157,10 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
         for (auto& bin : chunk.bins) bin.clear();
         const std::size_t end = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
-        for (std::size_t t = c * kChunkTriangles; t < end; ++t)
-            j.self->setup_for_raster(*j.in, t, chunk.stats, [&](const detail::RasterTriangle& tri) {
-                for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
-                    chunk.bins[std::size_t(band)].push_back(tri);
-            });
+        j.self->setup_for_raster(*j.in, c * kChunkTriangles, end, chunk.stats, [&](const detail::RasterTriangle& tri) {
+            for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
+                chunk.bins[std::size_t(band)].push_back(tri);
+        });
     }, &job);
 
     parallel.run(parallel.user, bands, [](void* data, std::size_t band) {

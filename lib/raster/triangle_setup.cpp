@@ -41,39 +41,49 @@ bool outside_side_plane(const glm::dvec4 clip[3]) {
            all([](const glm::dvec4& c) { return c.y > c.w; }) || all([](const glm::dvec4& c) { return c.y < -c.w; });
 }
 
-SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w, int sample_width, int sample_height,
-                           RasterStats& stats) {
-    ++stats.triangles_in;
-    glm::dvec4 model[3], clip[3];
-    if (!fetch_clip_triangle(in, t, model, clip)) {
-        ++stats.invalid;
-        return {};
-    }
-    return setup_clip_triangle(clip, in.shared_edges ? in.shared_edges[t] : 0, in.backface, near_w, sample_width, sample_height, stats);
+bool outside_frustum(const glm::dvec4 clip[3], double near_w) {
+    return (clip[0].w < near_w && clip[1].w < near_w && clip[2].w < near_w) || outside_side_plane(clip);
 }
 
-SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
-                                int sample_height, RasterStats& stats) {
-    SetupResult result;
-    // Entirely outside one plane of the view frustum (or behind the near plane)?
-    if ((clip[0].w < near_w && clip[1].w < near_w && clip[2].w < near_w) || outside_side_plane(clip)) {
-        ++stats.outside;
-        return result;
-    }
+bool too_large_to_clip(const glm::dvec4 clip[3], double near_w) {
     double extent = 0.0, min_w = HUGE_VAL;
     for (int k = 0; k < 3; ++k) {
         const glm::dvec4& c = clip[k];
         extent = std::max({extent, std::abs(c.x), std::abs(c.y)});
         min_w = std::min(min_w, c.w);
     }
-    if (extent > 0x1.0p28 * std::max(near_w, min_w)) {
-        ++stats.too_large;
-        return result;
-    }
+    return extent > 0x1.0p28 * std::max(near_w, min_w);
+}
+
+bool needs_clipping(const glm::dvec4 clip[3], double near_w) {
     bool needs_clip = false;
     for (int k = 0; k < 3; ++k)
         needs_clip = needs_clip || clip[k].w < near_w || std::abs(clip[k].x) > kGuardBand * clip[k].w ||
                      std::abs(clip[k].y) > kGuardBand * clip[k].w;
+    return needs_clip;
+}
+
+TriangleFate unclipped_fate(const glm::dvec4 clip[3], Backface backface, double near_w) {
+    if (outside_frustum(clip, near_w)) return TriangleFate::outside;
+    if (too_large_to_clip(clip, near_w) || needs_clipping(clip, near_w)) return TriangleFate::needs_setup;
+    const double det = 0.0 + homogeneous_det(clip[0], clip[1], clip[2]);  // as setup_clip_triangle sums it
+    if (det == 0.0) return TriangleFate::degenerate;
+    return facing_away(det, backface) ? TriangleFate::backfacing : TriangleFate::needs_setup;
+}
+
+SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
+                                int sample_height, RasterStats& stats) {
+    SetupResult result;
+    // Entirely outside one plane of the view frustum (or behind the near plane)?
+    if (outside_frustum(clip, near_w)) {
+        ++stats.outside;
+        return result;
+    }
+    if (too_large_to_clip(clip, near_w)) {
+        ++stats.too_large;
+        return result;
+    }
+    const bool needs_clip = needs_clipping(clip, near_w);
     const ClipVertex corners[3] = {{clip[0].x, clip[0].y, clip[0].w}, {clip[1].x, clip[1].y, clip[1].w},
                                    {clip[2].x, clip[2].y, clip[2].w}};
     ClipPolygon poly;
@@ -92,6 +102,20 @@ SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bi
         return result;
     }
 
+    // Orientation and degeneracy from homogeneous determinants det[x y w] (w > 0 after
+    // clipping): positive for counter-clockwise in NDC, and exactly zero for collinear
+    // input, before any division rounds it. Summed over the polygon's fan, because clipping
+    // may leave three consecutive vertices on one line.
+    double det = 0.0;
+    for (int k = 1; k + 1 < poly.count; ++k) det += homogeneous_det(poly.v[0], poly.v[k], poly.v[k + 1]);
+    if (det == 0.0) {
+        ++stats.degenerate;
+        return result;
+    }
+    if (facing_away(det, backface)) {
+        ++stats.backface_culled;
+        return result;
+    }
     // Project to sample space (y down) with depth 1/w.
     glm::dvec2 screen[ClipPolygon::kMax];
     double depth[ClipPolygon::kMax];
@@ -99,24 +123,6 @@ SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bi
         const double inv_w = 1.0 / poly.v[k].z;
         screen[k] = {(poly.v[k].x * inv_w + 1.0) * 0.5 * sample_width, (1.0 - poly.v[k].y * inv_w) * 0.5 * sample_height};
         depth[k] = inv_w;
-    }
-    // Orientation and degeneracy from homogeneous determinants det[x y w] (w > 0 after
-    // clipping): positive for counter-clockwise in NDC, and exactly zero for collinear
-    // input, before any division rounds it. Summed over the polygon's fan, because clipping
-    // may leave three consecutive vertices on one line.
-    auto det3 = [](const ClipVertex& a, const ClipVertex& b, const ClipVertex& c) {
-        return a.x * (b.y * c.z - b.z * c.y) - a.y * (b.x * c.z - b.z * c.x) + a.z * (b.x * c.y - b.y * c.x);
-    };
-    double det = 0.0;
-    for (int k = 1; k + 1 < poly.count; ++k) det += det3(poly.v[0], poly.v[k], poly.v[k + 1]);
-    if (det == 0.0) {
-        ++stats.degenerate;
-        return result;
-    }
-    const bool ccw_in_ndc = det > 0.0;
-    if ((backface == Backface::cw && !ccw_in_ndc) || (backface == Backface::ccw && ccw_in_ndc)) {
-        ++stats.backface_culled;
-        return result;
     }
     // Fan triangles (0, k, k + 1): their diagonals are shared with each other.
     for (int k = 1; k + 1 < poly.count; ++k) {

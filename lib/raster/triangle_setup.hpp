@@ -28,22 +28,53 @@ bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 mode
 // then so does the whole triangle.
 bool outside_side_plane(const glm::dvec4 clip[3]);
 
+// Whether the triangle lies entirely behind the near plane or outside one side plane.
+bool outside_frustum(const glm::dvec4 clip[3], double near_w);
+
 // The guard band, in NDC units: triangles reaching beyond |x/w| or |y/w| = kGuardBand are
 // clipped there, so that sample coordinates stay small enough for double edge functions to be
 // exact to far below the coverage margin.
 constexpr double kGuardBand = 32.0;
+
+// Reaching more than 2^28 times its nearest w (or near_w) in x or y: clipping it in double would
+// lose the precision conservative coverage needs (RasterStats::too_large).
+bool too_large_to_clip(const glm::dvec4 clip[3], double near_w);
+
+// Whether a vertex lies before the near plane or beyond the guard band: the triangle is clipped.
+bool needs_clipping(const glm::dvec4 clip[3], double near_w);
+
+// The homogeneous determinant det[x y w] of three clip-space points (w > 0 after clipping):
+// positive for counter-clockwise in NDC, and exactly zero for collinear input, before any
+// division rounds it. One fixed order of operations, which the SIMD front end repeats.
+template <typename V>
+inline double homogeneous_det(const V& a, const V& b, const V& c) {
+    auto w = [](const V& v) {
+        if constexpr (V::length() == 4) return v.w;
+        else return v.z;  // ClipVertex keeps w in z
+    };
+    return a.x * (b.y * w(c) - w(b) * c.y) - a.y * (b.x * w(c) - w(b) * c.x) + w(a) * (b.x * c.y - b.y * c.x);
+}
+
+// Whether a triangle of determinant det (homogeneous_det, non-zero) is culled by the backface mode.
+inline bool facing_away(double det, Backface backface) {
+    const bool ccw_in_ndc = det > 0.0;
+    return (backface == Backface::cw && !ccw_in_ndc) || (backface == Backface::ccw && ccw_in_ndc);
+}
+
+// What setup_clip_triangle will do with a triangle, decided without clipping: rejected as
+// outside, degenerate or backfacing (the statistic it counts), or set up (clipped, too large,
+// or rasterized: setup_clip_triangle decides).
+enum class TriangleFate : std::uint8_t { needs_setup, invalid, outside, degenerate, backfacing };
+TriangleFate unclipped_fate(const glm::dvec4 clip[3], Backface backface, double near_w);
 
 struct SetupResult {
     ScreenTriangle triangles[6];  // the clipped polygon's fan (a triangle clips to at most 8 vertices)
     int count = 0;
 };
 
-// Sets up triangle t of the input; updates the setup statistics (everything but
-// subtiles_touched). `sample_width/height` is the buffer's sample grid.
-SetupResult setup_triangle(const TriangleInput& in, std::size_t t, double near_w, int sample_width, int sample_height,
-                           RasterStats& stats);
-// The same for a triangle already fetched and in clip space, with its shared-edge bits
-// (counts everything but triangles_in and invalid).
+// Sets up a triangle already fetched and in clip space (fetch_clip_triangle), with its shared-edge
+// bits: clipping, backface culling, projection to the sample grid of sample_width x sample_height.
+// Counts the setup statistics but triangles_in, invalid and subtiles_touched.
 SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
                                 int sample_height, RasterStats& stats);
 

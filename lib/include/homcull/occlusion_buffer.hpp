@@ -252,7 +252,7 @@ private:
     // binned by bands of subtile rows; the same bits either way.
     detail::RasterTarget raster_target(int row_begin, int row_end);
     template <typename Emit>
-    void setup_for_raster(const TriangleInput& in, std::size_t t, RasterStats& stats, Emit&& emit) const;
+    void setup_for_raster(const TriangleInput& in, std::size_t begin, std::size_t end, RasterStats& stats, Emit&& emit) const;
     void render_serial(const TriangleInput& in);
     void render_binned(const TriangleInput& in, const ParallelFor& parallel);
 
