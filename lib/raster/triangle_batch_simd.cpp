@@ -15,8 +15,8 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-void ClassifyTriangleBatch(const TriangleInput& in, double near_w, TriangleBatch& batch) {
-    const hn::ScalableTag<double> d;
+void ClassifyTriangleBatch(const TriangleInput& in, double near_w, int count, TriangleBatch& batch, RasterStats& stats) {
+    const hn::CappedTag<double, 8> d;  // at most 8 lanes: one byte of mask bits per group
     using V = hn::Vec<decltype(d)>;
     using M = hn::Mask<decltype(d)>;
     const int lanes = int(hn::Lanes(d));
@@ -29,7 +29,9 @@ void ClassifyTriangleBatch(const TriangleInput& in, double near_w, TriangleBatch
                                hn::Mul(hn::Set(d, double(m[8 + r])), z)),
                        hn::Mul(hn::Set(d, double(m[12 + r])), w));
     };
-    for (int g = 0; g < TriangleBatch::kSize; g += lanes) {
+    batch.needs_setup = 0;
+    for (int g = 0; g < count; g += lanes) {
+        const M live = hn::FirstN(d, std::size_t(count - g));
         M finite = hn::FirstN(d, std::size_t(lanes)), behind = finite, right = finite, left = finite, above = finite,
           below = finite, needs_clip = hn::Not(finite);
         V extent = zero, min_w = infinity;
@@ -68,28 +70,21 @@ void ClassifyTriangleBatch(const TriangleInput& in, double near_w, TriangleBatch
         if (in.backface == Backface::cw) away = hn::Not(ccw);
         else if (in.backface == Backface::ccw) away = ccw;
 
-        // The fates in unclipped_fate's order of precedence, each lane in exactly one.
-        const M invalid = hn::Not(finite);
-        const M out = hn::AndNot(invalid, outside);
-        const M decided = hn::Or(invalid, outside);
-        const M setup = hn::AndNot(decided, hn::Or(too_large, needs_clip));
-        const M open = hn::Not(hn::Or(decided, setup));
+        // The fates in unclipped_fate's order of precedence, each live lane in exactly one.
+        const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};  // lanes <= 8
+        const M invalid = hn::And(live, hn::Not(hn::And(finite, hn::LoadMaskBits(d, index_bits))));
+        const M valid = hn::AndNot(invalid, live);
+        const M out = hn::And(valid, outside);
+        const M open = hn::AndNot(hn::Or(outside, hn::Or(too_large, needs_clip)), valid);  // neither decided nor set up
         const M degenerate = hn::And(open, hn::Eq(det, zero));
         const M backfacing = hn::And(hn::AndNot(degenerate, open), away);
-        std::uint8_t bits[4][8] = {};
-        hn::StoreMaskBits(d, invalid, bits[0]);
-        hn::StoreMaskBits(d, out, bits[1]);
-        hn::StoreMaskBits(d, degenerate, bits[2]);
-        hn::StoreMaskBits(d, backfacing, bits[3]);
-        for (int i = 0; i < lanes; ++i) {
-            auto bit = [&](int which) { return (bits[which][i / 8] >> (i % 8)) & 1; };
-            const int t = g + i;
-            batch.fate[t] = !batch.indices_valid[t] || bit(0) ? TriangleFate::invalid
-                            : bit(1)                           ? TriangleFate::outside
-                            : bit(2)                           ? TriangleFate::degenerate
-                            : bit(3)                           ? TriangleFate::backfacing
-                                                               : TriangleFate::needs_setup;
-        }
+        stats.invalid += hn::CountTrue(d, invalid);
+        stats.outside += hn::CountTrue(d, out);
+        stats.degenerate += hn::CountTrue(d, degenerate);
+        stats.backface_culled += hn::CountTrue(d, backfacing);
+        std::uint8_t setup_bits[8] = {};
+        hn::StoreMaskBits(d, hn::AndNot(hn::Or(hn::Or(invalid, out), hn::Or(degenerate, backfacing)), live), setup_bits);
+        batch.needs_setup |= std::uint32_t(setup_bits[0]) << g;
     }
 }
 
@@ -102,8 +97,8 @@ namespace homcull::detail {
 HWY_EXPORT(ClassifyTriangleBatch);
 
 namespace {
-void dispatch_classify(const TriangleInput& in, double near_w, TriangleBatch& batch) {
-    HWY_DYNAMIC_DISPATCH(ClassifyTriangleBatch)(in, near_w, batch);
+void dispatch_classify(const TriangleInput& in, double near_w, int count, TriangleBatch& batch, RasterStats& stats) {
+    HWY_DYNAMIC_DISPATCH(ClassifyTriangleBatch)(in, near_w, count, batch, stats);
 }
 }  // namespace
 
