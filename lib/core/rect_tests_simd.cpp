@@ -124,6 +124,16 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
     }
 }
 
+// The lanes of a mask as bits (lane k: bit k), for at most 32 lanes: the set ones are then
+// visited with a count of trailing zeros instead of testing every lane.
+template <class D>
+HWY_INLINE std::uint32_t LaneBits(D d, hn::Mask<D> mask) {
+    static_assert(kMaxSimdLanes <= 32, "one 32-bit word of lane bits");
+    HWY_ALIGN std::uint8_t bytes[8] = {};
+    hn::StoreMaskBits(d, mask, bytes);
+    return std::uint32_t(bytes[0]) | std::uint32_t(bytes[1]) << 8 | std::uint32_t(bytes[2]) << 16 | std::uint32_t(bytes[3]) << 24;
+}
+
 // The exact stage on the subtiles [sx0, sx1] x [sy0, sy1] of the rectangle, row by row, a
 // vector of subtiles at a time: false when one shows it. A subtile with d0 > d_near hides it
 // whatever its mask; one with d0 <= d_near shows it if it is interior (all its samples in the
@@ -149,11 +159,8 @@ HWY_INLINE bool SubtilesHide(const SubtileView& view, const RectQuery& q, const 
                     hn::And(hn::Not(hn::Lt(column, hn::Set(di, interior.ix0))), hn::Not(hn::Gt(column, hn::Set(di, interior.ix1))));
                 if (!hn::AllFalse(df, hn::And(shows, hn::RebindMask(df, inside)))) return false;
             }
-            HWY_ALIGN std::uint8_t bits[8];
-            hn::StoreMaskBits(df, shows, bits);
-            for (int k = 0; k < lanes; ++k)
-                if ((bits[k / 8] >> (k % 8)) & 1u)
-                    if (!subtile_hides(view, tx + k, ty, q)) return false;
+            for (std::uint32_t bits = LaneBits(df, shows); bits != 0; bits &= bits - 1)
+                if (!subtile_hides(view, tx + __builtin_ctz(bits), ty, q)) return false;
         }
     }
     return true;
@@ -186,14 +193,11 @@ Visibility RectScan(const SubtileView& view, const RectQuery& q) {
             const auto reached = hn::FirstN(df, std::size_t(cx1 - cx + 1));
             const auto open = hn::And(reached, hn::Not(hn::Lt(d_near, hn::LoadU(df, row + cx))));
             if (hn::AllFalse(df, open)) continue;
-            HWY_ALIGN std::uint8_t bits[8];
-            hn::StoreMaskBits(df, open, bits);
-            for (int k = 0; k < lanes; ++k)
-                if ((bits[k / 8] >> (k % 8)) & 1u) {
-                    const int c = cx + k;
-                    if (!SubtilesHide(view, q, interior, std::max(tx0, c * kCell), std::min(tx1, c * kCell + kCell - 1), sy0, sy1))
-                        return Visibility::visible;
-                }
+            for (std::uint32_t bits = LaneBits(df, open); bits != 0; bits &= bits - 1) {
+                const int c = cx + __builtin_ctz(bits);
+                if (!SubtilesHide(view, q, interior, std::max(tx0, c * kCell), std::min(tx1, c * kCell + kCell - 1), sy0, sy1))
+                    return Visibility::visible;
+            }
         }
     }
     return Visibility::occluded;
