@@ -183,17 +183,21 @@ bool same_stats(const RasterStats& a, const RasterStats& b) {
 }
 
 // The setup front end decides batches of triangles in SIMD lanes (invalid, outside,
-// degenerate, backfacing) and hands the rest to the one-triangle setup: every instruction
-// set counts every statistic as the scalar reference does and gives its bits, on input that
-// reaches every fate: vertices behind the eye, beyond the guard band and far outside, huge,
-// collinear, NaN and Inf, indices out of range, 16- and 32-bit indices, 4 components with a
-// padded stride, each backface mode, and counts that are not a multiple of the batch.
+// degenerate, backfacing) and hands the rest to the one-triangle setup; indexed input with no
+// more vertices than triangles first transforms every vertex once, with its outcode. Every
+// instruction set counts every statistic as the scalar reference does and gives its bits, with
+// and without the vertex cache, and both give the same, on input that reaches every fate:
+// vertices behind the eye, beyond the guard band and far outside, huge, collinear, NaN and
+// Inf, indices out of range, 16- and 32-bit indices, 4 components with a padded stride, each
+// backface mode, and counts that are not a multiple of the batch.
 TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
     std::mt19937_64 rng(77);
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f), w(0.2f, 40.0f);
-    constexpr std::size_t kVertices = 3001, kStride = 6;  // x, y, z, w and two floats of padding
-    std::vector<float> vertices(kVertices * kStride, 0.0f);
-    for (std::size_t v = 0; v < kVertices; ++v) {
+    // kUsed vertices referenced; the input may declare kUsed + kUnused (then more vertices than
+    // triangles: no vertex cache).
+    constexpr std::size_t kUsed = 3001, kUnused = 30000, kStride = 6;  // x, y, z, w and two floats of padding
+    std::vector<float> vertices((kUsed + kUnused) * kStride, 1.0f);
+    for (std::size_t v = 0; v < kUsed; ++v) {
         const float wv = (v % 97 == 0) ? -w(rng) : w(rng);  // some behind the eye
         const float spread = v % 13 == 0 ? 200.0f : v % 29 == 0 ? 1e12f : 1.3f;  // beyond the guard band, too large
         float* p = &vertices[v * kStride];
@@ -202,35 +206,41 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
         if (v % 223 == 0) p[3] = std::numeric_limits<float>::infinity();
     }
     // Triangles of nearby vertices (small, some collinear), with indices out of range now and then.
+    constexpr std::size_t kTriangles = 20011;
     std::vector<std::uint32_t> indices32;
-    for (std::size_t t = 0; t < 20011; ++t) {
-        const std::uint32_t a = std::uint32_t(rng() % (kVertices - 2));
-        std::uint32_t tri[3] = {a, a + 1 + std::uint32_t(t % 2), a + 2 - std::uint32_t(t % 2)};
-        if (t % 101 == 0) tri[t % 3] = std::uint32_t(kVertices + t);  // out of range
-        if (t % 89 == 0) tri[2] = tri[1];                             // zero area
-        indices32.insert(indices32.end(), tri, tri + 3);
-    }
     std::vector<std::uint16_t> indices16;
-    for (std::uint32_t i : indices32) indices16.push_back(std::uint16_t(std::min<std::uint32_t>(i, 65535u)));
+    for (std::size_t t = 0; t < kTriangles; ++t) {
+        const std::uint32_t a = std::uint32_t(rng() % (kUsed - 2));
+        std::uint32_t tri[3] = {a, a + 1 + std::uint32_t(t % 2), a + 2 - std::uint32_t(t % 2)};
+        if (t % 89 == 0) tri[2] = tri[1];  // zero area
+        for (int k = 0; k < 3; ++k) {
+            const bool out_of_range = t % 101 == 0 && std::size_t(k) == t % 3;
+            indices32.push_back(out_of_range ? 0xFFFFFFF0u : tri[k]);
+            indices16.push_back(out_of_range ? std::uint16_t(65535) : std::uint16_t(tri[k]));
+        }
+    }
 
     TriangleInput in;
     in.positions = vertices.data();
     in.position_components = 4;
     in.position_stride = kStride * sizeof(float);
-    in.vertex_count = kVertices;
     in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    // Buffers in pairs: the same triangles with kUsed vertices declared (vertex cache when
+    // there are more triangles than that) and with kUsed + kUnused (none).
     auto render_all = [&](std::vector<OcclusionBuffer>& out) {
         for (const Backface backface : {Backface::none, Backface::cw, Backface::ccw})
             for (const bool sixteen : {false, true})
-                for (const std::size_t count : {std::size_t(20011), std::size_t(7)}) {
-                    TriangleInput input = in;
-                    input.backface = backface;
-                    input.indices_16bit = sixteen;
-                    input.indices = sixteen ? static_cast<const void*>(indices16.data()) : indices32.data();
-                    input.triangle_count = count;
-                    out.emplace_back(test::buffer_config(203, 117, 2, 0.5f));
-                    out.back().render(input);
-                }
+                for (const std::size_t count : {kTriangles, std::size_t(7)})
+                    for (const std::size_t vertex_count : {kUsed, kUsed + kUnused}) {
+                        TriangleInput input = in;
+                        input.backface = backface;
+                        input.indices_16bit = sixteen;
+                        input.indices = sixteen ? static_cast<const void*>(indices16.data()) : indices32.data();
+                        input.triangle_count = count;
+                        input.vertex_count = vertex_count;
+                        out.emplace_back(test::buffer_config(203, 117, 2, 0.5f));
+                        out.back().render(input);
+                    }
     };
     select_isa("scalar");
     std::vector<OcclusionBuffer> reference;
@@ -245,6 +255,10 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
     EXPECT_GT(all.backface_culled, 0u);
     EXPECT_GT(all.degenerate, 0u);
     EXPECT_GT(all.rasterized, 1000u);
+    for (std::size_t k = 0; k < reference.size(); k += 2) {  // with and without the vertex cache
+        EXPECT_TRUE(same_stats(reference[k].stats(), reference[k + 1].stats())) << "buffer " << k;
+        EXPECT_TRUE(same_subtiles(reference[k], reference[k + 1])) << "buffer " << k;
+    }
     for (const std::string& isa : available_isas()) {
         select_isa(isa);
         std::vector<OcclusionBuffer> buffers;

@@ -109,8 +109,35 @@ detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) 
 // Sets up triangles [begin, end) of the input and hands each triangle of their clipped fans
 // that covers a sample's bounding box to `emit`, in input order.
 template <typename Emit>
-void OcclusionBuffer::setup_for_raster(const TriangleInput& in, std::size_t begin, std::size_t end, RasterStats& stats, Emit&& emit) const {
-    detail::setup_triangle_range(in, begin, end, config_.near_w, config_.edge_margin, sample_width_, sample_height_, stats, emit);
+void OcclusionBuffer::setup_for_raster(const TriangleInput& in, const detail::VertexClip* cache, std::size_t begin, std::size_t end,
+                                       RasterStats& stats, Emit&& emit) const {
+    detail::setup_triangle_range(in, cache, begin, end, config_.near_w, config_.edge_margin, sample_width_, sample_height_, stats, emit);
+}
+
+bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache) {
+    if (!detail::use_vertex_cache(in)) return false;
+    const std::size_t plane = in.vertex_count + detail::kVertexClipPadding;
+    if (vertex_clip_.size() < 4 * plane) vertex_clip_.resize(4 * plane);
+    if (vertex_outcode_.size() < in.vertex_count) vertex_outcode_.resize(in.vertex_count);
+    double* planes = vertex_clip_.data();
+    cache = {planes, planes + plane, planes + 2 * plane, planes + 3 * plane, vertex_outcode_.data()};
+    const detail::TransformVerticesKernel transform = detail::selected_front_end_kernels().transform_vertices;
+    constexpr std::size_t kVerticesPerTask = 16384;
+    const std::size_t tasks = (in.vertex_count + kVerticesPerTask - 1) / kVerticesPerTask;
+    struct Job {
+        const TriangleInput* in;
+        const detail::VertexClip* cache;
+        detail::TransformVerticesKernel transform;
+        double near_w;
+    } job{&in, &cache, transform, double(config_.near_w)};
+    const auto task = [](void* data, std::size_t k) {
+        const Job& j = *static_cast<Job*>(data);
+        j.transform(*j.in, j.near_w, k * kVerticesPerTask, std::min(j.in->vertex_count, (k + 1) * kVerticesPerTask), *j.cache);
+    };
+    if (parallel.run && tasks > 1) parallel.run(parallel.user, tasks, task, &job);
+    else
+        for (std::size_t k = 0; k < tasks; ++k) task(&job, k);
+    return true;
 }
 
 void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& parallel) {
@@ -120,26 +147,29 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         throw Error("render: positions missing, or stride smaller than one position");
     if (!in.indices && in.vertex_count / 3 < in.triangle_count)  // (no overflow for any count)
         throw Error("render: without indices, vertex_count must be at least 3 * triangle_count");
-    if (parallel.run) render_binned(in, parallel);
-    else render_serial(in);
+    detail::VertexClip storage;
+    const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;
+    if (parallel.run) render_binned(in, parallel, cache);
+    else render_serial(in, cache);
     build_pyramid();
 }
 
 // One thread: each triangle is rasterized over the whole buffer as soon as it is set up, in
 // input order; nothing is binned. Every subtile sees the triangles in the same order as in
 // render_binned, so both give the same bits.
-void OcclusionBuffer::render_serial(const TriangleInput& in) {
+void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache) {
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t touched = 0;
     RasterStats stats;
-    setup_for_raster(in, 0, in.triangle_count, stats, [&](const detail::RasterTriangle& tri) { touched += target.kernel(target, tri); });
+    setup_for_raster(in, cache, 0, in.triangle_count, stats,
+                     [&](const detail::RasterTriangle& tri) { touched += target.kernel(target, tri); });
     stats.subtiles_touched = touched;
     stats_ += stats;
 }
 
 // With a job system: phase 1 sets up and bins chunks of triangles in parallel, phase 2
 // rasterizes bands of subtile rows in parallel, each band its triangles in input order.
-void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel) {
+void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache) {
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_touched_.size();
     if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
@@ -147,8 +177,9 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
     struct Job {
         OcclusionBuffer* self;
         const TriangleInput* in;
+        const detail::VertexClip* cache;
         std::size_t chunk_count, bands;
-    } job{this, &in, chunk_count, bands};
+    } job{this, &in, cache, chunk_count, bands};
 
     parallel.run(parallel.user, chunk_count, [](void* data, std::size_t c) {
         const Job& j = *static_cast<Job*>(data);
@@ -157,7 +188,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
         for (auto& bin : chunk.bins) bin.clear();
         const std::size_t end = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
-        j.self->setup_for_raster(*j.in, c * kChunkTriangles, end, chunk.stats, [&](const detail::RasterTriangle& tri) {
+        j.self->setup_for_raster(*j.in, j.cache, c * kChunkTriangles, end, chunk.stats, [&](const detail::RasterTriangle& tri) {
             for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
                 chunk.bins[std::size_t(band)].push_back(tri);
         });

@@ -5,7 +5,23 @@
 namespace homcull::detail {
 namespace {
 
-// The three indices of lanes [0, count), and the indices_valid bits.
+// Index k of triangle t: from 16- or 32-bit indices, or 3t + k without them.
+template <typename Index>
+inline std::uint32_t vertex_index(const Index* indices, std::size_t t, int k) {
+    const std::size_t n = 3 * t + std::size_t(k);
+    return indices ? std::uint32_t(indices[n]) : std::uint32_t(n);
+}
+
+// The position of vertex v as (x, y, z, w), w = 1 for 3 components. Fixed-size copies: the
+// stride need not keep floats aligned, and a copy of a run-time size goes through a library
+// call whose byte stores the loads after it cannot forward from.
+inline void read_position(const TriangleInput& in, std::uint32_t v, float p[4]) {
+    const unsigned char* vertex = static_cast<const unsigned char*>(in.positions) + std::size_t(v) * in.position_stride;
+    std::memcpy(p, vertex, 3 * sizeof(float));
+    p[3] = 1.0f;
+    if (in.position_components == 4) std::memcpy(&p[3], vertex + 3 * sizeof(float), sizeof(float));
+}
+
 template <typename Index>
 std::uint32_t read_indices(const Index* indices, std::size_t first, int count, std::size_t vertex_count,
                            std::uint32_t (&index)[3][TriangleBatch::kSize]) {
@@ -13,8 +29,7 @@ std::uint32_t read_indices(const Index* indices, std::size_t first, int count, s
     for (int t = 0; t < count; ++t) {
         bool ok = true;
         for (int k = 0; k < 3; ++k) {
-            const std::size_t n = 3 * (first + std::size_t(t)) + std::size_t(k);
-            index[k][t] = indices ? std::uint32_t(indices[n]) : std::uint32_t(n);
+            index[k][t] = vertex_index(indices, first + std::size_t(t), k);
             ok = ok && index[k][t] < vertex_count;
         }
         valid |= std::uint32_t(ok) << t;
@@ -22,7 +37,66 @@ std::uint32_t read_indices(const Index* indices, std::size_t first, int count, s
     return valid;
 }
 
+template <typename Index>
+std::size_t gather_cached(const Index* indices, const TriangleInput& in, const VertexClip& cache, std::size_t first, std::size_t end,
+                          TriangleBatch& batch, RasterStats& stats) {
+    batch.count = 0;
+    batch.indices_valid = 0;
+    std::size_t t = first;
+    for (; t < end && batch.count < TriangleBatch::kSize; ++t) {
+        ++stats.triangles_in;
+        std::uint32_t v[3];
+        bool valid = true;
+        for (int k = 0; k < 3; ++k) {
+            v[k] = vertex_index(indices, t, k);
+            valid = valid && v[k] < in.vertex_count;
+        }
+        if (!valid) {
+            ++stats.invalid;
+            continue;
+        }
+        const std::uint8_t a = cache.outcode[v[0]], b = cache.outcode[v[1]], c = cache.outcode[v[2]];
+        if ((a | b | c) & kNotFinite) {
+            ++stats.invalid;
+            continue;
+        }
+        if (a & b & c & kOutsidePlanes) {
+            ++stats.outside;
+            continue;
+        }
+        const int lane = batch.count++;
+        batch.triangle[lane] = t;
+        batch.indices_valid |= 1u << lane;
+        for (int k = 0; k < 3; ++k) {
+            batch.cx[k][lane] = cache.x[v[k]], batch.cy[k][lane] = cache.y[v[k]];
+            batch.cz[k][lane] = cache.z[v[k]], batch.cw[k][lane] = cache.w[v[k]];
+        }
+    }
+    return t;
+}
+
 }  // namespace
+
+std::uint8_t outcode(const glm::dvec4& c, double near_w) {
+    if (!finite_clip(c)) return kNotFinite;
+    return std::uint8_t((c.w < near_w ? kBehindNear : 0) | (c.x > c.w ? kBeyondRight : 0) | (c.x < -c.w ? kBeyondLeft : 0) |
+                        (c.y > c.w ? kBeyondTop : 0) | (c.y < -c.w ? kBeyondBottom : 0));
+}
+
+void transform_vertices_reference(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache) {
+    for (std::size_t v = begin; v < end; ++v) {
+        float p[4];
+        read_position(in, std::uint32_t(v), p);
+        const glm::dvec4 c = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
+        cache.x[v] = c.x, cache.y[v] = c.y, cache.z[v] = c.z, cache.w[v] = c.w;
+        cache.outcode[v] = outcode(c, near_w);
+    }
+}
+
+bool use_vertex_cache(const TriangleInput& in) {
+    constexpr std::size_t kMaxCachedVertices = std::size_t(1) << 22;  // 4M vertices: 136 MB of cache at most
+    return in.indices && in.vertex_count > 0 && in.vertex_count <= in.triangle_count && in.vertex_count <= kMaxCachedVertices;
+}
 
 void gather_triangle_batch(const TriangleInput& in, std::size_t first, int count, TriangleBatch& batch) {
     std::uint32_t index[3][TriangleBatch::kSize];
@@ -30,36 +104,37 @@ void gather_triangle_batch(const TriangleInput& in, std::size_t first, int count
     else if (in.indices_16bit)
         batch.indices_valid = read_indices(static_cast<const std::uint16_t*>(in.indices), first, count, in.vertex_count, index);
     else batch.indices_valid = read_indices(static_cast<const std::uint32_t*>(in.indices), first, count, in.vertex_count, index);
-
-    const auto* bytes = static_cast<const unsigned char*>(in.positions);
-    const bool has_w = in.position_components == 4;
+    for (int t = 0; t < count; ++t) batch.triangle[t] = first + std::size_t(t);
     for (int k = 0; k < 3; ++k)
         for (int t = 0; t < TriangleBatch::kSize; ++t) {
-            // Lanes without valid indices (and past count) read nothing: the origin.
-            float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-            if ((batch.indices_valid >> t) & 1u) {
-                // Fixed-size copies (the stride need not keep floats aligned; a copy of a
-                // run-time size goes through a library call and stalls the loads after it).
-                const unsigned char* vertex = bytes + std::size_t(index[k][t]) * in.position_stride;
-                std::memcpy(p, vertex, 3 * sizeof(float));
-                if (has_w) std::memcpy(&p[3], vertex + 3 * sizeof(float), sizeof(float));
-            }
+            float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // lanes without valid indices (and past count) read nothing
+            if ((batch.indices_valid >> t) & 1u) read_position(in, index[k][t], p);
             batch.px[k][t] = p[0], batch.py[k][t] = p[1], batch.pz[k][t] = p[2], batch.pw[k][t] = p[3];
         }
 }
 
-void classify_triangle_batch_reference(const TriangleInput& in, double near_w, int count, TriangleBatch& batch, RasterStats& stats) {
-    batch.needs_setup = 0;
-    for (int t = 0; t < count; ++t) {
-        glm::dvec4 clip[3];
-        bool finite = true;
+std::size_t gather_cached_batch(const TriangleInput& in, const VertexClip& cache, std::size_t first, std::size_t end, TriangleBatch& batch,
+                                RasterStats& stats) {
+    if (!in.indices) return gather_cached<std::uint32_t>(nullptr, in, cache, first, end, batch, stats);
+    if (in.indices_16bit) return gather_cached(static_cast<const std::uint16_t*>(in.indices), in, cache, first, end, batch, stats);
+    return gather_cached(static_cast<const std::uint32_t*>(in.indices), in, cache, first, end, batch, stats);
+}
+
+void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch) {
+    for (int t = 0; t < TriangleBatch::kSize; ++t)
         for (int k = 0; k < 3; ++k) {
-            clip[k] = transform_to_clip(in.model_to_clip, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t]);
-            batch.cx[k][t] = clip[k].x, batch.cy[k][t] = clip[k].y, batch.cz[k][t] = clip[k].z, batch.cw[k][t] = clip[k].w;
-            finite = finite && finite_clip(clip[k]);
+            const glm::dvec4 c = transform_to_clip(in.model_to_clip, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t]);
+            batch.cx[k][t] = c.x, batch.cy[k][t] = c.y, batch.cz[k][t] = c.z, batch.cw[k][t] = c.w;
         }
+}
+
+void classify_batch_reference(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
+    batch.needs_setup = 0;
+    for (int t = 0; t < batch.count; ++t) {
+        const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
+        const bool finite = finite_clip(clip[0]) && finite_clip(clip[1]) && finite_clip(clip[2]);
         const TriangleFate fate =
-            !((batch.indices_valid >> t) & 1u) || !finite ? TriangleFate::invalid : unclipped_fate(clip, in.backface, near_w);
+            !((batch.indices_valid >> t) & 1u) || !finite ? TriangleFate::invalid : unclipped_fate(clip, backface, near_w);
         switch (fate) {
         case TriangleFate::invalid: ++stats.invalid; break;
         case TriangleFate::outside: ++stats.outside; break;

@@ -1,11 +1,16 @@
 #pragma once
-// The front of triangle setup, a batch of consecutive triangles at a time: index and vertex
-// fetch, the model-to-clip transform, and the rejections that need no clipping (invalid
-// input, outside the frustum, degenerate, backfacing). Most of an engine's occluder
-// triangles end there (30,000 of the castle's 48,700 are outside view C0, 10,000 more face
-// away), so the SIMD kernel (triangle_batch_simd.cpp) decides them in double lanes, several
-// triangles per instruction, as Intel's MOC does for its setup. The triangles left go to
-// setup_clip_triangle one by one, with clip coordinates bit-identical to fetch_clip_triangle's.
+// The front of triangle setup, a batch of triangles at a time: index and vertex fetch, the
+// model-to-clip transform, and the rejections that need no clipping (invalid input, outside
+// the frustum, degenerate, backfacing). Most of an engine's occluder triangles end there
+// (30,000 of the castle's 48,700 are outside view C0, 10,000 more face away), so SIMD kernels
+// (triangle_batch_simd.cpp) decide them in double lanes, several triangles per instruction,
+// as Intel's MOC does for its setup. The triangles left go to setup_clip_triangle one by one,
+// with clip coordinates bit-identical to fetch_clip_triangle's.
+//
+// Indexed meshes share each vertex among about six triangles, so for them every vertex is
+// transformed once per render into a VertexClip cache with its frustum outcode, and a
+// triangle is rejected as invalid or outside from its three outcodes before anything is
+// fetched (MOC's TransformVertices, and Blinn and Newell's outcodes).
 #include "raster/triangle_setup.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -15,10 +20,13 @@
 
 namespace homcull::detail {
 
-// A batch of triangles in structure-of-arrays form: the vertex positions as fetched, and
-// after classification the clip-space x, y, z, w and which triangles need the one-triangle setup.
+// A batch of triangles in structure-of-arrays form: their input indices, the vertex positions
+// as fetched, the clip-space x, y, z, w, and after classification which triangles need the
+// one-triangle setup.
 struct TriangleBatch {
     static constexpr int kSize = 16;  // a multiple of every target's double lanes (2, 4, 8)
+    int count = 0;                    // lanes in use
+    std::size_t triangle[kSize];      // lane t holds triangle triangle[t] of the input
     alignas(64) double px[3][kSize], py[3][kSize], pz[3][kSize], pw[3][kSize];  // per vertex k, per lane
     alignas(64) double cx[3][kSize], cy[3][kSize], cz[3][kSize], cw[3][kSize];
     std::uint32_t indices_valid = 0;  // bit t: lane t's three indices are below vertex_count
@@ -28,39 +36,89 @@ struct TriangleBatch {
     glm::dvec4 clip(int t, int k) const { return {cx[k][t], cy[k][t], cz[k][t], cw[k][t]}; }
 };
 
+// Frustum outcode bits of a clip-space vertex: a triangle is outside when its three vertices
+// share a plane bit (outside_frustum), and invalid when one is not finite (finite_clip).
+enum OutcodeBit : std::uint8_t {
+    kNotFinite = 1,
+    kBehindNear = 2,   // w < near_w
+    kBeyondRight = 4,  // x > w
+    kBeyondLeft = 8,   // x < -w
+    kBeyondTop = 16,   // y > w
+    kBeyondBottom = 32,
+};
+constexpr std::uint8_t kOutsidePlanes = kBehindNear | kBeyondRight | kBeyondLeft | kBeyondTop | kBeyondBottom;
+std::uint8_t outcode(const glm::dvec4& clip, double near_w);
+
+// Every vertex of an input in clip space, as planes of x, y, z, w, and its outcode. Each plane
+// has kVertexClipPadding elements past the last vertex, for whole-vector stores.
+constexpr std::size_t kVertexClipPadding = 8;
+struct VertexClip {
+    double *x, *y, *z, *w;
+    std::uint8_t* outcode;
+};
+// Transforms vertices [begin, end) of the input (transform_to_clip) into the cache.
+using TransformVerticesKernel = void (*)(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end,
+                                         const VertexClip& cache);
+void transform_vertices_reference(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache);
+
+// Whether a render should transform the input's vertices once (indexed, and no more vertices
+// than triangles: then it transforms fewer points than three per triangle).
+bool use_vertex_cache(const TriangleInput& in);
+
 // Fetches triangles [first, first + count) (0 < count <= kSize) into the batch's lanes
 // [0, count): positions as doubles, (x, y, z, 1) for 3 components. Lanes with an index out of
 // range, and lanes past count, get a finite position and no indices_valid bit.
 void gather_triangle_batch(const TriangleInput& in, std::size_t first, int count, TriangleBatch& batch);
 
-// Transforms a gathered batch's lanes [0, count) to clip space (transform_to_clip's operations)
-// and decides each: invalid (an index out of range, or a non-finite clip x, y or w), or
-// unclipped_fate. Counts the triangles rejected (invalid, outside, degenerate, backfacing) in
-// `stats` and sets needs_setup for the others. Every kernel gives the same clip coordinates,
-// counts and bits.
-using ClassifyBatchKernel = void (*)(const TriangleInput& in, double near_w, int count, TriangleBatch& batch, RasterStats& stats);
-void classify_triangle_batch_reference(const TriangleInput& in, double near_w, int count, TriangleBatch& batch, RasterStats& stats);
-// The reference or the SIMD kernel, following select_isa.
-ClassifyBatchKernel selected_classify_kernel();
+// Fills the batch from the cache with the triangles from `first` on that are neither invalid
+// nor outside by their outcodes, until it is full or `end` is reached; counts those skipped
+// (triangles_in, invalid, outside). Returns the first triangle not looked at.
+std::size_t gather_cached_batch(const TriangleInput& in, const VertexClip& cache, std::size_t first, std::size_t end, TriangleBatch& batch,
+                                RasterStats& stats);
+
+// Transforms a gathered batch's positions to clip space (transform_to_clip's operations).
+using TransformBatchKernel = void (*)(const TriangleInput& in, TriangleBatch& batch);
+void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch);
+
+// Decides each lane of a batch in clip space: invalid (an index out of range, or a non-finite
+// clip x, y or w), or unclipped_fate. Counts the triangles rejected (invalid, outside,
+// degenerate, backfacing) in `stats` and sets needs_setup for the others.
+using ClassifyBatchKernel = void (*)(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats);
+void classify_batch_reference(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats);
+
+// The reference or the SIMD kernels, following select_isa. Every kernel gives the same clip
+// coordinates, outcodes, counts and bits.
+struct FrontEndKernels {
+    TransformVerticesKernel transform_vertices;
+    TransformBatchKernel transform_batch;
+    ClassifyBatchKernel classify;
+};
+FrontEndKernels selected_front_end_kernels();
 
 // Sets up triangles [begin, end) of the input in batches and hands every triangle of their
 // clipped fans that covers a sample's bounding box to emit(const RasterTriangle&), in input
 // order; the statistics are those of fetch_clip_triangle and setup_clip_triangle, triangle
-// by triangle.
+// by triangle. `cache` (null: none) holds every vertex of the input, transformed.
 template <typename Emit>
-void setup_triangle_range(const TriangleInput& in, std::size_t begin, std::size_t end, double near_w, double edge_margin, int sample_width,
-                          int sample_height, RasterStats& stats, Emit&& emit) {
-    const ClassifyBatchKernel classify = selected_classify_kernel();
-    TriangleBatch batch;
-    for (std::size_t first = begin; first < end; first += TriangleBatch::kSize) {
-        const int count = int(std::min<std::size_t>(TriangleBatch::kSize, end - first));
-        gather_triangle_batch(in, first, count, batch);
-        classify(in, near_w, count, batch, stats);
-        stats.triangles_in += std::uint64_t(count);
+void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std::size_t begin, std::size_t end, double near_w,
+                          double edge_margin, int sample_width, int sample_height, RasterStats& stats, Emit&& emit) {
+    const FrontEndKernels kernels = selected_front_end_kernels();
+    TriangleBatch batch{};  // zeroed: the last vector of a batch may read lanes past count
+    for (std::size_t first = begin; first < end;) {
+        if (cache) {
+            first = gather_cached_batch(in, *cache, first, end, batch, stats);
+        } else {
+            batch.count = int(std::min<std::size_t>(TriangleBatch::kSize, end - first));
+            gather_triangle_batch(in, first, batch.count, batch);
+            kernels.transform_batch(in, batch);
+            stats.triangles_in += std::uint64_t(batch.count);
+            first += std::size_t(batch.count);
+        }
+        kernels.classify(in.backface, near_w, batch, stats);
         for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
             const int t = __builtin_ctz(bits);
             const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
-            const std::size_t index = first + std::size_t(t);
+            const std::size_t index = batch.triangle[t];
             const SetupResult setup = setup_clip_triangle(clip, in.shared_edges ? in.shared_edges[index] : 0, in.backface, near_w,
                                                           sample_width, sample_height, stats);
             for (int k = 0; k < setup.count; ++k) {

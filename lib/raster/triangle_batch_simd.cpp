@@ -1,7 +1,7 @@
-// The SIMD kernel of the setup front end (triangle_batch.hpp): a batch's triangles as double
-// lanes (2 on SSE4 and NEON, 4 on AVX2, 8 on AVX-512), each lane computing exactly what
-// classify_triangle_batch_reference computes for it: transform_to_clip's products and sums in
-// the same order (no fused multiply-add), then the comparisons of outside_frustum,
+// The SIMD kernels of the setup front end (triangle_batch.hpp), double lanes (2 on SSE4 and
+// NEON, 4 on AVX2, 8 on AVX-512), each lane computing exactly what the references in
+// triangle_batch.cpp compute for it: transform_to_clip's products and sums in the same order
+// (no fused multiply-add), then the comparisons of outcode, outside_frustum,
 // too_large_to_clip, needs_clipping, homogeneous_det and facing_away, which are exact.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/triangle_batch_simd.cpp"
@@ -11,38 +11,97 @@
 
 #include "raster/triangle_batch.hpp"
 
+#include <cstring>
+
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-void ClassifyTriangleBatch(const TriangleInput& in, double near_w, int count, TriangleBatch& batch, RasterStats& stats) {
-    const hn::CappedTag<double, 8> d;  // at most 8 lanes: one byte of mask bits per group
-    using V = hn::Vec<decltype(d)>;
-    using M = hn::Mask<decltype(d)>;
+using D = hn::CappedTag<double, 8>;  // at most 8 lanes: one byte of mask bits per vector
+using V = hn::Vec<D>;
+using M = hn::Mask<D>;
+
+// transform_to_clip's row r: ((m[r] x + m[4 + r] y) + m[8 + r] z) + m[12 + r] w.
+HWY_INLINE V ClipRow(D d, const std::array<float, 16>& m, int r, V x, V y, V z, V w) {
+    return hn::Add(hn::Add(hn::Add(hn::Mul(hn::Set(d, double(m[r])), x), hn::Mul(hn::Set(d, double(m[4 + r])), y)),
+                           hn::Mul(hn::Set(d, double(m[8 + r])), z)),
+                   hn::Mul(hn::Set(d, double(m[12 + r])), w));
+}
+
+HWY_INLINE std::uint32_t Bits(D d, M m) {
+    std::uint8_t bytes[8] = {};
+    hn::StoreMaskBits(d, m, bytes);
+    return bytes[0];
+}
+
+void TransformVertices(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache) {
+    const D d;
+    const hn::Rebind<std::int32_t, D> di;
+    constexpr int kBlock = 8;
     const int lanes = int(hn::Lanes(d));
-    const std::array<float, 16>& m = in.model_to_clip;
+    const V near = hn::Set(d, near_w), infinity = hn::Set(d, HUGE_VAL);
+    const bool has_w = in.position_components == 4;
+    const auto* bytes = static_cast<const unsigned char*>(in.positions);
+    HWY_ALIGN double p[4][kBlock];
+    for (std::size_t v0 = begin; v0 < end; v0 += kBlock) {
+        const int n = int(std::min<std::size_t>(kBlock, end - v0));
+        for (int i = 0; i < kBlock; ++i) {  // positions to structure of arrays (past n: the last one again)
+            const unsigned char* vertex = bytes + (v0 + std::size_t(std::min(i, n - 1))) * in.position_stride;
+            float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+            std::memcpy(f, vertex, 3 * sizeof(float));
+            if (has_w) std::memcpy(&f[3], vertex + 3 * sizeof(float), sizeof(float));
+            p[0][i] = f[0], p[1][i] = f[1], p[2][i] = f[2], p[3][i] = f[3];
+        }
+        for (int g = 0; g < n; g += lanes) {
+            const V px = hn::Load(d, p[0] + g), py = hn::Load(d, p[1] + g), pz = hn::Load(d, p[2] + g), pw = hn::Load(d, p[3] + g);
+            const V x = ClipRow(d, in.model_to_clip, 0, px, py, pz, pw), y = ClipRow(d, in.model_to_clip, 1, px, py, pz, pw);
+            const V z = ClipRow(d, in.model_to_clip, 2, px, py, pz, pw), w = ClipRow(d, in.model_to_clip, 3, px, py, pz, pw);
+            const std::size_t count = std::size_t(std::min(lanes, n - g)), at = v0 + std::size_t(g);
+            hn::StoreU(x, d, cache.x + at);  // whole vectors: the planes are padded by kVertexClipPadding
+            hn::StoreU(y, d, cache.y + at);
+            hn::StoreU(z, d, cache.z + at);
+            hn::StoreU(w, d, cache.w + at);
+            // outcode(), lane by lane, as small integers in double (exact), then bytes.
+            const V none = hn::Zero(d);
+            auto bit = [&](M m, OutcodeBit b) { return hn::IfThenElse(m, hn::Set(d, double(b)), none); };
+            const V planes = hn::Add(hn::Add(hn::Add(bit(hn::Lt(w, near), kBehindNear), bit(hn::Gt(x, w), kBeyondRight)),
+                                             hn::Add(bit(hn::Lt(x, hn::Neg(w)), kBeyondLeft), bit(hn::Gt(y, w), kBeyondTop))),
+                                     bit(hn::Lt(y, hn::Neg(w)), kBeyondBottom));
+            const M finite = hn::And(hn::And(hn::Lt(hn::Abs(x), infinity), hn::Lt(hn::Abs(y), infinity)), hn::Lt(hn::Abs(w), infinity));
+            HWY_ALIGN std::int32_t code[8];
+            hn::Store(hn::DemoteTo(di, hn::IfThenElse(finite, planes, hn::Set(d, double(kNotFinite)))), di, code);
+            for (std::size_t i = 0; i < count; ++i) cache.outcode[at + i] = std::uint8_t(code[i]);
+        }
+    }
+}
+
+void TransformBatch(const TriangleInput& in, TriangleBatch& batch) {
+    const D d;
+    const int lanes = int(hn::Lanes(d));
+    for (int g = 0; g < TriangleBatch::kSize; g += lanes)
+        for (int k = 0; k < 3; ++k) {
+            const V px = hn::Load(d, batch.px[k] + g), py = hn::Load(d, batch.py[k] + g), pz = hn::Load(d, batch.pz[k] + g),
+                    pw = hn::Load(d, batch.pw[k] + g);
+            hn::Store(ClipRow(d, in.model_to_clip, 0, px, py, pz, pw), d, batch.cx[k] + g);
+            hn::Store(ClipRow(d, in.model_to_clip, 1, px, py, pz, pw), d, batch.cy[k] + g);
+            hn::Store(ClipRow(d, in.model_to_clip, 2, px, py, pz, pw), d, batch.cz[k] + g);
+            hn::Store(ClipRow(d, in.model_to_clip, 3, px, py, pz, pw), d, batch.cw[k] + g);
+        }
+}
+
+void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
+    const D d;
+    const int lanes = int(hn::Lanes(d));
     const V near = hn::Set(d, near_w), guard = hn::Set(d, kGuardBand), infinity = hn::Set(d, HUGE_VAL);
     const V zero = hn::Zero(d), limit = hn::Set(d, 0x1.0p28);
-    // transform_to_clip's row: ((m[row] x + m[4 + row] y) + m[8 + row] z) + m[12 + row] w.
-    auto row = [&](int r, V x, V y, V z, V w) {
-        return hn::Add(hn::Add(hn::Add(hn::Mul(hn::Set(d, double(m[r])), x), hn::Mul(hn::Set(d, double(m[4 + r])), y)),
-                               hn::Mul(hn::Set(d, double(m[8 + r])), z)),
-                       hn::Mul(hn::Set(d, double(m[12 + r])), w));
-    };
     batch.needs_setup = 0;
-    for (int g = 0; g < count; g += lanes) {
-        const M live = hn::FirstN(d, std::size_t(count - g));
+    for (int g = 0; g < batch.count; g += lanes) {
+        const M live = hn::FirstN(d, std::size_t(batch.count - g));
         M finite = hn::FirstN(d, std::size_t(lanes)), behind = finite, right = finite, left = finite, above = finite,
           below = finite, needs_clip = hn::Not(finite);
         V extent = zero, min_w = infinity;
         for (int k = 0; k < 3; ++k) {
-            const V px = hn::Load(d, batch.px[k] + g), py = hn::Load(d, batch.py[k] + g), pz = hn::Load(d, batch.pz[k] + g),
-                    pw = hn::Load(d, batch.pw[k] + g);
-            const V x = row(0, px, py, pz, pw), y = row(1, px, py, pz, pw), w = row(3, px, py, pz, pw);
-            hn::Store(x, d, batch.cx[k] + g);
-            hn::Store(y, d, batch.cy[k] + g);
-            hn::Store(row(2, px, py, pz, pw), d, batch.cz[k] + g);
-            hn::Store(w, d, batch.cw[k] + g);
+            const V x = hn::Load(d, batch.cx[k] + g), y = hn::Load(d, batch.cy[k] + g), w = hn::Load(d, batch.cw[k] + g);
             const V ax = hn::Abs(x), ay = hn::Abs(y);
             finite = hn::And(finite, hn::And(hn::And(hn::Lt(ax, infinity), hn::Lt(ay, infinity)), hn::Lt(hn::Abs(w), infinity)));
             behind = hn::And(behind, hn::Lt(w, near));  // outside_frustum
@@ -55,23 +114,23 @@ void ClassifyTriangleBatch(const TriangleInput& in, double near_w, int count, Tr
             const V band = hn::Mul(guard, w);  // needs_clipping
             needs_clip = hn::Or(needs_clip, hn::Or(hn::Lt(w, near), hn::Or(hn::Gt(ax, band), hn::Gt(ay, band))));
         }
-        // The clip coordinates back from the batch (SVE vectors cannot be array elements).
+        const M outside = hn::Or(behind, hn::Or(hn::Or(right, left), hn::Or(above, below)));
+        const M too_large = hn::Gt(extent, hn::Mul(limit, hn::Max(near, min_w)));
+        // homogeneous_det(v0, v1, v2), plus 0.0 as setup_clip_triangle sums it. (SVE vectors
+        // cannot be array elements: the vertices are loaded again.)
         const V x0 = hn::Load(d, batch.cx[0] + g), x1 = hn::Load(d, batch.cx[1] + g), x2 = hn::Load(d, batch.cx[2] + g);
         const V y0 = hn::Load(d, batch.cy[0] + g), y1 = hn::Load(d, batch.cy[1] + g), y2 = hn::Load(d, batch.cy[2] + g);
         const V w0 = hn::Load(d, batch.cw[0] + g), w1 = hn::Load(d, batch.cw[1] + g), w2 = hn::Load(d, batch.cw[2] + g);
-        const M outside = hn::Or(behind, hn::Or(hn::Or(right, left), hn::Or(above, below)));
-        const M too_large = hn::Gt(extent, hn::Mul(limit, hn::Max(near, min_w)));
-        // homogeneous_det(v0, v1, v2), plus 0.0 as setup_clip_triangle sums it.
         const V det = hn::Add(zero, hn::Add(hn::Sub(hn::Mul(x0, hn::Sub(hn::Mul(y1, w2), hn::Mul(w1, y2))),
                                                     hn::Mul(y0, hn::Sub(hn::Mul(x1, w2), hn::Mul(w1, x2)))),
                                             hn::Mul(w0, hn::Sub(hn::Mul(x1, y2), hn::Mul(y1, x2)))));
         const M ccw = hn::Gt(det, zero);
         M away = hn::FirstN(d, 0);  // facing_away: nothing with Backface::none
-        if (in.backface == Backface::cw) away = hn::Not(ccw);
-        else if (in.backface == Backface::ccw) away = ccw;
+        if (backface == Backface::cw) away = hn::Not(ccw);
+        else if (backface == Backface::ccw) away = ccw;
 
         // The fates in unclipped_fate's order of precedence, each live lane in exactly one.
-        const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};  // lanes <= 8
+        const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};
         const M invalid = hn::And(live, hn::Not(hn::And(finite, hn::LoadMaskBits(d, index_bits))));
         const M valid = hn::AndNot(invalid, live);
         const M out = hn::And(valid, outside);
@@ -82,9 +141,7 @@ void ClassifyTriangleBatch(const TriangleInput& in, double near_w, int count, Tr
         stats.outside += hn::CountTrue(d, out);
         stats.degenerate += hn::CountTrue(d, degenerate);
         stats.backface_culled += hn::CountTrue(d, backfacing);
-        std::uint8_t setup_bits[8] = {};
-        hn::StoreMaskBits(d, hn::AndNot(hn::Or(hn::Or(invalid, out), hn::Or(degenerate, backfacing)), live), setup_bits);
-        batch.needs_setup |= std::uint32_t(setup_bits[0]) << g;
+        batch.needs_setup |= Bits(d, hn::AndNot(hn::Or(hn::Or(invalid, out), hn::Or(degenerate, backfacing)), live)) << g;
     }
 }
 
@@ -94,16 +151,23 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace homcull::detail {
 
-HWY_EXPORT(ClassifyTriangleBatch);
+HWY_EXPORT(TransformVertices);
+HWY_EXPORT(TransformBatch);
+HWY_EXPORT(ClassifyBatch);
 
 namespace {
-void dispatch_classify(const TriangleInput& in, double near_w, int count, TriangleBatch& batch, RasterStats& stats) {
-    HWY_DYNAMIC_DISPATCH(ClassifyTriangleBatch)(in, near_w, count, batch, stats);
+void dispatch_transform_vertices(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache) {
+    HWY_DYNAMIC_DISPATCH(TransformVertices)(in, near_w, begin, end, cache);
+}
+void dispatch_transform_batch(const TriangleInput& in, TriangleBatch& batch) { HWY_DYNAMIC_DISPATCH(TransformBatch)(in, batch); }
+void dispatch_classify(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
+    HWY_DYNAMIC_DISPATCH(ClassifyBatch)(backface, near_w, batch, stats);
 }
 }  // namespace
 
-ClassifyBatchKernel selected_classify_kernel() {
-    return scalar_reference_selected() ? &classify_triangle_batch_reference : &dispatch_classify;
+FrontEndKernels selected_front_end_kernels() {
+    if (scalar_reference_selected()) return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference};
+    return {&dispatch_transform_vertices, &dispatch_transform_batch, &dispatch_classify};
 }
 
 }  // namespace homcull::detail

@@ -38,6 +38,7 @@ struct PyramidLevel {
 struct RectQuery;
 struct SubtileView;
 struct RasterTarget;
+struct VertexClip;
 struct RasterTriangle;
 }  // namespace detail
 
@@ -252,14 +253,20 @@ private:
     // binned by bands of subtile rows; the same bits either way.
     detail::RasterTarget raster_target(int row_begin, int row_end);
     template <typename Emit>
-    void setup_for_raster(const TriangleInput& in, std::size_t begin, std::size_t end, RasterStats& stats, Emit&& emit) const;
-    void render_serial(const TriangleInput& in);
-    void render_binned(const TriangleInput& in, const ParallelFor& parallel);
+    void setup_for_raster(const TriangleInput& in, const detail::VertexClip* cache, std::size_t begin, std::size_t end, RasterStats& stats,
+                          Emit&& emit) const;
+    void render_serial(const TriangleInput& in, const detail::VertexClip* cache);
+    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache);
+    // Transforms an indexed input's vertices to clip space into the scratch below and points
+    // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
+    bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
 
-    // Render scratch, reused across frames.
+    // Render scratch, reused across frames (grown, never shrunk).
     struct Chunk;
     std::vector<Chunk> chunks_;
     std::vector<std::uint64_t> band_touched_;
+    std::vector<double> vertex_clip_;           // four planes of vertex_count + padding
+    std::vector<std::uint8_t> vertex_outcode_;
 
 public:
     ~OcclusionBuffer();
