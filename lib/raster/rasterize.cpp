@@ -44,19 +44,24 @@ std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_hei
 // magnitudes involved, that is less than 2^-21 (|a| + |dzdx| width + |dzdy| height); the
 // subtraction of `error` rounds by less than 2^-25 of the same; `error` = 2^-20 of it covers
 // both, plus the double rounding of a (2^-40 of its terms is far more than it needs).
-PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], double area2, int width, int height) {
-    const double dzdx = ((d[1] - d[0]) * (p[2].y - p[0].y) - (d[2] - d[0]) * (p[1].y - p[0].y)) / area2;
-    const double dzdy = ((d[2] - d[0]) * (p[1].x - p[0].x) - (d[1] - d[0]) * (p[2].x - p[0].x)) / area2;
-    const double a = d[0] - dzdx * p[0].x - dzdy * p[0].y;
-    const double magnitude = std::abs(a) + std::abs(dzdx) * width + std::abs(dzdy) * height;
-    const double error = 0x1.0p-20 * magnitude + 0x1.0p-40 * (std::abs(d[0]) + std::abs(dzdx * p[0].x) + std::abs(dzdy * p[0].y));
+DepthPlaneTerms depth_plane_terms(const glm::dvec2 p[3], const double d[3], double area2, int width, int height) {
+    DepthPlaneTerms t;
+    t.dzdx = ((d[1] - d[0]) * (p[2].y - p[0].y) - (d[2] - d[0]) * (p[1].y - p[0].y)) / area2;
+    t.dzdy = ((d[2] - d[0]) * (p[1].x - p[0].x) - (d[1] - d[0]) * (p[2].x - p[0].x)) / area2;
+    t.a = d[0] - t.dzdx * p[0].x - t.dzdy * p[0].y;
+    t.magnitude = std::abs(t.a) + std::abs(t.dzdx) * width + std::abs(t.dzdy) * height;
+    t.error = 0x1.0p-20 * t.magnitude + 0x1.0p-40 * (std::abs(d[0]) + std::abs(t.dzdx * p[0].x) + std::abs(t.dzdy * p[0].y));
+    return t;
+}
+
+PreparedTriangle finish_depth_plane(const DepthPlaneTerms& t, const double d[3]) {
     PreparedTriangle tri;
     tri.z_vertex_min = float_down(std::min({d[0], d[1], d[2]}));
-    if (std::isfinite(error) && magnitude < 0x1.0p100) {
-        tri.a = float(a);
-        tri.dzdx = float(dzdx);
-        tri.dzdy = float(dzdy);
-        tri.error = float_up(error);
+    if (std::isfinite(t.error) && t.magnitude < 0x1.0p100) {
+        tri.a = float(t.a);
+        tri.dzdx = float(t.dzdx);
+        tri.dzdy = float(t.dzdy);
+        tri.error = float_up(t.error);
         tri.has_plane = true;
     } else {  // a plane too steep for float (a sliver seen edge-on): the farthest vertex alone
         tri.a = tri.dzdx = tri.dzdy = tri.error = 0.0f;
@@ -65,6 +70,10 @@ PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], d
     tri.far_is_left = tri.dzdx > 0.0f;
     tri.far_is_top = tri.dzdy > 0.0f;
     return tri;
+}
+
+PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], double area2, int width, int height) {
+    return finish_depth_plane(depth_plane_terms(p, d, area2, width, height), d);
 }
 
 bool orient_triangle(const ScreenTriangle& tri, OrientedTriangle& out) {
@@ -115,7 +124,7 @@ bool setup_raster_triangle(const ScreenTriangle& triangle, double edge_margin, i
 
     out.edges = edge_functions(tri);
     for (int k = 0; k < 3; ++k)  // inner margin on silhouette edges (see the top of this file)
-        out.edges.threshold[k] = out.edges.shared[k] ? 0.0 : edge_margin * (std::abs(out.edges.sa[k]) + std::abs(out.edges.sb[k]));
+        out.edges.threshold[k] = edge_threshold(out.edges.shared[k], edge_margin, out.edges.sa[k], out.edges.sb[k]);
     out.plane = prepare_depth_plane(tri.v, tri.d, tri.area2, sample_width, sample_height);
     return true;
 }

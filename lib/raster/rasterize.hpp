@@ -75,6 +75,13 @@ struct PreparedTriangle {
 // The depth plane of a triangle with vertices p[k] and depths d[k] (counter-clockwise,
 // twice its area `area2` > 0), for a sample grid of width x height.
 PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], double area2, int width, int height);
+// prepare_depth_plane in two steps: the plane's double terms (which the SIMD setup repeats
+// lane by lane), then their float form.
+struct DepthPlaneTerms {
+    double dzdx, dzdy, a, magnitude, error;
+};
+DepthPlaneTerms depth_plane_terms(const glm::dvec2 p[3], const double d[3], double area2, int width, int height);
+PreparedTriangle finish_depth_plane(const DepthPlaneTerms& terms, const double d[3]);
 
 // The conservative depth a triangle enters a subtile with, given the column and row (in
 // samples) of the covered samples' corner where the plane is smallest: the plane lowered by
@@ -96,6 +103,12 @@ struct RasterTriangle {
     PreparedTriangle plane;
     int i0, i1, j0, j1;
 };
+
+// The coverage threshold of an edge with sign-normalized normal (sa, sb): an inner margin of
+// edge_margin samples (times the normal's L1 length) on a silhouette edge, none on a shared one.
+inline double edge_threshold(bool shared, double edge_margin, double sa, double sb) {
+    return shared ? 0.0 : edge_margin * (std::abs(sa) + std::abs(sb));
+}
 
 // Sets up a triangle of either orientation for a sample grid of width x height, with the inner
 // coverage margin edge_margin (samples) on its silhouette edges. False when it covers no

@@ -1,6 +1,8 @@
 #include "raster/triangle_batch.hpp"
 
+#include <cmath>
 #include <cstring>
+#include <utility>
 
 namespace homcull::detail {
 namespace {
@@ -128,8 +130,26 @@ void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch) {
         }
 }
 
+bool assemble_raster_triangle(const BatchSetup& s, int t, std::uint8_t shared_bits, double edge_margin, RasterTriangle& out) {
+    if (s.area2[t] == 0.0) return false;  // orient_triangle
+    out.i0 = s.i0[t], out.i1 = s.i1[t], out.j0 = s.j0[t], out.j1 = s.j1[t];
+    if (out.i0 > out.i1 || out.j0 > out.j1) return false;
+    bool shared[3] = {(shared_bits & 1u) != 0, (shared_bits & 2u) != 0, (shared_bits & 4u) != 0};
+    if ((s.flipped >> t) & 1u) std::swap(shared[0], shared[2]);  // edges 0->2, 2->1, 1->0 were edges 2, 1, 0
+    for (int k = 0; k < 3; ++k) {
+        out.edges.ox[k] = s.ox[k][t], out.edges.oy[k] = s.oy[k][t];
+        out.edges.sa[k] = s.sa[k][t], out.edges.sb[k] = s.sb[k][t], out.edges.inverse_sa[k] = s.inverse_sa[k][t];
+        out.edges.shared[k] = shared[k];
+        out.edges.threshold[k] = edge_threshold(shared[k], edge_margin, s.sa[k][t], s.sb[k][t]);
+    }
+    const double d[3] = {s.d[0][t], s.d[1][t], s.d[2][t]};
+    out.plane = finish_depth_plane({s.dzdx[t], s.dzdy[t], s.a[t], s.magnitude[t], s.error[t]}, d);
+    return true;
+}
+
 void classify_batch_reference(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
     batch.needs_setup = 0;
+    batch.simple = 0;  // the reference sets every triangle up with setup_clip_triangle
     for (int t = 0; t < batch.count; ++t) {
         const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
         const bool finite = finite_clip(clip[0]) && finite_clip(clip[1]) && finite_clip(clip[2]);

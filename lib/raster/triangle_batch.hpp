@@ -30,7 +30,8 @@ struct TriangleBatch {
     alignas(64) double px[3][kSize], py[3][kSize], pz[3][kSize], pw[3][kSize];  // per vertex k, per lane
     alignas(64) double cx[3][kSize], cy[3][kSize], cz[3][kSize], cw[3][kSize];
     std::uint32_t indices_valid = 0;  // bit t: lane t's three indices are below vertex_count
-    std::uint32_t needs_setup = 0;    // bit t: lane t goes on to setup_clip_triangle
+    std::uint32_t needs_setup = 0;    // bit t: lane t goes on to the one-triangle setup
+    std::uint32_t simple = 0;         // bit t: ... and needs no clipping: the SIMD kernels set it up (BatchSetup)
 
     // Vertex k of lane t in clip space, as fetch_clip_triangle gives it.
     glm::dvec4 clip(int t, int k) const { return {cx[k][t], cy[k][t], cz[k][t], cw[k][t]}; }
@@ -86,12 +87,32 @@ void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch);
 using ClassifyBatchKernel = void (*)(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats);
 void classify_batch_reference(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats);
 
+// The screen-space setup of a batch's unclipped triangles, lane by lane, as
+// setup_clip_triangle (projection to the sample grid) and setup_raster_triangle (orientation,
+// sample bounding box, edge functions, depth plane terms) compute it in double, before the
+// parts that depend on the edge flags or convert to float (assemble_raster_triangle).
+struct BatchSetup {
+    static constexpr int kSize = TriangleBatch::kSize;
+    alignas(64) double d[3][kSize];                              // vertex depths, counter-clockwise
+    alignas(64) double area2[kSize];                             // twice the area; 0: nothing to rasterize
+    alignas(64) double ox[3][kSize], oy[3][kSize], sa[3][kSize], sb[3][kSize], inverse_sa[3][kSize];
+    alignas(64) double dzdx[kSize], dzdy[kSize], a[kSize], magnitude[kSize], error[kSize];
+    alignas(64) std::int32_t i0[kSize], i1[kSize], j0[kSize], j1[kSize];
+    std::uint32_t flipped = 0;  // bit t: vertices 1 and 2 were swapped to orient the triangle
+};
+using SetupBatchKernel = void (*)(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& setup);
+
+// The RasterTriangle of simple lane t, as setup_raster_triangle makes it from the projected
+// triangle with edge flags `shared_bits`; false when it has no area or covers no sample's box.
+bool assemble_raster_triangle(const BatchSetup& setup, int t, std::uint8_t shared_bits, double edge_margin, RasterTriangle& out);
+
 // The reference or the SIMD kernels, following select_isa. Every kernel gives the same clip
 // coordinates, outcodes, counts and bits.
 struct FrontEndKernels {
     TransformVerticesKernel transform_vertices;
     TransformBatchKernel transform_batch;
     ClassifyBatchKernel classify;
+    SetupBatchKernel setup;  // null for the scalar reference, whose classify marks no lane simple
 };
 FrontEndKernels selected_front_end_kernels();
 
@@ -104,6 +125,7 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
                           double edge_margin, int sample_width, int sample_height, RasterStats& stats, Emit&& emit) {
     const FrontEndKernels kernels = selected_front_end_kernels();
     TriangleBatch batch{};  // zeroed: the last vector of a batch may read lanes past count
+    BatchSetup simple;
     for (std::size_t first = begin; first < end;) {
         if (cache) {
             first = gather_cached_batch(in, *cache, first, end, batch, stats);
@@ -115,12 +137,19 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             first += std::size_t(batch.count);
         }
         kernels.classify(in.backface, near_w, batch, stats);
+        if (batch.simple) kernels.setup(batch, sample_width, sample_height, simple);
         for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
             const int t = __builtin_ctz(bits);
-            const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
             const std::size_t index = batch.triangle[t];
-            const SetupResult setup = setup_clip_triangle(clip, in.shared_edges ? in.shared_edges[index] : 0, in.backface, near_w,
-                                                          sample_width, sample_height, stats);
+            const std::uint8_t shared = in.shared_edges ? in.shared_edges[index] : 0;
+            if ((batch.simple >> t) & 1u) {
+                ++stats.rasterized;  // what setup_clip_triangle counts for it
+                RasterTriangle tri;
+                if (assemble_raster_triangle(simple, t, shared, edge_margin, tri)) emit(tri);
+                continue;
+            }
+            const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
+            const SetupResult setup = setup_clip_triangle(clip, shared, in.backface, near_w, sample_width, sample_height, stats);
             for (int k = 0; k < setup.count; ++k) {
                 RasterTriangle tri;
                 if (setup_raster_triangle(setup.triangles[k], edge_margin, sample_width, sample_height, tri)) emit(tri);

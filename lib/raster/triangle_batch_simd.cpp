@@ -95,6 +95,7 @@ void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, Raste
     const V near = hn::Set(d, near_w), guard = hn::Set(d, kGuardBand), infinity = hn::Set(d, HUGE_VAL);
     const V zero = hn::Zero(d), limit = hn::Set(d, 0x1.0p28);
     batch.needs_setup = 0;
+    batch.simple = 0;
     for (int g = 0; g < batch.count; g += lanes) {
         const M live = hn::FirstN(d, std::size_t(batch.count - g));
         M finite = hn::FirstN(d, std::size_t(lanes)), behind = finite, right = finite, left = finite, above = finite,
@@ -142,6 +143,84 @@ void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, Raste
         stats.degenerate += hn::CountTrue(d, degenerate);
         stats.backface_culled += hn::CountTrue(d, backfacing);
         batch.needs_setup |= Bits(d, hn::AndNot(hn::Or(hn::Or(invalid, out), hn::Or(degenerate, backfacing)), live)) << g;
+        batch.simple |= Bits(d, hn::AndNot(hn::Or(degenerate, backfacing), open)) << g;
+    }
+}
+
+// setup_clip_triangle's projection of an unclipped triangle and setup_raster_triangle's double
+// work (orient_triangle, sample_span, edge_functions, depth_plane_terms), lane by lane with
+// the same operations in the same order.
+void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& out) {
+    const D d;
+    const hn::Rebind<std::int32_t, D> di;
+    const int lanes = int(hn::Lanes(d));
+    const V one = hn::Set(d, 1.0), half = hn::Set(d, 0.5), zero = hn::Zero(d), minus_one = hn::Set(d, -1.0);
+    const V width = hn::Set(d, double(sample_width)), height = hn::Set(d, double(sample_height));
+    out.flipped = 0;
+    for (int g = 0; g < batch.count; g += lanes) {
+        // Projection to the sample grid, depth 1/w. (No arrays of vectors: SVE vectors cannot
+        // be array elements.)
+        auto project = [&](int k, V& x, V& y, V& depth) {
+            const V inv_w = hn::Div(one, hn::Load(d, batch.cw[k] + g));
+            x = hn::Mul(hn::Mul(hn::Add(hn::Mul(hn::Load(d, batch.cx[k] + g), inv_w), one), half), width);
+            y = hn::Mul(hn::Mul(hn::Sub(one, hn::Mul(hn::Load(d, batch.cy[k] + g), inv_w)), half), height);
+            depth = inv_w;
+        };
+        V x0 = zero, y0 = zero, d0 = zero, px1 = zero, py1 = zero, pd1 = zero, px2 = zero, py2 = zero, pd2 = zero;
+        project(0, x0, y0, d0);
+        project(1, px1, py1, pd1);
+        project(2, px2, py2, pd2);
+        // orient_triangle: counter-clockwise, swapping vertices 1 and 2 when the area is negative.
+        const V area2 = hn::Sub(hn::Mul(hn::Sub(px1, x0), hn::Sub(py2, y0)), hn::Mul(hn::Sub(py1, y0), hn::Sub(px2, x0)));
+        const M flip = hn::Lt(area2, zero);
+        out.flipped |= Bits(d, flip) << g;
+        const V x1 = hn::IfThenElse(flip, px2, px1), x2 = hn::IfThenElse(flip, px1, px2);
+        const V y1 = hn::IfThenElse(flip, py2, py1), y2 = hn::IfThenElse(flip, py1, py2);
+        const V d1 = hn::IfThenElse(flip, pd2, pd1), d2 = hn::IfThenElse(flip, pd1, pd2);
+        const V area = hn::IfThenElse(flip, hn::Neg(area2), area2);
+        hn::Store(d0, d, out.d[0] + g), hn::Store(d1, d, out.d[1] + g), hn::Store(d2, d, out.d[2] + g);
+        hn::Store(area, d, out.area2 + g);
+
+        // sample_span of the bounding box (min and max are exact).
+        auto span = [&](V lo, V hi, V count, std::int32_t* first, std::int32_t* last) {
+            const V top = hn::Add(count, one);
+            lo = hn::Min(hn::Max(lo, minus_one), top);
+            hi = hn::Min(hn::Max(hi, minus_one), top);
+            hn::Store(hn::Max(hn::DemoteTo(di, hn::Ceil(hn::Sub(lo, half))), hn::Zero(di)), di, first + g);
+            hn::Store(hn::Min(hn::DemoteTo(di, hn::Floor(hn::Sub(hi, half))), hn::Sub(hn::DemoteTo(di, count), hn::Set(di, 1))), di,
+                      last + g);
+        };
+        span(hn::Min(hn::Min(x0, x1), x2), hn::Max(hn::Max(x0, x1), x2), width, out.i0, out.i1);
+        span(hn::Min(hn::Min(y0, y1), y2), hn::Max(hn::Max(y0, y1), y2), height, out.j0, out.j1);
+
+        // edge_functions: edge k from vertex k to vertex k + 1, measured from its lower end (by
+        // y, then x), its normal signed to be positive inside.
+        auto edge = [&](int k, V fx, V fy, V tx, V ty) {
+            const M vertical_order = hn::Ne(fy, ty);
+            const M forward = hn::Or(hn::And(vertical_order, hn::Lt(fy, ty)), hn::AndNot(vertical_order, hn::Lt(fx, tx)));
+            const V lo_x = hn::IfThenElse(forward, fx, tx), lo_y = hn::IfThenElse(forward, fy, ty);
+            const V hi_x = hn::IfThenElse(forward, tx, fx), hi_y = hn::IfThenElse(forward, ty, fy);
+            const V sign = hn::IfThenElse(forward, one, minus_one);
+            const V sa = hn::Mul(sign, hn::Neg(hn::Sub(hi_y, lo_y))), sb = hn::Mul(sign, hn::Sub(hi_x, lo_x));
+            hn::Store(lo_x, d, out.ox[k] + g);
+            hn::Store(lo_y, d, out.oy[k] + g);
+            hn::Store(sa, d, out.sa[k] + g);
+            hn::Store(sb, d, out.sb[k] + g);
+            hn::Store(hn::IfThenElse(hn::Eq(sa, zero), zero, hn::Div(one, sa)), d, out.inverse_sa[k] + g);
+        };
+        edge(0, x0, y0, x1, y1);
+        edge(1, x1, y1, x2, y2);
+        edge(2, x2, y2, x0, y0);
+
+        // depth_plane_terms.
+        const V dzdx = hn::Div(hn::Sub(hn::Mul(hn::Sub(d1, d0), hn::Sub(y2, y0)), hn::Mul(hn::Sub(d2, d0), hn::Sub(y1, y0))), area);
+        const V dzdy = hn::Div(hn::Sub(hn::Mul(hn::Sub(d2, d0), hn::Sub(x1, x0)), hn::Mul(hn::Sub(d1, d0), hn::Sub(x2, x0))), area);
+        const V a = hn::Sub(hn::Sub(d0, hn::Mul(dzdx, x0)), hn::Mul(dzdy, y0));
+        const V magnitude = hn::Add(hn::Add(hn::Abs(a), hn::Mul(hn::Abs(dzdx), width)), hn::Mul(hn::Abs(dzdy), height));
+        const V terms = hn::Add(hn::Add(hn::Abs(d0), hn::Abs(hn::Mul(dzdx, x0))), hn::Abs(hn::Mul(dzdy, y0)));
+        const V error = hn::Add(hn::Mul(hn::Set(d, 0x1.0p-20), magnitude), hn::Mul(hn::Set(d, 0x1.0p-40), terms));
+        hn::Store(dzdx, d, out.dzdx + g), hn::Store(dzdy, d, out.dzdy + g), hn::Store(a, d, out.a + g);
+        hn::Store(magnitude, d, out.magnitude + g), hn::Store(error, d, out.error + g);
     }
 }
 
@@ -154,6 +233,7 @@ namespace homcull::detail {
 HWY_EXPORT(TransformVertices);
 HWY_EXPORT(TransformBatch);
 HWY_EXPORT(ClassifyBatch);
+HWY_EXPORT(SetupBatch);
 
 namespace {
 void dispatch_transform_vertices(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache) {
@@ -163,11 +243,15 @@ void dispatch_transform_batch(const TriangleInput& in, TriangleBatch& batch) { H
 void dispatch_classify(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
     HWY_DYNAMIC_DISPATCH(ClassifyBatch)(backface, near_w, batch, stats);
 }
+void dispatch_setup(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& setup) {
+    HWY_DYNAMIC_DISPATCH(SetupBatch)(batch, sample_width, sample_height, setup);
+}
 }  // namespace
 
 FrontEndKernels selected_front_end_kernels() {
-    if (scalar_reference_selected()) return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference};
-    return {&dispatch_transform_vertices, &dispatch_transform_batch, &dispatch_classify};
+    if (scalar_reference_selected())
+        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr};
+    return {&dispatch_transform_vertices, &dispatch_transform_batch, &dispatch_classify, &dispatch_setup};
 }
 
 }  // namespace homcull::detail
