@@ -18,53 +18,103 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// The subtiles tx..tx + lanes - 1 of a row as vector lanes, float and 32-bit integer, at most 8
-// (4 on SSE4 and NEON; wider vectors are capped, and rows are padded for kMaxSimdLanes).
-HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
-                               const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
+// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2), the subtiles
+// tx..tx + columns - 1 of each row as vector lanes, float and 32-bit integer: at most 8 columns
+// (4 on SSE4 and NEON; rows are padded for kMaxSimdLanes). first and last hold the rows'
+// sample-row intervals, 4 per subtile row. Two rows at a time suit AVX-512's 16 lanes: S1's
+// triangles reach about 5 subtiles per row, and one row in 16 lanes was 10 % slower than in 8.
+// Whether this target may update two subtile rows per vector (AVX-512, and SVE when its
+// vectors are that wide); the scalar target has no half vectors.
+#undef HOMCULL_PAIR_ROWS
+#if HWY_TARGET == HWY_SCALAR
+#define HOMCULL_PAIR_ROWS 0
+#else
+#define HOMCULL_PAIR_ROWS 1
+#endif
+
+// A plane's elements of the lanes of UpdateSubtileRows: one vector from row offset row0, or
+// half a vector from each of row0 and row1.
+template <int kRows, class D, typename T>
+HWY_INLINE hn::Vec<D> LoadRows(D d, const T* plane, std::size_t row0, std::size_t row1, std::size_t tx) {
+#if HOMCULL_PAIR_ROWS
+    if constexpr (kRows == 2) {
+        const hn::Half<D> dh;
+        return hn::Combine(d, hn::LoadU(dh, plane + row1 + tx), hn::LoadU(dh, plane + row0 + tx));
+    }
+#endif
+    (void)row1;
+    return hn::LoadU(d, plane + row0 + tx);
+}
+template <int kRows, class D, typename T>
+HWY_INLINE void StoreRows(hn::Vec<D> v, D d, T* plane, std::size_t row0, std::size_t row1, std::size_t tx) {
+#if HOMCULL_PAIR_ROWS
+    if constexpr (kRows == 2) {
+        const hn::Half<D> dh;
+        hn::StoreU(hn::LowerHalf(dh, v), dh, plane + row0 + tx);
+        hn::StoreU(hn::UpperHalf(dh, v), dh, plane + row1 + tx);
+        return;
+    }
+#endif
+    (void)row1;
+    hn::StoreU(v, d, plane + row0 + tx);
+}
+
+template <int kRows>
+HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t* first,
+                                           const std::int32_t* last, const PreparedTriangle& tri, int sample_width, int sample_height) {
+    static_assert(kRows == 1 || kRows == 2, "one or two subtile rows");
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    // At most 8 subtiles per vector: S1's triangles reach about 5 subtiles per row, and 16-lane
-    // AVX-512 vectors were 10 % slower on S1 than 8-lane ones (same bits either way).
-    const hn::CappedTag<float, 8> df;
+    const hn::CappedTag<float, 8 * kRows> df;
     const hn::RebindToSigned<decltype(df)> di;
     const hn::RebindToUnsigned<decltype(df)> du;
-    const int lanes = int(hn::Lanes(df));
+    const int row_lanes = int(hn::Lanes(df)) / kRows;
     using VI = hn::Vec<decltype(di)>;
     using VU = hn::Vec<decltype(du)>;
     using VF = hn::Vec<decltype(df)>;
 
-    // The valid-sample mask of this row's subtiles (see valid_sample_mask): all ones except in
+    // Highway's Iota goes through memory (a store-forwarding stall per call): built once.
+    const VI lane = hn::Iota(di, 0);
+    const VI lane_column = kRows == 1 ? lane : hn::And(lane, hn::Set(di, row_lanes - 1));
+    const auto second_row = hn::Gt(lane, hn::Set(di, kRows == 1 ? 1 << 30 : row_lanes - 1));  // lanes of row ty + 1
+    // A value per lane from its row's: a for row ty, b for row ty + 1.
+    const auto per_row = [&](std::int32_t a, std::int32_t b) {
+        return kRows == 1 ? hn::Set(di, a) : hn::IfThenElse(second_row, hn::Set(di, b), hn::Set(di, a));
+    };
+
+    // The valid-sample mask of each row's subtiles (see valid_sample_mask): all ones except in
     // the last column and the last row of subtiles, as (row bits of the lane's columns) x
     // (one bit per existing row).
-    const int rows = std::min(kH, sample_height - ty * kH);
-    std::uint32_t replicate = 0;
-    for (int j = 0; j < rows; ++j) replicate |= 1u << (j * kW);
+    std::uint32_t replicate[2] = {0, 0};
+    for (int r = 0; r < kRows; ++r)
+        for (int j = 0; j < std::min(kH, sample_height - (ty + r) * kH); ++j) replicate[r] |= 1u << (j * kW);
+    const VU replicate_v = hn::BitCast(du, per_row(std::int32_t(replicate[0]), std::int32_t(replicate[kRows - 1])));
+    const VI row_y = per_row(ty * kH, (ty + kRows - 1) * kH);
 
     // Per sample row j: its interval, broadcast in the row loop below (SVE vectors are sizeless
     // and cannot be array elements). Local copies: the stores to the planes cannot alias them.
-    std::int32_t first_l[kH], last_l[kH];
-    for (int j = 0; j < kH; ++j) {
+    std::int32_t first_l[2 * kH], last_l[2 * kH];
+    for (int j = 0; j < kRows * kH; ++j) {
         first_l[j] = first[j];
         last_l[j] = last[j];
     }
+    const std::size_t row0 = std::size_t(ty) * planes.stride, row1 = std::size_t(ty + kRows - 1) * planes.stride;
+    const auto load = [&](auto d, const auto* plane, std::size_t tx) { return LoadRows<kRows>(d, plane, row0, row1, tx); };
+    const auto store = [&](auto v, auto d, auto* plane, std::size_t tx) { StoreRows<kRows>(v, d, plane, row0, row1, tx); };
     const VI zero_i = hn::Zero(di), seven = hn::Set(di, kW - 1), eight = hn::Set(di, kW);
     const VU byte = hn::Set(du, 0xFFu);
     const VF a = hn::Set(df, tri.a), dzdx = hn::Set(df, tri.dzdx), dzdy = hn::Set(df, tri.dzdy), error = hn::Set(df, tri.error);
     const VF z_vertex_min = hn::Set(df, tri.z_vertex_min), half = hn::Set(df, 0.5f), lower = hn::Set(df, 1.0f - 0x1.0p-20f);
 
-    // Highway's Iota goes through memory (a store-forwarding stall per call): built once.
-    const VI lane = hn::Iota(di, 0);
     std::uint64_t touched = 0;
-    const std::size_t row = std::size_t(ty) * planes.stride;
-    for (int tx = tx_begin; tx <= tx_end; tx += lanes) {
-        const VI column0 = hn::ShiftLeft<3>(hn::Add(lane, hn::Set(di, tx)));  // tx * 8 per lane
+    for (int tx = tx_begin; tx <= tx_end; tx += row_lanes) {
+        const VI column0 = hn::ShiftLeft<3>(hn::Add(lane_column, hn::Set(di, tx)));  // tx * 8 per lane
 
         // Mask and far corner, as the reference (lanes past tx_end get empty masks).
         VU m = hn::Zero(du);
         VI far_column = tri.far_is_left ? eight : hn::Set(di, -1), far_row = hn::Set(di, kH);
         for (int j = 0; j < kH; ++j) {
-            const VI lo = hn::Max(hn::Sub(hn::Set(di, first_l[j]), column0), zero_i);
-            const VI hi = hn::Min(hn::Sub(hn::Set(di, last_l[j]), column0), seven);
+            const VI lo = hn::Max(hn::Sub(per_row(first_l[j], first_l[(kRows - 1) * kH + j]), column0), zero_i);
+            const VI hi = hn::Min(hn::Sub(per_row(last_l[j], last_l[(kRows - 1) * kH + j]), column0), seven);
             const auto empty = hn::Gt(lo, hi);
             // Shift counts clamped to [0, 8]: only lanes with lo <= hi (both in [0, 7]) are kept.
             const VU lo_u = hn::BitCast(du, hn::Min(lo, eight));
@@ -80,14 +130,14 @@ HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, i
         if (hn::AllFalse(du, active)) continue;
         touched += hn::CountTrue(du, active);
 
-        const std::size_t i = row + std::size_t(tx);
-        VF d0 = hn::LoadU(df, planes.d0 + i), d1 = hn::LoadU(df, planes.d1 + i);
-        VU mask = hn::LoadU(du, planes.mask + i);
-        hn::StoreU(hn::Or(hn::LoadU(du, planes.covered + i), m), du, planes.covered + i);
+        const std::size_t i = std::size_t(tx);
+        VF d0 = load(df, planes.d0, i), d1 = load(df, planes.d1, i);
+        VU mask = load(du, planes.mask, i);
+        store(hn::Or(load(du, planes.covered, i), m), du, planes.covered, i);
 
         // conservative_depth, lane by lane.
         const VF x = hn::Add(hn::ConvertTo(df, hn::Add(column0, far_column)), half);
-        const VF y = hn::Add(hn::ConvertTo(df, hn::Add(hn::Set(di, ty * kH), far_row)), half);
+        const VF y = hn::Add(hn::ConvertTo(df, hn::Add(row_y, far_row)), half);
         const VF plane = hn::Add(hn::Add(a, hn::Mul(dzdy, y)), hn::Mul(dzdx, x));
         const VF lowered = hn::Sub(plane, error);
         const VF bound = hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered);  // std::max(lowered, z_vertex_min)
@@ -104,15 +154,15 @@ HWY_INLINE std::uint64_t UpdateSubtileRow(const SubtilePlanes& planes, int ty, i
         VU mask_new = hn::Or(kept, m);
         const VI columns = hn::Min(hn::Sub(hn::Set(di, sample_width), column0), eight);
         const VU row_bits = hn::Shr(byte, hn::BitCast(du, hn::Max(hn::Sub(eight, columns), zero_i)));
-        const VU full = hn::Mul(row_bits, hn::Set(du, replicate));
+        const VU full = hn::Mul(row_bits, replicate_v);
         const auto promote = hn::RebindMask(df, hn::Eq(mask_new, full));
         const VF d0_new = hn::IfThenElse(promote, d1_new, d0);
         mask_new = hn::IfThenZeroElse(hn::RebindMask(du, promote), mask_new);
         d1_new = hn::IfThenZeroElse(promote, d1_new);
 
-        hn::StoreU(hn::IfThenElse(update, d0_new, d0), df, planes.d0 + i);
-        hn::StoreU(hn::IfThenElse(update, d1_new, d1), df, planes.d1 + i);
-        hn::StoreU(hn::IfThenElse(hn::RebindMask(du, update), mask_new, mask), du, planes.mask + i);
+        store(hn::IfThenElse(update, d0_new, d0), df, planes.d0, i);
+        store(hn::IfThenElse(update, d1_new, d1), df, planes.d1, i);
+        store(hn::IfThenElse(hn::RebindMask(du, update), mask_new, mask), du, planes.mask, i);
     }
     return touched;
 }
@@ -139,6 +189,9 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     const auto lane = hn::Iota(d, 0.0);  // once: Highway's Iota goes through memory
 
     constexpr int kChunkSubtileRows = 16, kChunkRows = kChunkSubtileRows * kH;
+#if HOMCULL_PAIR_ROWS
+    const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
+#endif
     HWY_ALIGN std::int32_t first[kChunkRows + 8], last[kChunkRows + 8];  // + 8: the last vector may pass the chunk's rows
     std::uint64_t touched = 0;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
@@ -165,13 +218,33 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             hn::StoreU(hn::DemoteTo(di, lo), di, first + r);
             hn::StoreU(hn::DemoteTo(di, hi), di, last + r);
         }
-        for (int ty = ty0; ty <= ty1; ++ty) {
+        for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
             int tx_begin, tx_end;
-            if (!reached_subtile_columns(row_first, row_last, i0, i1, tx_begin, tx_end)) continue;
-            touched += UpdateSubtileRow(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width, t.sample_height);
-            if (t.planes.sample_depth) update_sample_depth(t.planes, ty, row_first, row_last, tri);
+            const bool reached = reached_subtile_columns(row_first, row_last, i0, i1, tx_begin, tx_end);
+            // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
+#if HOMCULL_PAIR_ROWS
+            {
+                int next_begin, next_end;
+                if (pair_rows && ty < ty1 && reached_subtile_columns(row_first + kH, row_last + kH, i0, i1, next_begin, next_end)) {
+                    if (!reached) tx_begin = next_begin, tx_end = next_end;
+                    touched += UpdateSubtileRows<2>(t.planes, ty, std::min(tx_begin, next_begin), std::max(tx_end, next_end), row_first,
+                                                    row_last, tri, t.sample_width, t.sample_height);
+                    if (t.planes.sample_depth) {
+                        update_sample_depth(t.planes, ty, row_first, row_last, tri);
+                        update_sample_depth(t.planes, ty + 1, row_first + kH, row_last + kH, tri);
+                    }
+                    ty += 2;
+                    continue;
+                }
+            }
+#endif
+            if (reached) {
+                touched += UpdateSubtileRows<1>(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width, t.sample_height);
+                if (t.planes.sample_depth) update_sample_depth(t.planes, ty, row_first, row_last, tri);
+            }
+            ++ty;
         }
     }
     return touched;
