@@ -157,7 +157,7 @@ TEST(VisibilityGrid, MalformedFilesAreClearErrors) {
     }
 }
 
-TEST(VisibilityGrid, BakedRankingPutsTheListedOccludersFirst) {
+TEST(VisibilityGrid, BakedRankingOrdersByExpectedHiddenPerTriangle) {
     const Scene scene = generate_scene("city:seed=2,blocks=4");
     const RayScene rays(scene);
     const BakeOptions options = city_bake(scene);
@@ -172,26 +172,32 @@ TEST(VisibilityGrid, BakedRankingPutsTheListedOccludersFirst) {
     OccluderBudget budget{OccluderRanking::baked, 0, &grid};
     rank_occluders(scene, options.candidates, camera, 16.0 / 9.0, budget, chosen, scratch);
     ASSERT_FALSE(chosen.empty());
-    // Listed occluders (score > 0) first, by score per triangle; then the others.
-    bool unlisted_seen = false;
+    // Listed and unlisted candidates in one order: by the point's score plus 2 per square
+    // radian of (box diagonal / distance), per triangle, decreasing.
+    bool listed_after_unlisted = false, unlisted_seen = false;
     double last = 1e300;
     for (std::uint32_t id : chosen) {
+        const Aabb& box = scene.objects[id].world_bounds;
+        const glm::dvec3 nearest = glm::clamp(camera.eye, glm::dvec3(box.min), glm::dvec3(box.max));
+        const double distance = std::max(glm::length(camera.eye - nearest), camera.near_plane);
+        const double diagonal = glm::length(glm::dvec3(box.extent()));
         const std::uint32_t score = grid.score(*point, id);
-        if (score == 0) {
-            unlisted_seen = true;
-            continue;
-        }
-        EXPECT_FALSE(unlisted_seen) << "object " << id << " is listed but ranked after an unlisted one";
-        const double density = double(score) / double(scene.triangle_count(scene.objects[id]));
-        EXPECT_LE(density, last * (1.0 + 1e-6));
+        const double hidden = double(score) + 2.0 * diagonal * diagonal / (distance * distance);
+        const double density = hidden / double(scene.triangle_count(scene.objects[id]));
+        EXPECT_LE(density, last * (1.0 + 1e-5)) << "object " << id;
         last = density;
+        listed_after_unlisted |= score > 0 && unlisted_seen;
+        unlisted_seen |= score == 0;
     }
+    // The order mixes them here (it did not when listed candidates always came first).
+    EXPECT_TRUE(listed_after_unlisted);
     budget.grid = nullptr;
     EXPECT_THROW(rank_occluders(scene, options.candidates, camera, 16.0 / 9.0, budget, chosen, scratch), Error);
 }
 
 // The check of issue 5: on a castle walkthrough, the baked ranking culls more than distance
-// ranking under the same occluder triangle budget, and neither culls anything visible.
+// ranking under the same occluder triangle budget, and neither culls anything visible. At
+// 4,000 triangles the two tied while every listed occluder came before every unlisted one.
 TEST(VisibilityGrid, BakedRankingBeatsDistanceOnTheCastle) {
     const std::string file = test::shared_scene("intel_castle.glb");
     if (file.empty()) GTEST_SKIP() << "intel_castle.glb is not in " << test::shared_scenes_dir();
@@ -205,30 +211,36 @@ TEST(VisibilityGrid, BakedRankingBeatsDistanceOnTheCastle) {
     walk.frames = 120;
     walk.seed = 7;
     const CameraPath path = walk_path(rays, scene, walk);
-    SceneCullerConfig config;
-    config.display = {640, 360};
-    config.occluder_budget = {OccluderRanking::distance, 10000, nullptr};
-    SceneCuller by_distance(scene, options.candidates, config);
-    config.occluder_budget = {OccluderRanking::baked, 10000, &grid};
-    SceneCuller baked(scene, options.candidates, config);
     TruthOptions truth_options;
-    truth_options.resolution = config.display;
-    std::size_t hidden = 0, culled_by_distance = 0, culled_baked = 0, false_culls = 0;
-    std::vector<OccludeeAnswer> answers;
-    for (std::size_t k = 0; k < path.frames.size(); k += 4) {
-        const TruthResult truth = compute_ground_truth(rays, scene, path.frames[k], truth_options);
-        const WalkFrame d = measure_walk_frame(scene, by_distance, path.frames[k], &truth, answers);
-        const WalkFrame b = measure_walk_frame(scene, baked, path.frames[k], &truth, answers);
-        hidden += d.hidden_in_frustum;
-        culled_by_distance += d.hidden_in_frustum - d.missed_culls;
-        culled_baked += b.hidden_in_frustum - b.missed_culls;
-        false_culls += d.false_culls + b.false_culls;
-        EXPECT_LE(b.work.occluder_triangles, 10000u);
+    truth_options.resolution = {640, 360};
+    std::vector<TruthResult> truths;
+    for (std::size_t k = 0; k < path.frames.size(); k += 4)
+        truths.push_back(compute_ground_truth(rays, scene, path.frames[k], truth_options));
+    for (const std::size_t triangles : {std::size_t(4000), std::size_t(10000)}) {
+        SceneCullerConfig config;
+        config.display = truth_options.resolution;
+        config.occluder_budget = {OccluderRanking::distance, triangles, nullptr};
+        SceneCuller by_distance(scene, options.candidates, config);
+        config.occluder_budget = {OccluderRanking::baked, triangles, &grid};
+        SceneCuller baked(scene, options.candidates, config);
+        std::size_t hidden = 0, culled_by_distance = 0, culled_baked = 0, false_culls = 0;
+        std::vector<OccludeeAnswer> answers;
+        for (std::size_t k = 0; k < path.frames.size(); k += 4) {
+            const TruthResult& truth = truths[k / 4];
+            const WalkFrame d = measure_walk_frame(scene, by_distance, path.frames[k], &truth, answers);
+            const WalkFrame b = measure_walk_frame(scene, baked, path.frames[k], &truth, answers);
+            hidden += d.hidden_in_frustum;
+            culled_by_distance += d.hidden_in_frustum - d.missed_culls;
+            culled_baked += b.hidden_in_frustum - b.missed_culls;
+            false_culls += d.false_culls + b.false_culls;
+            EXPECT_LE(b.work.occluder_triangles, triangles);
+        }
+        std::printf("[ baked    ] castle, %zu occluder triangles: distance culls %zu, baked %zu of %zu hidden\n", triangles,
+                    culled_by_distance, culled_baked, hidden);
+        EXPECT_EQ(false_culls, 0u) << triangles << " triangles";
+        // At least 2 % of the hidden objects more (the tie was within 0.1 %).
+        EXPECT_GT(culled_baked, culled_by_distance + hidden / 50) << triangles << " triangles";
     }
-    std::printf("[ baked    ] castle, 10,000 occluder triangles: distance culls %zu, baked %zu of %zu hidden\n", culled_by_distance,
-                culled_baked, hidden);
-    EXPECT_EQ(false_culls, 0u);
-    EXPECT_GT(culled_baked, culled_by_distance);
 }
 
 }  // namespace

@@ -57,6 +57,25 @@ double distance_to_box(const glm::dvec3& p, const Aabb& box) {
     return glm::length(p - nearest);
 }
 
+// Projected size of a box, a square angle: (box diagonal / distance)^2.
+double projected_size(const Aabb& box, double distance) {
+    const double diagonal = glm::length(glm::dvec3(box.extent()));
+    return (diagonal * diagonal) / (distance * distance);
+}
+
+// The hidden objects credited to an occluder whose box diagonal subtends one radian, on top of
+// its baked score. The grid's rays are a few degrees apart (4,096 over the sphere), so the
+// scores are small counts (mostly 1 to 4 on the castle) and many occluders that do hide
+// something from the eye score 0. Projected size fills that gap. On the castle's walks, 1 to 4
+// do about equally well; more lets size outweigh the grid.
+constexpr double kHiddenPerSquareRadian = 2.0;
+
+// Baked ranking's estimate of the objects an occluder hides from the eye: its score at the
+// grid point plus a share for its projected size (the size area ranking uses).
+double expected_hidden(std::uint32_t score, const Aabb& box, double distance) {
+    return double(score) + kHiddenPerSquareRadian * projected_size(box, distance);
+}
+
 }  // namespace
 
 void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candidates, const Camera& camera, double aspect,
@@ -75,13 +94,14 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
         const double distance = std::max(distance_to_box(camera.eye, box), camera.near_plane);
         double key = distance;
         if (budget.ranking == OccluderRanking::area) {
-            const double diagonal = glm::length(glm::dvec3(box.extent()));
-            key = -(diagonal * diagonal) / (distance * distance);
+            key = -projected_size(box, distance);
         } else if (point) {
-            // Listed occluders first, by decreasing score per triangle drawn (the most hidden for
-            // the budget; negative keys), then the rest by distance.
-            if (const std::uint32_t score = budget.grid->score(*point, id))
-                key = -double(score) / double(occluder_triangles_drawn(scene, id, camera, lods));
+            // One order for all candidates, by decreasing expected hidden objects per triangle
+            // drawn (the greedy knapsack order; negative keys). Putting every listed occluder
+            // before every unlisted one spent half a 4,000-triangle budget on a gate that scored
+            // 1 for 1,968 triangles, ahead of small walls next to the eye that scored 0.
+            const double hidden = expected_hidden(budget.grid->score(*point, id), box, distance);
+            key = -hidden / double(std::max<std::size_t>(occluder_triangles_drawn(scene, id, camera, lods), 1));
         }
         scratch.emplace_back(float(key), id);
     }

@@ -39,9 +39,11 @@ enum class OccluderRanking : std::uint8_t {
     none,      // every candidate, every frame (no per-frame work)
     distance,  // nearest box first (Zhang's distance-based selection under a polygon budget)
     area,      // largest projected size first: box diagonal over distance, squared
-    baked,     // the visibility grid's point nearest to the eye (Zhang 7.5): the occluders it
-               // lists by score per triangle (greedy knapsack order: the most hidden for the
-               // budget), then the candidates it does not list, nearest first
+    baked,     // the visibility grid's point nearest to the eye (Zhang 7.5): by expected hidden
+               // objects per triangle drawn (greedy knapsack order: the most hidden for the
+               // budget), the expectation being the point's score plus a share for the
+               // projected size (box diagonal / distance)^2, which ranks the occluders the
+               // point does not list
 };
 
 struct OccluderBudget {
