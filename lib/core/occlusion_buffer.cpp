@@ -12,7 +12,7 @@ namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 constexpr std::size_t kChunkTriangles = 2048;  // triangles set up per task
-constexpr int kBandSubtileRows = 8;           // subtile rows rasterized per task (32 sample rows)
+constexpr int kBandSubtileRows = 16;          // subtile rows rasterized per task (64 sample rows)
 
 }  // namespace
 
