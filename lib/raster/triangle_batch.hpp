@@ -4,8 +4,10 @@
 // the frustum, degenerate, backfacing). Most of an engine's occluder triangles end there
 // (30,000 of the castle's 48,700 are outside view C0, 10,000 more face away), so SIMD kernels
 // (triangle_batch_simd.cpp) decide them in double lanes, several triangles per instruction,
-// as Intel's MOC does for its setup. The triangles left go to setup_clip_triangle one by one,
-// with clip coordinates bit-identical to fetch_clip_triangle's.
+// as Intel's MOC does for its setup. The triangles left that need no clipping (nearly all) are
+// then projected and set up in lanes as well (BatchSetup); those that cross the near plane or
+// the guard band go to setup_clip_triangle one by one. Clip coordinates, statistics and the
+// rasterized triangles are bit-identical to the one-triangle path's on every target.
 //
 // Indexed meshes share each vertex among about six triangles, so for them every vertex is
 // transformed once per render into a VertexClip cache with its frustum outcode, and a
