@@ -19,8 +19,10 @@ namespace homcull {
 namespace {
 
 void report(const char* what, const CullingTally& t) {
-    std::printf("[ culling  ] %s: %d views, %zu visible objects, %zu false culls, culled %zu of %zu hidden (%.1f %%)\n", what,
-                t.views, t.visible, t.false_culls, t.culled_hidden, t.hidden_in_frustum, 100.0 * t.efficiency());
+    std::printf("[ culling  ] %s: %d views, %zu visible objects, %zu false culls, culled %zu of %zu hidden (%.1f %%; "
+                "%zu hidden only through ties, %.1f %% of those hidden outright)\n",
+                what, t.views, t.visible, t.false_culls, t.culled_hidden, t.hidden_in_frustum, 100.0 * t.efficiency(),
+                t.hidden_through_ties, 100.0 * t.robust_efficiency());
     for (const std::string& line : t.false_cull_reports) ADD_FAILURE() << "false cull: " << line;
 }
 
@@ -133,6 +135,9 @@ TEST(CullingVsTruth, SharedScenesAlongWalksHaveNoFalseCulls) {
         report(file, tally);
         EXPECT_EQ(tally.false_culls, 0u) << file;
         EXPECT_GE(tally.efficiency(), floor) << file << ": culling efficiency regressed";
+        // Over the objects hidden outright (no tie could show them), issue 4's 95 % holds on
+        // every scene, the house included.
+        EXPECT_GE(tally.robust_efficiency(), 0.95) << file;
     }
     if (found == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
 }

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 namespace homcull {
 namespace {
 
@@ -114,6 +116,35 @@ TEST(GroundTruth, CoincidentSurfacesAreVisibleButNotRobust) {
     EXPECT_GT(r.objects[c].visible_samples, 0u);
     EXPECT_EQ(r.objects[c].robust_samples, r.objects[c].visible_samples);
     EXPECT_EQ(r.objects[d].visible_samples, 0u);
+    // Tie samples: at every sample of the two coincident quads, the one not hit lies in the
+    // hit's window; d is hidden outright (no tie samples), and c's hits have no tie.
+    EXPECT_EQ(r.objects[a].tie_samples + r.objects[b].tie_samples, r.objects[a].visible_samples + r.objects[b].visible_samples);
+    EXPECT_EQ(r.objects[c].tie_samples, 0u);
+    EXPECT_EQ(r.objects[d].tie_samples, 0u);
+}
+
+// A quad seen nowhere because a coincident one wins every tie is hidden only through ties: it
+// has tie samples, which tell it apart from a quad hidden outright.
+TEST(GroundTruth, AnObjectHiddenOnlyThroughTiesHasTieSamples) {
+    Scene scene;
+    const auto big = add_quad(scene, "big", {-1, -1, -3}, {1, -1, -3}, {1, 1, -3}, {-1, 1, -3});
+    const auto behind = add_quad(scene, "behind", {-0.5f, -0.5f, -4}, {0.5f, -0.5f, -4}, {0.5f, 0.5f, -4}, {-0.5f, 0.5f, -4});
+    // Up to four coincident copies of a small quad inside the big one's area: each sample of it
+    // hits one of the five surfaces; the others at that sample are its ties.
+    std::vector<std::uint32_t> copies;
+    for (int k = 0; k < 4; ++k)
+        copies.push_back(add_quad(scene, "copy", {-0.25f, -0.25f, -3}, {0.25f, -0.25f, -3}, {0.25f, 0.25f, -3}, {-0.25f, 0.25f, -3}));
+    const TruthResult r = cast(scene, camera_down_minus_z(90.0), {64, 64});
+    EXPECT_GT(r.objects[big].visible_samples, 0u);  // alone around the copies
+    EXPECT_EQ(r.objects[behind].visible_samples, 0u);
+    EXPECT_EQ(r.objects[behind].tie_samples, 0u);
+    int hidden_copies = 0;
+    for (std::uint32_t c : copies) {
+        if (r.objects[c].visible_samples > 0) continue;
+        ++hidden_copies;
+        EXPECT_GT(r.objects[c].tie_samples, 0u) << "copy " << c << " is hidden, but only through ties";
+    }
+    EXPECT_GE(hidden_copies, 1);  // five coincident surfaces: most lose every tie
 }
 
 TEST(GroundTruth, ObjectsOutsideTheFrustumAreNotInIt) {

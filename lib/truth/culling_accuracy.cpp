@@ -38,6 +38,10 @@ void tally_answers(const Scene& scene, const TruthResult& truth, const std::vect
         } else if (t.in_frustum) {
             ++tally.hidden_in_frustum;
             tally.culled_hidden += answer != Visibility::visible;
+            if (t.tie_samples > 0) {
+                ++tally.hidden_through_ties;
+                tally.culled_through_ties += answer != Visibility::visible;
+            }
         }
     }
 }

@@ -10,6 +10,7 @@
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -21,11 +22,32 @@ constexpr int kPacket = 8;  // rtcIntersect8: 8 consecutive samples of one row
 constexpr std::uint32_t kNone = RTC_INVALID_GEOMETRY_ID;
 static_assert(kNone == kNoObject, "sample ids hand Embree's 'no geometry' on as kNoObject");
 
-// Tie check: a hit of the ray's own object (stored in the ray id) does not count.
-void reject_same_object(const RTCFilterFunctionNArguments* args) {
+// The tie check of a packet: which other objects lie within each ray's tie window. The ray
+// id holds the ray's lane in the packet; hits of the lane's own object do not count.
+constexpr int kMaxTies = 4;  // distinct other objects recorded per sample (more are counted as a tie, not named)
+struct TieContext {
+    RTCIntersectContext base;  // first: Embree hands the filter a pointer to it
+    std::uint32_t hit_object[kPacket];
+    std::uint32_t tied[kPacket][kMaxTies];
+    int tie_count[kPacket];
+};
+
+// Records every other object's hit in the window and rejects it, so that traversal goes on to
+// find them all.
+void record_ties(const RTCFilterFunctionNArguments* args) {
+    auto* context = reinterpret_cast<TieContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0) continue;
-        if (RTCHitN_geomID(args->hit, args->N, i) == RTCRayN_id(args->ray, args->N, i)) args->valid[i] = 0;
+        args->valid[i] = 0;
+        const unsigned lane = RTCRayN_id(args->ray, args->N, i);
+        const std::uint32_t object = RTCHitN_geomID(args->hit, args->N, i);
+        if (lane >= unsigned(kPacket) || object == context->hit_object[lane]) continue;
+        int& count = context->tie_count[lane];
+        bool known = false;
+        for (int k = 0; k < std::min(count, kMaxTies); ++k) known = known || context->tied[lane][k] == object;
+        if (known) continue;
+        if (count < kMaxTies) context->tied[lane][count] = object;
+        ++count;
     }
 }
 
@@ -58,13 +80,15 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
     std::vector<std::uint32_t> ids(std::size_t(width) * std::size_t(height), kNone);
     std::vector<std::uint8_t> tied(ids.size(), 0);
     std::atomic<std::uint64_t> tie_rays{0};
+    // Per object: samples at which it lies in another object's tie window (summed over tiles).
+    std::vector<std::atomic<std::uint64_t>> tie_samples(scene.objects.size());
 
     tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 8, 0, width, 64), [&](const tbb::blocked_range2d<int>& tile) {
         RTCIntersectContext primary;
         rtcInitIntersectContext(&primary);
-        RTCIntersectContext tie_check;
-        rtcInitIntersectContext(&tie_check);
-        tie_check.filter = reject_same_object;
+        TieContext tie_check;
+        rtcInitIntersectContext(&tie_check.base);
+        tie_check.base.filter = record_ties;
         std::uint64_t local_tie_rays = 0;
 
         for (int y = tile.rows().begin(); y < tile.rows().end(); ++y) {
@@ -112,18 +136,22 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
                     tie.tfar[k] = rh.ray.tfar[k] * tie_hi;
                     tie.time[k] = 0.0f;
                     tie.mask[k] = 0xFFFFFFFFu;
-                    tie.id[k] = hit ? rh.hit.geomID[k] : kNone;
+                    tie.id[k] = unsigned(k);
                     tie.flags[k] = 0;
+                    tie_check.hit_object[k] = hit ? rh.hit.geomID[k] : kNone;
+                    tie_check.tie_count[k] = 0;
                 }
                 if (any) {
-                    rtcOccluded8(tie_valid, rtc, &tie_check, &tie);
+                    rtcOccluded8(tie_valid, rtc, &tie_check.base, &tie);
                     for (int k = 0; k < kPacket; ++k) local_tie_rays += tie_valid[k] != 0;
                 }
                 const std::size_t row = std::size_t(y) * std::size_t(width);
                 for (int k = 0; k < kPacket && x0 + k < tile.cols().end(); ++k) {
                     ids[row + std::size_t(x0 + k)] = rh.hit.geomID[k];
-                    // rtcOccluded8 sets tfar to -inf for rays that hit something.
-                    tied[row + std::size_t(x0 + k)] = tie_valid[k] != 0 && tie.tfar[k] == -INFINITY;
+                    tied[row + std::size_t(x0 + k)] = tie_valid[k] != 0 && tie_check.tie_count[k] > 0;
+                    if (tie_valid[k] == 0) continue;
+                    for (int n = 0; n < std::min(tie_check.tie_count[k], kMaxTies); ++n)
+                        tie_samples[tie_check.tied[k][n]].fetch_add(1, std::memory_order_relaxed);
                 }
             }
         }
@@ -140,6 +168,7 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
         ++v.visible_samples;
         v.robust_samples += tied[i] == 0;
     }
+    for (std::size_t id = 0; id < scene.objects.size(); ++id) result.objects[id].tie_samples = tie_samples[id].load();
     const Frustum frustum = make_frustum(camera, aspect);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.objects.size()), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i < r.end(); ++i)

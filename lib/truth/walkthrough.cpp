@@ -36,6 +36,8 @@ WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Came
         } else if (t.in_frustum) {
             f.hidden_in_frustum += 1;
             f.missed_culls += kept;
+            f.hidden_through_ties += t.tie_samples > 0;
+            f.missed_through_ties += kept && t.tie_samples > 0;
         }
     }
     return f;

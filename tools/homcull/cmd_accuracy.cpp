@@ -65,7 +65,9 @@ void run_scene_accuracy(const Options& o) {
                                           {"visible", tally.visible}, {"hidden_in_frustum", tally.hidden_in_frustum},
                                           {"culled_hidden", tally.culled_hidden}, {"missed_culls", tally.missed_culls()},
                                           {"false_culls", tally.false_culls}, {"robust_false_culls", tally.robust_false_culls},
-                                          {"efficiency", tally.efficiency()}, {"false_cull_reports", tally.false_cull_reports}}
+                                          {"efficiency", tally.efficiency()}, {"hidden_through_ties", tally.hidden_through_ties},
+                                          {"culled_through_ties", tally.culled_through_ties},
+                                          {"robust_efficiency", tally.robust_efficiency()}, {"false_cull_reports", tally.false_cull_reports}}
                                 .dump(1));
         return;
     }
@@ -78,6 +80,8 @@ void run_scene_accuracy(const Options& o) {
     fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %), missed {}\n",
                tally.false_culls, tally.robust_false_culls, tally.culled_hidden, tally.hidden_in_frustum, 100.0 * tally.efficiency(),
                tally.missed_culls());
+    fmt::print("hidden only through ties: {} (culled {}); hidden outright: culled {:.1f} %\n", tally.hidden_through_ties,
+               tally.culled_through_ties, 100.0 * tally.robust_efficiency());
     for (const std::string& line : tally.false_cull_reports) fmt::print("false cull: {}\n", line);
 }
 

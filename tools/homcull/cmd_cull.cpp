@@ -111,6 +111,8 @@ void run_cull(const CullCommandOptions& o) {
             out["truth"] = {{"false_culls", tally.false_culls},   {"robust_false_culls", tally.robust_false_culls},
                             {"hidden_in_frustum", tally.hidden_in_frustum}, {"culled_hidden", tally.culled_hidden},
                             {"missed_culls", tally.missed_culls()}, {"efficiency", tally.efficiency()},
+                            {"hidden_through_ties", tally.hidden_through_ties}, {"culled_through_ties", tally.culled_through_ties},
+                            {"robust_efficiency", tally.robust_efficiency()},
                             {"false_cull_reports", tally.false_cull_reports}, {"trace_ms", truth_ms}};
         }
         fmt::print("{}\n", out.dump(1));
@@ -128,8 +130,10 @@ void run_cull(const CullCommandOptions& o) {
     fmt::print("time       load {:.1f} ms, setup {:.1f} ms; render {:.3f} ms, maps {:.3f} ms, tests {:.3f} ms\n", load_ms, setup_ms,
                ms.render_ms, ms.maps_ms, ms.test_ms);
     if (o.truth) {
-        fmt::print("truth      {} false culls; culled {} of {} hidden objects ({:.1f} %); trace {:.0f} ms\n", tally.false_culls,
-                   tally.culled_hidden, tally.hidden_in_frustum, 100.0 * tally.efficiency(), truth_ms);
+        fmt::print("truth      {} false culls; culled {} of {} hidden objects ({:.1f} %; {} of them hidden only through ties); "
+                   "trace {:.0f} ms\n",
+                   tally.false_culls, tally.culled_hidden, tally.hidden_in_frustum, 100.0 * tally.efficiency(), tally.hidden_through_ties,
+                   truth_ms);
         for (const std::string& line : tally.false_cull_reports) fmt::print("false cull: {}\n", line);
     }
     fmt::print("(--json lists every object)\n");

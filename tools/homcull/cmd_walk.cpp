@@ -136,18 +136,25 @@ void run_walk(const WalkCommandOptions& o) {
     }
     for (std::size_t i = 0; i < names.size(); ++i)
         summary[names[i].first] = {{"mean", sum[i] / double(measured.size())}, {"max", most[i]}};
-    std::size_t false_culls = 0, robust_false_culls = 0, hidden = 0, missed = 0;
+    std::size_t false_culls = 0, robust_false_culls = 0, hidden = 0, missed = 0, hidden_ties = 0, missed_ties = 0;
     for (const WalkFrame& f : measured) {
         false_culls += f.false_culls;
         robust_false_culls += f.robust_false_culls;
         hidden += f.hidden_in_frustum;
         missed += f.missed_culls;
+        hidden_ties += f.hidden_through_ties;
+        missed_ties += f.missed_through_ties;
     }
     const double efficiency = hidden ? double(hidden - missed) / double(hidden) : 1.0;
+    const std::size_t hidden_outright = hidden - hidden_ties, missed_outright = missed - missed_ties;
+    const double robust_efficiency = hidden_outright ? double(hidden_outright - missed_outright) / double(hidden_outright) : 1.0;
     if (rays) {
         summary["total_false_culls"] = false_culls;
         summary["total_robust_false_culls"] = robust_false_culls;
         summary["efficiency"] = efficiency;
+        summary["hidden_through_ties"] = hidden_ties;
+        summary["missed_through_ties"] = missed_ties;
+        summary["robust_efficiency"] = robust_efficiency;
     }
     if (!o.dump.empty()) {
         const std::vector<std::pair<std::string, std::string>> settings = {
@@ -190,9 +197,12 @@ void run_walk(const WalkCommandOptions& o) {
         (void)value;
         fmt::print("{:<28}{:>14.3f}{:>14.3f}\n", name, summary[name]["mean"].get<double>(), summary[name]["max"].get<double>());
     }
-    if (rays)
+    if (rays) {
         fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %)\n", false_culls,
                    robust_false_culls, hidden - missed, hidden, 100.0 * efficiency);
+        fmt::print("hidden only through ties: {} (missed {}); hidden outright: culled {:.1f} %\n", hidden_ties, missed_ties,
+                   100.0 * robust_efficiency);
+    }
 }
 
 }  // namespace

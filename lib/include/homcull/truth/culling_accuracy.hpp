@@ -15,6 +15,10 @@ struct CullingTally {
     std::size_t visible = 0;            // objects some sample sees
     std::size_t hidden_in_frustum = 0;  // in the frustum, seen by no sample
     std::size_t culled_hidden = 0;      // of those, declared occluded or view-culled
+    // Of the hidden ones, those hidden only through ties (ObjectVisibility::tie_samples > 0):
+    // under another tie-break some sample would see them, so culling them is not required.
+    std::size_t hidden_through_ties = 0;
+    std::size_t culled_through_ties = 0;  // of those, declared occluded or view-culled
     std::size_t false_culls = 0;        // seen, yet declared occluded or view-culled
     std::size_t robust_false_culls = 0; // of those, seen by at least one robust sample
     std::uint64_t most_samples_falsely_culled = 0;  // the largest visible_samples among them
@@ -22,6 +26,11 @@ struct CullingTally {
     SceneCullTimings total_ms;                    // the culler's stage times, summed over views
     double efficiency() const { return hidden_in_frustum ? double(culled_hidden) / double(hidden_in_frustum) : 1.0; }
     std::size_t missed_culls() const { return hidden_in_frustum - culled_hidden; }
+    // Culling efficiency over the objects hidden outright (no tie samples).
+    double robust_efficiency() const {
+        const std::size_t hidden = hidden_in_frustum - hidden_through_ties;
+        return hidden ? double(culled_hidden - culled_through_ties) / double(hidden) : 1.0;
+    }
 };
 
 // Tallies one view's answers (answers[id] per object) against its ground truth.

@@ -25,6 +25,11 @@ struct ObjectVisibility {
     bool in_frustum = false;  // the world AABB meets the view frustum (exact test)
     std::uint64_t visible_samples = 0;
     std::uint64_t robust_samples = 0;
+    // Samples that see another object while this one lies within the tie window of that hit:
+    // had the tie gone the other way, they would see this one. An object with no visible
+    // sample but some tie samples is hidden only through ties (DESIGN.md's robust samples,
+    // seen from the hidden side).
+    std::uint64_t tie_samples = 0;
 };
 
 // "visible" (some sample sees it), "occluded" (in the frustum, no sample sees it) or

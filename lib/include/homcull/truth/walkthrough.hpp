@@ -25,6 +25,8 @@ struct WalkFrame {
     std::size_t robust_false_culls = 0; // of those, seen by a robust sample
     std::size_t hidden_in_frustum = 0;  // in the frustum, seen by no sample
     std::size_t missed_culls = 0;       // of those, kept
+    std::size_t hidden_through_ties = 0;  // hidden ones with tie samples (CullingTally)
+    std::size_t missed_through_ties = 0;  // of those, kept
     SceneCullTimings ms;
     SceneCullWork work;
     double truth_ms = 0.0;
