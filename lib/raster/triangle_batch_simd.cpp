@@ -11,6 +11,7 @@
 
 #include "raster/triangle_batch.hpp"
 
+#include <cstdint>
 #include <cstring>
 
 HWY_BEFORE_NAMESPACE();
@@ -34,44 +35,61 @@ HWY_INLINE std::uint32_t Bits(D d, M m) {
     return bytes[0];
 }
 
-void TransformVertices(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache) {
+// Transforms the lanes' positions (count of them, from vertex `at`) and stores their clip
+// coordinates and outcodes into the cache.
+HWY_INLINE void StoreVertexClips(const TriangleInput& in, V near, V px, V py, V pz, V pw, std::size_t at, std::size_t count,
+                                 const VertexClip& cache) {
     const D d;
     const hn::Rebind<std::int32_t, D> di;
+    const V x = ClipRow(d, in.model_to_clip, 0, px, py, pz, pw), y = ClipRow(d, in.model_to_clip, 1, px, py, pz, pw);
+    const V z = ClipRow(d, in.model_to_clip, 2, px, py, pz, pw), w = ClipRow(d, in.model_to_clip, 3, px, py, pz, pw);
+    hn::StoreU(x, d, cache.x + at);  // whole vectors: the planes are padded by kVertexClipPadding
+    hn::StoreU(y, d, cache.y + at);
+    hn::StoreU(z, d, cache.z + at);
+    hn::StoreU(w, d, cache.w + at);
+    // outcode(), lane by lane, as small integers in double (exact), then bytes.
+    const V none = hn::Zero(d), infinity = hn::Set(d, HUGE_VAL);
+    auto bit = [&](M m, OutcodeBit b) { return hn::IfThenElse(m, hn::Set(d, double(b)), none); };
+    const V planes = hn::Add(hn::Add(hn::Add(bit(hn::Lt(w, near), kBehindNear), bit(hn::Gt(x, w), kBeyondRight)),
+                                     hn::Add(bit(hn::Lt(x, hn::Neg(w)), kBeyondLeft), bit(hn::Gt(y, w), kBeyondTop))),
+                             bit(hn::Lt(y, hn::Neg(w)), kBeyondBottom));
+    const M finite = hn::And(hn::And(hn::Lt(hn::Abs(x), infinity), hn::Lt(hn::Abs(y), infinity)), hn::Lt(hn::Abs(w), infinity));
+    HWY_ALIGN std::int32_t code[8];
+    hn::Store(hn::DemoteTo(di, hn::IfThenElse(finite, planes, hn::Set(d, double(kNotFinite)))), di, code);
+    for (std::size_t i = 0; i < count; ++i) cache.outcode[at + i] = std::uint8_t(code[i]);
+}
+
+void TransformVertices(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache) {
+    const D d;
+    const hn::Rebind<float, D> df;
     constexpr int kBlock = 8;
     const int lanes = int(hn::Lanes(d));
-    const V near = hn::Set(d, near_w), infinity = hn::Set(d, HUGE_VAL);
+    const V near = hn::Set(d, near_w), one = hn::Set(d, 1.0);
+    std::size_t v0 = begin;
+    // Packed x, y, z floats (the common layout): whole vectors of vertices deinterleaved by loads.
+    const auto* packed = static_cast<const float*>(in.positions);
+    if (in.position_components == 3 && in.position_stride == 3 * sizeof(float) && reinterpret_cast<std::uintptr_t>(packed) % alignof(float) == 0)
+        for (; v0 + std::size_t(lanes) <= end; v0 += std::size_t(lanes)) {
+            hn::Vec<decltype(df)> x, y, z;
+            hn::LoadInterleaved3(df, packed + 3 * v0, x, y, z);
+            StoreVertexClips(in, near, hn::PromoteTo(d, x), hn::PromoteTo(d, y), hn::PromoteTo(d, z), one, v0, std::size_t(lanes), cache);
+        }
+    // Any stride and 4 components, and the last few: positions to structure of arrays one by one.
     const bool has_w = in.position_components == 4;
     const auto* bytes = static_cast<const unsigned char*>(in.positions);
     HWY_ALIGN double p[4][kBlock];
-    for (std::size_t v0 = begin; v0 < end; v0 += kBlock) {
+    for (; v0 < end; v0 += kBlock) {
         const int n = int(std::min<std::size_t>(kBlock, end - v0));
-        for (int i = 0; i < kBlock; ++i) {  // positions to structure of arrays (past n: the last one again)
+        for (int i = 0; i < kBlock; ++i) {  // past n: the last one again
             const unsigned char* vertex = bytes + (v0 + std::size_t(std::min(i, n - 1))) * in.position_stride;
             float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};
             std::memcpy(f, vertex, 3 * sizeof(float));
             if (has_w) std::memcpy(&f[3], vertex + 3 * sizeof(float), sizeof(float));
             p[0][i] = f[0], p[1][i] = f[1], p[2][i] = f[2], p[3][i] = f[3];
         }
-        for (int g = 0; g < n; g += lanes) {
-            const V px = hn::Load(d, p[0] + g), py = hn::Load(d, p[1] + g), pz = hn::Load(d, p[2] + g), pw = hn::Load(d, p[3] + g);
-            const V x = ClipRow(d, in.model_to_clip, 0, px, py, pz, pw), y = ClipRow(d, in.model_to_clip, 1, px, py, pz, pw);
-            const V z = ClipRow(d, in.model_to_clip, 2, px, py, pz, pw), w = ClipRow(d, in.model_to_clip, 3, px, py, pz, pw);
-            const std::size_t count = std::size_t(std::min(lanes, n - g)), at = v0 + std::size_t(g);
-            hn::StoreU(x, d, cache.x + at);  // whole vectors: the planes are padded by kVertexClipPadding
-            hn::StoreU(y, d, cache.y + at);
-            hn::StoreU(z, d, cache.z + at);
-            hn::StoreU(w, d, cache.w + at);
-            // outcode(), lane by lane, as small integers in double (exact), then bytes.
-            const V none = hn::Zero(d);
-            auto bit = [&](M m, OutcodeBit b) { return hn::IfThenElse(m, hn::Set(d, double(b)), none); };
-            const V planes = hn::Add(hn::Add(hn::Add(bit(hn::Lt(w, near), kBehindNear), bit(hn::Gt(x, w), kBeyondRight)),
-                                             hn::Add(bit(hn::Lt(x, hn::Neg(w)), kBeyondLeft), bit(hn::Gt(y, w), kBeyondTop))),
-                                     bit(hn::Lt(y, hn::Neg(w)), kBeyondBottom));
-            const M finite = hn::And(hn::And(hn::Lt(hn::Abs(x), infinity), hn::Lt(hn::Abs(y), infinity)), hn::Lt(hn::Abs(w), infinity));
-            HWY_ALIGN std::int32_t code[8];
-            hn::Store(hn::DemoteTo(di, hn::IfThenElse(finite, planes, hn::Set(d, double(kNotFinite)))), di, code);
-            for (std::size_t i = 0; i < count; ++i) cache.outcode[at + i] = std::uint8_t(code[i]);
-        }
+        for (int g = 0; g < n; g += lanes)
+            StoreVertexClips(in, near, hn::Load(d, p[0] + g), hn::Load(d, p[1] + g), hn::Load(d, p[2] + g), hn::Load(d, p[3] + g),
+                             v0 + std::size_t(g), std::size_t(std::min(lanes, n - g)), cache);
     }
 }
 
