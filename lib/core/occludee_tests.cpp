@@ -48,7 +48,7 @@ bool OcclusionBuffer::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x,
 
 detail::SubtileView OcclusionBuffer::subtile_view() const {
     return {d0_.data(),       d1_.data(),     mask_.data(),      stride_, sample_depth_.empty() ? nullptr : sample_depth_.data(),
-            std::size_t(sample_width_), pyramid_.data(), levels_.data(), int(levels_.size())};
+            sample_depth_stride_, pyramid_.data(), levels_.data(), int(levels_.size())};
 }
 
 Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y,

@@ -50,7 +50,8 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     d1_.assign(plane, 0.0f);
     mask_.assign(plane, 0u);
     covered_.assign(plane, 0u);
-    if (config.sample_depth) sample_depth_.assign(std::size_t(sample_width_) * std::size_t(sample_height_), 0.0f);
+    sample_depth_stride_ = std::size_t(sample_width_) + detail::kMaxSimdLanes;
+    if (config.sample_depth) sample_depth_.assign(sample_depth_stride_ * std::size_t(sample_height_), 0.0f);
     band_touched_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
     std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
@@ -102,7 +103,7 @@ detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) 
                                        covered_.data(),
                                        stride_,
                                        sample_depth_.empty() ? nullptr : sample_depth_.data(),
-                                       std::size_t(sample_width_)};
+                                       sample_depth_stride_};
     return {planes, sample_width_, sample_height_, row_begin, row_end, detail::selected_rows_kernel()};
 }
 
@@ -239,7 +240,7 @@ void OcclusionBuffer::read_depth(std::vector<float>& w) const {
             const bool in_mask = (s.mask >> ((y % kH) * kW + x % kW)) & 1u;
             const std::size_t at = std::size_t(y) * std::size_t(sample_width_) + std::size_t(x);
             float d = in_mask ? std::max(s.d0, s.d1) : s.d0;
-            if (!sample_depth_.empty()) d = std::max(d, sample_depth_[at]);
+            if (!sample_depth_.empty()) d = std::max(d, sample_depth_[std::size_t(y) * sample_depth_stride_ + std::size_t(x)]);
             w[at] = d > 0.0f ? 1.0f / d : INFINITY;
         }
 }

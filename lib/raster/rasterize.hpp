@@ -237,8 +237,8 @@ inline bool reached_subtile_columns(const std::int32_t first[4], const std::int3
 std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_height);
 
 // The per-sample depth of a subtile row's covered samples (planes.sample_depth, which must be
-// non-null): the maximum of what it holds and conservative_depth at the sample. One plain loop
-// for every instruction set, so that all give the same bits.
+// non-null): the maximum of what it holds and conservative_depth at the sample. The scalar
+// reference; the SIMD kernels repeat its float operations lane by lane (UpdateSampleDepth).
 void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t first[4], const std::int32_t last[4],
                          const PreparedTriangle& tri);
 

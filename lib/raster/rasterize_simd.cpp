@@ -167,6 +167,37 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     return touched;
 }
 
+// update_sample_depth for one subtile row, the samples of a sample row as lanes: each lane
+// evaluates conservative_depth with the same float operations (the row's part, a + dzdy y,
+// once per row: the same rounding for every sample) and keeps the larger. Whole vectors are
+// loaded and stored; lanes past the interval write back what they read, within the row and
+// its padding (OcclusionBuffer::sample_depth_stride_), which no other band touches.
+HWY_INLINE void UpdateSampleDepth(const SubtilePlanes& planes, int ty, const std::int32_t* first, const std::int32_t* last,
+                                  const PreparedTriangle& tri, hn::Vec<hn::CappedTag<std::int32_t, kMaxSimdLanes>> lane) {
+    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many (sample_depth_stride_)
+    const hn::RebindToSigned<decltype(df)> di;
+    const int lanes = int(hn::Lanes(df));
+    const auto dzdx = hn::Set(df, tri.dzdx), error = hn::Set(df, tri.error), z_vertex_min = hn::Set(df, tri.z_vertex_min);
+    const auto half = hn::Set(df, 0.5f), lower = hn::Set(df, 1.0f - 0x1.0p-20f);
+    for (int j = 0; j < kH; ++j) {
+        if (first[j] > last[j]) continue;
+        const int row = ty * kH + j;
+        const float y = float(row) + 0.5f;
+        const auto row_part = hn::Set(df, tri.a + tri.dzdy * y);
+        float* depth = planes.sample_depth + std::size_t(row) * planes.sample_stride;
+        for (int x = first[j]; x <= last[j]; x += lanes) {
+            const auto xs = hn::Add(hn::ConvertTo(df, hn::Add(lane, hn::Set(di, x))), half);  // exact: |x| < 2^23
+            const auto lowered = hn::Sub(hn::Add(row_part, hn::Mul(dzdx, xs)), error);
+            const auto bound = hn::Mul(hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered), lower);
+            const auto old = hn::LoadU(df, depth + x);
+            const auto in_interval = hn::FirstN(df, std::size_t(last[j] - x + 1));
+            // std::max(old, bound): bound where old < bound.
+            hn::StoreU(hn::IfThenElse(hn::And(in_interval, hn::Lt(old, bound)), bound, old), df, depth + x);
+        }
+    }
+}
+
 // The reference's row loop, in two passes over chunks of up to 16 subtile rows: first the
 // coverage interval of every sample row of the chunk, the sample rows as vector lanes (8 on
 // AVX-512, 4 on AVX2, 2 on SSE4), each lane evaluating rasterize_rows_reference's formula for
@@ -187,6 +218,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     const auto half = hn::Set(d, 0.5), one = hn::Set(d, 1.0), zero = hn::Zero(d);
     const auto row_min = hn::Set(d, double(j0)), row_max = hn::Set(d, double(j1));
     const auto lane = hn::Iota(d, 0.0);  // once: Highway's Iota goes through memory
+    const auto sample_lane = hn::Iota(hn::CappedTag<std::int32_t, kMaxSimdLanes>(), 0);
 
     constexpr int kChunkSubtileRows = 16, kChunkRows = kChunkSubtileRows * kH;
 #if HOMCULL_PAIR_ROWS
@@ -232,8 +264,8 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
                     touched += UpdateSubtileRows<2>(t.planes, ty, std::min(tx_begin, next_begin), std::max(tx_end, next_end), row_first,
                                                     row_last, tri, t.sample_width, t.sample_height);
                     if (t.planes.sample_depth) {
-                        update_sample_depth(t.planes, ty, row_first, row_last, tri);
-                        update_sample_depth(t.planes, ty + 1, row_first + kH, row_last + kH, tri);
+                        UpdateSampleDepth(t.planes, ty, row_first, row_last, tri, sample_lane);
+                        UpdateSampleDepth(t.planes, ty + 1, row_first + kH, row_last + kH, tri, sample_lane);
                     }
                     ty += 2;
                     continue;
@@ -242,7 +274,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
 #endif
             if (reached) {
                 touched += UpdateSubtileRows<1>(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width, t.sample_height);
-                if (t.planes.sample_depth) update_sample_depth(t.planes, ty, row_first, row_last, tri);
+                if (t.planes.sample_depth) UpdateSampleDepth(t.planes, ty, row_first, row_last, tri, sample_lane);
             }
             ++ty;
         }

@@ -230,6 +230,9 @@ private:
     std::vector<float> d0_, d1_;
     std::vector<std::uint32_t> mask_, covered_;
     std::vector<float> sample_depth_;  // 1/w per sample, row-major; empty unless config_.sample_depth
+    // Its row stride: the width plus room for a whole vector from any sample of the row, so that
+    // the SIMD kernel's vectors never reach into the next row (another band's, on another thread).
+    std::size_t sample_depth_stride_ = 0;
     std::size_t at(int tx, int ty) const { return std::size_t(ty) * stride_ + std::size_t(tx); }
     RasterStats stats_;
 
