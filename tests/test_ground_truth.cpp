@@ -138,13 +138,18 @@ TEST(GroundTruth, AnObjectHiddenOnlyThroughTiesHasTieSamples) {
     EXPECT_GT(r.objects[big].visible_samples, 0u);  // alone around the copies
     EXPECT_EQ(r.objects[behind].visible_samples, 0u);
     EXPECT_EQ(r.objects[behind].tie_samples, 0u);
-    int hidden_copies = 0;
+    // Whichever surface wins a sample of the small area (that depends on Embree's traversal
+    // order), the other four lie in its window: four tie samples per sample there.
+    std::uint64_t copies_seen = 0, ties = r.objects[big].tie_samples;
     for (std::uint32_t c : copies) {
-        if (r.objects[c].visible_samples > 0) continue;
-        ++hidden_copies;
-        EXPECT_GT(r.objects[c].tie_samples, 0u) << "copy " << c << " is hidden, but only through ties";
+        copies_seen += r.objects[c].visible_samples;
+        ties += r.objects[c].tie_samples;
+        if (r.objects[c].visible_samples == 0) {
+            EXPECT_GT(r.objects[c].tie_samples, 0u) << "copy " << c << " is hidden only through ties";
+        }
     }
-    EXPECT_GE(hidden_copies, 1);  // five coincident surfaces: most lose every tie
+    EXPECT_GE(ties, 4 * copies_seen);
+    EXPECT_GT(ties, 0u);
 }
 
 TEST(GroundTruth, ObjectsOutsideTheFrustumAreNotInIt) {

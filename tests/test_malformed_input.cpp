@@ -179,6 +179,11 @@ TEST(MalformedInput, OccluderArraysAndCounts) {
     in.vertex_count = 3;
     in.triangle_count = std::numeric_limits<std::size_t>::max() / 3 + 1;  // 3 * count wraps around to 2
     EXPECT_THROW(buffer.render(in), Error);
+    // Without indices, vertex numbers must fit 32 bits: a clear error, not a wrapped index
+    // (nothing is read before the check).
+    in.triangle_count = std::size_t(1) << 31;
+    in.vertex_count = 3 * in.triangle_count;
+    EXPECT_THROW(buffer.render(in), Error);
 }
 
 }  // namespace

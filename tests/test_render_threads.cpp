@@ -271,5 +271,64 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
     select_isa("best");
 }
 
+// The vertex cache as engines feed it: packed x, y, z positions (the deinterleaving path), a
+// perspective camera's matrix (no exact products), more vertices than one transform task,
+// serial and with TBB. Every instruction set gives the scalar reference's statistics and bits,
+// and the reference gives the same without the cache.
+TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
+    std::mt19937_64 rng(91);
+    std::uniform_real_distribution<float> coordinate(-30.0f, 30.0f), jitter(-0.6f, 0.6f);
+    constexpr std::size_t kVertices = 40009, kTriangles = 60013,
+                          kUnused = 30000;  // 40,009 vertices: three transform tasks
+    std::vector<float> positions;
+    for (std::size_t v = 0; v < kVertices + kUnused; ++v)
+        positions.insert(positions.end(), {coordinate(rng), coordinate(rng), coordinate(rng) - 40.0f});
+    std::vector<std::uint32_t> indices;
+    for (std::size_t t = 0; t < kTriangles; ++t) {
+        const std::uint32_t a = std::uint32_t(rng() % kVertices);
+        // Small triangles: neighbours in space are not neighbours in the array, so move two
+        // vertices near the first by reusing close indices' positions.
+        const std::uint32_t b = std::uint32_t((a + 1) % kVertices), c = std::uint32_t((a + 2) % kVertices);
+        for (std::uint32_t k : {b, c})
+            for (int axis = 0; axis < 3; ++axis)
+                positions[3 * k + std::size_t(axis)] = positions[3 * a + std::size_t(axis)] + jitter(rng);
+        indices.insert(indices.end(), {a, b, c});
+    }
+    Camera camera;
+    camera.eye = {3, 2, 5};
+    camera.target = {-2, -1, -40};
+    TriangleInput in;
+    in.positions = positions.data();
+    in.vertex_count = kVertices;
+    in.indices = indices.data();
+    in.triangle_count = kTriangles;
+    in.model_to_clip = clip_from_world(camera, 331.0 / 197.0);
+    in.backface = Backface::cw;
+    const ParallelFor tbb = tbb_parallel_for();
+    auto render = [&](std::size_t vertex_count, const ParallelFor& parallel) {
+        TriangleInput input = in;
+        input.vertex_count = vertex_count;
+        OcclusionBuffer buffer(test::buffer_config(331, 197, 2, float(camera.near_plane), true));
+        buffer.render(input, parallel);
+        return buffer;
+    };
+    select_isa("scalar");
+    const OcclusionBuffer reference = render(kVertices, {});
+    EXPECT_GT(reference.stats().rasterized, 10000u);
+    EXPECT_GT(reference.stats().outside + reference.stats().backface_culled, 10000u);
+    const OcclusionBuffer without_cache = render(kVertices + kUnused, {});  // more vertices than triangles: no cache
+    EXPECT_TRUE(same_stats(reference.stats(), without_cache.stats()));
+    EXPECT_TRUE(same_subtiles(reference, without_cache));
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        for (const bool threads : {false, true}) {
+            const OcclusionBuffer b = render(kVertices, threads ? tbb : ParallelFor{});
+            EXPECT_TRUE(same_stats(reference.stats(), b.stats())) << isa << (threads ? ", TBB" : ", serial");
+            EXPECT_TRUE(same_subtiles(reference, b)) << isa << (threads ? ", TBB" : ", serial");
+        }
+    }
+    select_isa("best");
+}
+
 }  // namespace
 }  // namespace homcull

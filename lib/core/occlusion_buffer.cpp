@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 namespace homcull {
 namespace {
@@ -124,6 +126,9 @@ bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const Parallel
     cache = {planes, planes + plane, planes + 2 * plane, planes + 3 * plane, vertex_outcode_.data()};
     const detail::TransformVerticesKernel transform = detail::selected_front_end_kernels().transform_vertices;
     constexpr std::size_t kVerticesPerTask = 16384;
+    // The kernel stores whole vectors (up to 8 vertices) past a task's end: only the last task
+    // may have a partial vector, into the cache's padding, never into the next task's vertices.
+    static_assert(kVerticesPerTask % detail::kVertexClipPadding == 0, "tasks of whole vectors");
     const std::size_t tasks = (in.vertex_count + kVerticesPerTask - 1) / kVerticesPerTask;
     struct Job {
         const TriangleInput* in;
@@ -148,6 +153,8 @@ void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& paralle
         throw Error("render: positions missing, or stride smaller than one position");
     if (!in.indices && in.vertex_count / 3 < in.triangle_count)  // (no overflow for any count)
         throw Error("render: without indices, vertex_count must be at least 3 * triangle_count");
+    if (!in.indices && in.triangle_count > std::size_t(std::numeric_limits<std::uint32_t>::max()) / 3)
+        throw Error("render: without indices, at most 2^32 / 3 triangles per call (vertex numbers are 32-bit, as indices)");
     detail::VertexClip storage;
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;
     if (parallel.run) render_binned(in, parallel, cache);

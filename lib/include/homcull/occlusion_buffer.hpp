@@ -94,6 +94,8 @@ struct TriangleInput {
     const void* positions = nullptr;
     int position_components = 3;       // 3 or 4
     std::size_t position_stride = 12;  // bytes between consecutive positions
+    // Positions must hold vertex_count vertices: with indices and no more vertices than
+    // triangles, render() transforms every one of them once (not only those indexed).
     std::size_t vertex_count = 0;
     const void* indices = nullptr;     // nullptr: triangles are vertices 3k, 3k+1, 3k+2
     bool indices_16bit = false;

@@ -28,7 +28,8 @@ struct ObjectVisibility {
     // Samples that see another object while this one lies within the tie window of that hit:
     // had the tie gone the other way, they would see this one. An object with no visible
     // sample but some tie samples is hidden only through ties (DESIGN.md's robust samples,
-    // seen from the hidden side).
+    // seen from the hidden side). At most 4 other objects are recorded per sample; a fifth
+    // coincident one gets no tie sample there (and may then count as hidden outright).
     std::uint64_t tie_samples = 0;
 };
 
