@@ -184,6 +184,7 @@ TEST(MalformedInput, OccluderArraysAndCounts) {
     in.triangle_count = std::size_t(1) << 31;
     in.vertex_count = 3 * in.triangle_count;
     EXPECT_THROW(buffer.render(in), Error);
+    EXPECT_THROW(buffer.test_triangles(in), Error);  // the same check for occludees
 }
 
 }  // namespace

@@ -191,11 +191,7 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
                                                               std::size_t first_triangle) const {
     TriangleTest result;
     if (in.triangle_count == 0) return result;
-    if (in.position_components != 3 && in.position_components != 4) throw Error("test_triangles: positions must have 3 or 4 components");
-    if (!in.positions || in.position_stride < sizeof(float) * std::size_t(in.position_components))
-        throw Error("test_triangles: positions missing, or stride smaller than one position");
-    if (!in.indices && in.vertex_count / 3 < in.triangle_count)
-        throw Error("test_triangles: without indices, vertex_count must be at least 3 * triangle_count");
+    detail::check_triangle_input(in, "test_triangles");
 
     const detail::SubtileView view = subtile_view();
     const double near_w = config_.near_w;

@@ -6,8 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <limits>
 
 namespace homcull {
 namespace {
@@ -148,13 +146,7 @@ bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const Parallel
 
 void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& parallel) {
     if (in.triangle_count == 0) return;
-    if (in.position_components != 3 && in.position_components != 4) throw Error("render: positions must have 3 or 4 components");
-    if (!in.positions || in.position_stride < sizeof(float) * std::size_t(in.position_components))
-        throw Error("render: positions missing, or stride smaller than one position");
-    if (!in.indices && in.vertex_count / 3 < in.triangle_count)  // (no overflow for any count)
-        throw Error("render: without indices, vertex_count must be at least 3 * triangle_count");
-    if (!in.indices && in.triangle_count > std::size_t(std::numeric_limits<std::uint32_t>::max()) / 3)
-        throw Error("render: without indices, at most 2^32 / 3 triangles per call (vertex numbers are 32-bit, as indices)");
+    detail::check_triangle_input(in, "render");
     detail::VertexClip storage;
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;
     if (parallel.run) render_binned(in, parallel, cache);

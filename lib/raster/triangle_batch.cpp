@@ -1,28 +1,10 @@
 #include "raster/triangle_batch.hpp"
 
 #include <cmath>
-#include <cstring>
 #include <utility>
 
 namespace homcull::detail {
 namespace {
-
-// Index k of triangle t: from 16- or 32-bit indices, or 3t + k without them.
-template <typename Index>
-inline std::uint32_t vertex_index(const Index* indices, std::size_t t, int k) {
-    const std::size_t n = 3 * t + std::size_t(k);
-    return indices ? std::uint32_t(indices[n]) : std::uint32_t(n);
-}
-
-// The position of vertex v as (x, y, z, w), w = 1 for 3 components. Fixed-size copies: the
-// stride need not keep floats aligned, and a copy of a run-time size goes through a library
-// call whose byte stores the loads after it cannot forward from.
-inline void read_position(const TriangleInput& in, std::uint32_t v, float p[4]) {
-    const unsigned char* vertex = static_cast<const unsigned char*>(in.positions) + std::size_t(v) * in.position_stride;
-    std::memcpy(p, vertex, 3 * sizeof(float));
-    p[3] = 1.0f;
-    if (in.position_components == 4) std::memcpy(&p[3], vertex + 3 * sizeof(float), sizeof(float));
-}
 
 template <typename Index>
 std::uint32_t read_indices(const Index* indices, std::size_t first, int count, std::size_t vertex_count,

@@ -12,7 +12,6 @@
 #include "raster/triangle_batch.hpp"
 
 #include <cstdint>
-#include <cstring>
 
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
@@ -75,16 +74,12 @@ void TransformVertices(const TriangleInput& in, double near_w, std::size_t begin
             StoreVertexClips(in, near, hn::PromoteTo(d, x), hn::PromoteTo(d, y), hn::PromoteTo(d, z), one, v0, std::size_t(lanes), cache);
         }
     // Any stride and 4 components, and the last few: positions to structure of arrays one by one.
-    const bool has_w = in.position_components == 4;
-    const auto* bytes = static_cast<const unsigned char*>(in.positions);
     HWY_ALIGN double p[4][kBlock];
     for (; v0 < end; v0 += kBlock) {
         const int n = int(std::min<std::size_t>(kBlock, end - v0));
         for (int i = 0; i < kBlock; ++i) {  // past n: the last one again
-            const unsigned char* vertex = bytes + (v0 + std::size_t(std::min(i, n - 1))) * in.position_stride;
-            float f[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-            std::memcpy(f, vertex, 3 * sizeof(float));
-            if (has_w) std::memcpy(&f[3], vertex + 3 * sizeof(float), sizeof(float));
+            float f[4];
+            read_position(in, std::uint32_t(v0 + std::size_t(std::min(i, n - 1))), f);
             p[0][i] = f[0], p[1][i] = f[1], p[2][i] = f[2], p[3][i] = f[3];
         }
         for (int g = 0; g < n; g += lanes)

@@ -2,32 +2,34 @@
 
 #include "raster/clip_polygon.hpp"
 
+#include <homcull/error.hpp>
+
 #include <algorithm>
 #include <cmath>
-#include <cstring>
+#include <limits>
+#include <string>
 
 namespace homcull::detail {
 
+void check_triangle_input(const TriangleInput& in, const char* caller) {
+    const std::string name(caller);
+    if (in.position_components != 3 && in.position_components != 4) throw Error(name + ": positions must have 3 or 4 components");
+    if (!in.positions || in.position_stride < sizeof(float) * std::size_t(in.position_components))
+        throw Error(name + ": positions missing, or stride smaller than one position");
+    if (!in.indices && in.vertex_count / 3 < in.triangle_count)  // (no overflow for any count)
+        throw Error(name + ": without indices, vertex_count must be at least 3 * triangle_count");
+    if (!in.indices && in.triangle_count > std::size_t(std::numeric_limits<std::uint32_t>::max()) / 3)
+        throw Error(name + ": without indices, at most 2^32 / 3 triangles per call (vertex numbers are 32-bit, as indices)");
+}
+
 bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3]) {
-    const auto* bytes = static_cast<const unsigned char*>(in.positions);
     std::uint32_t index[3];
-    for (int k = 0; k < 3; ++k) {
-        const std::size_t n = 3 * t + std::size_t(k);
-        if (!in.indices) index[k] = std::uint32_t(n);
-        else if (in.indices_16bit) index[k] = static_cast<const std::uint16_t*>(in.indices)[n];
-        else index[k] = static_cast<const std::uint32_t*>(in.indices)[n];
-    }
+    for (int k = 0; k < 3; ++k) index[k] = vertex_index(in, t, k);
     if (index[0] >= in.vertex_count || index[1] >= in.vertex_count || index[2] >= in.vertex_count) return false;
     bool valid = true;
-    const bool has_w = in.position_components == 4;
     for (int k = 0; k < 3; ++k) {
-        // Component by component, each a fixed-size copy (the stride need not keep floats
-        // aligned): one copy of a run-time size went through a library call and made the
-        // loads after it stall on store forwarding, a third of the castle's render time.
-        const unsigned char* vertex = bytes + std::size_t(index[k]) * in.position_stride;
-        float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-        for (int c = 0; c < 3; ++c) std::memcpy(&p[c], vertex + sizeof(float) * std::size_t(c), sizeof(float));
-        if (has_w) std::memcpy(&p[3], vertex + 3 * sizeof(float), sizeof(float));
+        float p[4];
+        read_position(in, index[k], p);
         model[k] = {p[0], p[1], p[2], p[3]};
         clip[k] = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
         valid = valid && finite_clip(clip[k]);

@@ -6,6 +6,8 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace homcull::detail {
 
@@ -19,6 +21,35 @@ inline glm::dvec4 transform_to_clip(const std::array<float, 16>& m, double x, do
 }
 
 inline bool finite_clip(const glm::dvec4& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.w); }
+
+// Throws homcull::Error, naming `caller`, for input no triangle can be read from: 3 or 4
+// components, positions and a stride of at least one position, and without indices, enough
+// vertices for every triangle, numbered in 32 bits.
+void check_triangle_input(const TriangleInput& in, const char* caller);
+
+// Vertex number k of triangle t: from 16- or 32-bit indices, or 3t + k without them (indices
+// null; render() checks that 3t + k fits 32 bits).
+template <typename Index>
+inline std::uint32_t vertex_index(const Index* indices, std::size_t t, int k) {
+    const std::size_t n = 3 * t + std::size_t(k);
+    return indices ? std::uint32_t(indices[n]) : std::uint32_t(n);
+}
+inline std::uint32_t vertex_index(const TriangleInput& in, std::size_t t, int k) {
+    if (!in.indices) return vertex_index<std::uint32_t>(nullptr, t, k);
+    if (in.indices_16bit) return vertex_index(static_cast<const std::uint16_t*>(in.indices), t, k);
+    return vertex_index(static_cast<const std::uint32_t*>(in.indices), t, k);
+}
+
+// The position of vertex v (below vertex_count) as (x, y, z, w), w = 1 for 3 components.
+// Fixed-size copies: the stride need not keep floats aligned, and a copy of a run-time size
+// went through a library call whose byte stores the following loads could not forward from
+// (a third of the castle's render time once).
+inline void read_position(const TriangleInput& in, std::uint32_t v, float p[4]) {
+    const unsigned char* vertex = static_cast<const unsigned char*>(in.positions) + std::size_t(v) * in.position_stride;
+    std::memcpy(p, vertex, 3 * sizeof(float));
+    p[3] = 1.0f;
+    if (in.position_components == 4) std::memcpy(&p[3], vertex + 3 * sizeof(float), sizeof(float));
+}
 
 // Triangle t's vertices as given (x, y, z, w with w = 1 for 3 components) and in clip space.
 // False when an index is out of range or a clip coordinate is not finite.
