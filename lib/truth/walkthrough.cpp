@@ -43,4 +43,15 @@ WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Came
     return f;
 }
 
+void add_to_tally(const WalkFrame& f, CullingTally& tally) {
+    ++tally.views;
+    tally.visible += f.objects.exactly_visible;
+    tally.hidden_in_frustum += f.hidden_in_frustum;
+    tally.culled_hidden += f.hidden_in_frustum - f.missed_culls;
+    tally.hidden_through_ties += f.hidden_through_ties;
+    tally.culled_through_ties += f.hidden_through_ties - f.missed_through_ties;
+    tally.false_culls += f.false_culls;
+    tally.robust_false_culls += f.robust_false_culls;
+}
+
 }  // namespace homcull

@@ -136,25 +136,16 @@ void run_walk(const WalkCommandOptions& o) {
     }
     for (std::size_t i = 0; i < names.size(); ++i)
         summary[names[i].first] = {{"mean", sum[i] / double(measured.size())}, {"max", most[i]}};
-    std::size_t false_culls = 0, robust_false_culls = 0, hidden = 0, missed = 0, hidden_ties = 0, missed_ties = 0;
-    for (const WalkFrame& f : measured) {
-        false_culls += f.false_culls;
-        robust_false_culls += f.robust_false_culls;
-        hidden += f.hidden_in_frustum;
-        missed += f.missed_culls;
-        hidden_ties += f.hidden_through_ties;
-        missed_ties += f.missed_through_ties;
-    }
-    const double efficiency = hidden ? double(hidden - missed) / double(hidden) : 1.0;
-    const std::size_t hidden_outright = hidden - hidden_ties, missed_outright = missed - missed_ties;
-    const double robust_efficiency = hidden_outright ? double(hidden_outright - missed_outright) / double(hidden_outright) : 1.0;
+    CullingTally tally;
+    for (const WalkFrame& f : measured) add_to_tally(f, tally);
+    const double efficiency = tally.efficiency();
     if (rays) {
-        summary["total_false_culls"] = false_culls;
-        summary["total_robust_false_culls"] = robust_false_culls;
+        summary["total_false_culls"] = tally.false_culls;
+        summary["total_robust_false_culls"] = tally.robust_false_culls;
         summary["efficiency"] = efficiency;
-        summary["hidden_through_ties"] = hidden_ties;
-        summary["missed_through_ties"] = missed_ties;
-        summary["robust_efficiency"] = robust_efficiency;
+        summary["hidden_through_ties"] = tally.hidden_through_ties;
+        summary["missed_through_ties"] = tally.hidden_through_ties - tally.culled_through_ties;
+        summary["robust_efficiency"] = tally.robust_efficiency();
     }
     if (!o.dump.empty()) {
         const std::vector<std::pair<std::string, std::string>> settings = {
@@ -164,7 +155,7 @@ void run_walk(const WalkCommandOptions& o) {
             {"occluders", o.cull.occluders + ", rank " + o.cull.rank + ", budget " + std::to_string(o.cull.budget) + ", LOD " + o.cull.lod},
             {"display", std::to_string(config.display.width) + "x" + std::to_string(config.display.height) + ", " + o.cull.mode +
                             ", depth " + o.cull.depth},
-            {"efficiency", rays ? fmt::format("{:.1f} % of the hidden objects culled, {} false culls", 100.0 * efficiency, false_culls)
+            {"efficiency", rays ? fmt::format("{:.1f} % of the hidden objects culled, {} false culls", 100.0 * efficiency, tally.false_culls)
                                 : "no ground truth (--truth off)"}};
         for (const std::string& file : write_walk_report(o.dump, "homcull walk: " + scene.source, settings, measured, summary, "frame0"))
             fmt::print(stderr, "wrote      {}\n", file);
@@ -198,10 +189,10 @@ void run_walk(const WalkCommandOptions& o) {
         fmt::print("{:<28}{:>14.3f}{:>14.3f}\n", name, summary[name]["mean"].get<double>(), summary[name]["max"].get<double>());
     }
     if (rays) {
-        fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %)\n", false_culls,
-                   robust_false_culls, hidden - missed, hidden, 100.0 * efficiency);
-        fmt::print("hidden only through ties: {} (missed {}); hidden outright: culled {:.1f} %\n", hidden_ties, missed_ties,
-                   100.0 * robust_efficiency);
+        fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %)\n", tally.false_culls,
+                   tally.robust_false_culls, tally.culled_hidden, tally.hidden_in_frustum, 100.0 * efficiency);
+        fmt::print("hidden only through ties: {} (missed {}); hidden outright: culled {:.1f} %\n", tally.hidden_through_ties,
+                   tally.hidden_through_ties - tally.culled_through_ties, 100.0 * tally.robust_efficiency());
     }
 }
 

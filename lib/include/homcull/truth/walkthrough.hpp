@@ -3,6 +3,7 @@
 // total, after view-frustum culling, after occlusion culling and exactly visible (Embree), with
 // the false and missed culls against that ground truth and the time of every stage.
 #include <homcull/scene_culler.hpp>
+#include <homcull/truth/culling_accuracy.hpp>
 #include <homcull/truth/ground_truth.hpp>
 
 #include <cstdint>
@@ -36,5 +37,9 @@ struct WalkFrame {
 // the same camera at the culler's display resolution) also against ground truth.
 WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Camera& camera, const TruthResult* truth,
                              std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
+
+// Adds a measured frame's counts against ground truth to a tally (one view), so that walks
+// report efficiency with CullingTally's definitions.
+void add_to_tally(const WalkFrame& frame, CullingTally& tally);
 
 }  // namespace homcull
