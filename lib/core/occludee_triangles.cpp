@@ -8,11 +8,13 @@
 // - depth is the triangle's nearest over the covered samples of a subtile: its plane at the
 //   nearest corner of their bounding rectangle (or at each sample, against a per-sample depth),
 //   raised by the plane's float error and by how much the rounding of the vertices can move
-//   the plane, never above its nearest vertex.
+//   the plane, never above its nearest vertex; or, where smaller, the plane through its
+//   vertices raised by how far each may move (raised_vertex_plane.hpp).
 // The row intervals and subtile masks are the rasterizer's (one formula, see rasterize.cpp).
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/raised_vertex_plane.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_setup.hpp"
@@ -69,22 +71,54 @@ VertexSlack vertex_slack(const ClipError& e, const detail::ScreenTriangle& t, in
     return s;
 }
 
-// An upper bound of the triangle's 1/w at a sample, or over a rectangle of samples when given
-// the rectangle's corner where the plane is largest.
+// The same per vertex of an oriented triangle: how far it may move on screen, and its 1/w.
+struct PerVertexSlack {
+    double x[3], y[3], depth[3];
+};
+
+PerVertexSlack per_vertex_slack(const ClipError& e, const OrientedTriangle& t, int sample_width, int sample_height) {
+    PerVertexSlack s;
+    for (int k = 0; k < 3; ++k) {
+        const double ndc_x = t.v[k].x / (0.5 * sample_width) - 1.0, ndc_y = 1.0 - t.v[k].y / (0.5 * sample_height);
+        s.x[k] = (e.x + std::abs(ndc_x) * e.w) * t.d[k] * 0.5 * sample_width;
+        s.y[k] = (e.y + std::abs(ndc_y) * e.w) * t.d[k] * 0.5 * sample_height;
+        s.depth[k] = t.d[k] * (e.w * t.d[k]);  // d = 1/w with w off by e.w
+    }
+    return s;
+}
+
+// An upper bound of the triangle's 1/w at a sample, or over a rectangle of samples: the
+// smaller of two bounds, each evaluated at the rectangle's corner where it is largest.
 struct OccludeeDepth {
     PreparedTriangle plane{};  // usable when plane.has_plane
     float error = 0.0f;        // plane.error plus plane_error's absolute part, rounded up
     float z_vertex_max = 0.0f; // the nearest vertex, rounded up
     float plane_raise = 1.0f;  // 1 + plane_error's relative part, rounded up
     float raise = 1.0f;        // final relative raise, rounded up: 1 + 2^-20 + the w rounding
+    detail::RaisedVertexPlane raised{};  // usable when raised.usable; evaluated in double
 
-    float at(int column, int row) const {
+    // The plane-error bound at one sample.
+    float plane_bound(int column, int row) const {
         float bound = z_vertex_max;
         if (plane.has_plane) {
             const float x = float(column) + 0.5f, y = float(row) + 0.5f;
             bound = std::min(bound, (((plane.a + plane.dzdy * y) + plane.dzdx * x) + error) * plane_raise);
         }
         return bound * raise;
+    }
+    // The raised-vertex bound at one sample, with the relative 2^-20 of `raise` for the ray's
+    // rounding, rounded up to float.
+    float raised_bound(int column, int row) const {
+        return raised.usable ? detail::float_up(raised.at(column, row) * (1.0 + 0x1.0p-20)) : HUGE_VALF;
+    }
+    float at(int column, int row) const { return std::min(plane_bound(column, row), raised_bound(column, row)); }
+    // Over the samples of subtile (tx, ty) within the columns and rows of `c`.
+    float over(int tx, int ty, const detail::SubtileCoverage& c) const {
+        const bool far_is_left = plane.has_plane && plane.far_is_left, far_is_top = plane.has_plane && plane.far_is_top;
+        const float by_plane = plane_bound(tx * kW + (far_is_left ? c.column_hi : c.column_lo), ty * kH + (far_is_top ? c.row_hi : c.row_lo));
+        const float by_vertices = raised_bound(tx * kW + (raised.dzdx > 0.0 ? c.column_hi : c.column_lo),
+                                               ty * kH + (raised.dzdy > 0.0 ? c.row_hi : c.row_lo));
+        return std::min(by_plane, by_vertices);
     }
 };
 
@@ -163,9 +197,8 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
     } else {
         depth.plane.has_plane = false;  // zero area after projection: its padded bounding box, at its nearest vertex
     }
-    const bool far_is_left = depth.plane.has_plane && depth.plane.far_is_left;
-    const bool far_is_top = depth.plane.has_plane && depth.plane.far_is_top;
 
+    bool raised_ready = false;
     for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
         std::int32_t first[kH], last[kH];
         detail::subtile_row_intervals(has_area ? &edges : nullptr, ty, i0, i1, j0, j1, first, last);
@@ -174,10 +207,14 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
         for (int tx = tx_begin; tx <= tx_end; ++tx) {
             const detail::SubtileCoverage c = detail::subtile_coverage(first, last, tx);
             if (c.mask == 0) continue;
-            // The plane is largest (nearest) away from its far side.
-            const float d_near = depth.at(tx * kW + (far_is_left ? c.column_hi : c.column_lo), ty * kH + (far_is_top ? c.row_hi : c.row_lo));
             counts.samples += detail::bit_count(c.mask);
-            std::uint32_t unhidden = detail::subtile_unhidden_samples(view, tx, ty, c.mask, d_near);
+            std::uint32_t unhidden = detail::subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c));
+            if (unhidden && has_area && !raised_ready) {  // the raised-vertex bound, once a triangle needs it
+                raised_ready = true;
+                const PerVertexSlack vertex = per_vertex_slack(error, tri, sample_width, sample_height);
+                depth.raised = detail::raised_vertex_plane(tri, vertex.x, vertex.y, vertex.depth, pad_x, pad_y);
+                unhidden = detail::subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c));
+            }
             if (view.sample_depth && unhidden) unhidden = unhidden_by_sample_depth(view, tx, ty, unhidden, depth);
             counts.visible += detail::bit_count(unhidden);
             if (counts.visible > tolerated) return;
