@@ -120,11 +120,11 @@ TEST(CullingVsTruth, CastleViewsHaveNoFalseCulls) {
 
 TEST(CullingVsTruth, SharedScenesAlongWalksHaveNoFalseCulls) {
     int found = 0;
-    // Floors under the efficiency measured when they were set (100, 89.9, 98.2, 97.5 %): the
-    // house's misses are coplanar neighbours and coincident faces, ties no conservative test
-    // can break.
+    // Floors under the efficiency measured when they were set (100, 91.3, 99.4, 98.2 % with
+    // the raised-vertex occludee bound): the house's misses are coplanar neighbours and
+    // coincident faces, ties no conservative test can break.
     const std::pair<const char*, double> scenes[] = {
-        {"crytek_sponza.glb", 0.97}, {"fzk_haus.glb", 0.85}, {"openarena_oa_thor.glb", 0.96}, {"openarena_pul1duel-oa.glb", 0.95}};
+        {"crytek_sponza.glb", 0.97}, {"fzk_haus.glb", 0.88}, {"openarena_oa_thor.glb", 0.97}, {"openarena_pul1duel-oa.glb", 0.96}};
     for (const auto& [file, floor] : scenes) {
         const std::string path = test::shared_scene(file);
         if (path.empty()) continue;
@@ -136,9 +136,9 @@ TEST(CullingVsTruth, SharedScenesAlongWalksHaveNoFalseCulls) {
         EXPECT_EQ(tally.false_culls, 0u) << file;
         EXPECT_GE(tally.efficiency(), floor) << file << ": culling efficiency regressed";
         // Over the objects hidden outright (no tie could show them) every scene culls more than
-        // 95 % (issue 4's figure), the house included: 96.9 % (62 of 64) on this short walk, 98.9
-        // to 100 % on the others when set. The floor keeps a margin of a few objects.
-        EXPECT_GE(tally.robust_efficiency(), 0.93) << file;
+        // 95 % (issue 4's figure), the house included: 98.4 % (63 of 64) on this short walk, 99.3
+        // to 100 % on the others when set. The floor keeps a margin of two objects.
+        EXPECT_GE(tally.robust_efficiency(), 0.95) << file;
     }
     if (found == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
 }
