@@ -49,7 +49,7 @@ TEST(Cli, TruthJsonHasEveryObjectInTheDesignFormat) {
     for (std::size_t i = 0; i < j["objects"].size(); ++i) {
         const auto& o = j["objects"][i];
         EXPECT_EQ(o["id"], i);
-        for (const char* key : {"name", "triangles", "in_frustum", "visible_samples", "robust_samples", "result"})
+        for (const char* key : {"name", "triangles", "in_frustum", "visible_samples", "robust_samples", "tie_samples", "result"})
             EXPECT_TRUE(o.contains(key)) << key;
         samples += o["visible_samples"].get<std::uint64_t>();
     }
@@ -66,7 +66,10 @@ TEST(Cli, CullJsonHasEveryObjectStagesAndTruth) {
     for (std::size_t i = 0; i < j["objects"].size(); ++i) {
         const auto& o = j["objects"][i];
         EXPECT_EQ(o["id"], i);
-        for (const char* key : {"name", "triangles", "result", "level_of_visibility", "truth"}) EXPECT_TRUE(o.contains(key)) << key;
+        for (const char* key : {"name", "triangles", "result", "level_of_visibility", "truth", "visible_samples", "robust_samples",
+                                "tie_samples"})
+            EXPECT_TRUE(o.contains(key)) << key;
+        EXPECT_LE(o["robust_samples"].get<std::uint64_t>(), o["visible_samples"].get<std::uint64_t>());
         occluded += o["result"] == "occluded";
     }
     EXPECT_GT(occluded, 0u);

@@ -55,7 +55,8 @@ void run_truth(const TruthCommandOptions& o) {
             const ObjectVisibility& v = truth.objects[id];
             objects.push_back({{"id", id}, {"name", scene.objects[id].name}, {"triangles", scene.triangle_count(scene.objects[id])},
                                {"in_frustum", v.in_frustum}, {"visible_samples", v.visible_samples},
-                               {"robust_samples", v.robust_samples}, {"result", truth_result_name(v)}});
+                               {"robust_samples", v.robust_samples}, {"tie_samples", v.tie_samples},
+                               {"result", truth_result_name(v)}});
         }
         nlohmann::json out = {
             {"scene", scene.source},

@@ -15,6 +15,10 @@ nlohmann::json object_result_json(const Scene& scene, std::size_t id, const Occl
         const ObjectVisibility& t = truth->objects[id];
         item["truth"] = truth_result_name(t);
         item["visible_samples"] = t.visible_samples;
+        // DESIGN.md's robust samples, and the samples where only a tie hid it: why a miss or a
+        // false cull may be a tie rather than a real one.
+        item["robust_samples"] = t.robust_samples;
+        item["tie_samples"] = t.tie_samples;
     }
     return item;
 }
