@@ -54,35 +54,25 @@ ClipError clip_error(const std::array<float, 16>& m, const glm::dvec4 model[3]) 
     return e;
 }
 
-// The same in samples for a projected triangle (corners with d = 1/w): NDC x = x / w is off
-// by (ex + |x / w| ew) / w; and how far its w may be off, relatively.
+// The same in samples for a projected triangle (corners with d = 1/w), per vertex: NDC x =
+// x / w is off by (ex + |x / w| ew) / w; w is off by a relative ew d, and so d by d (ew d).
+// Their largest over the vertices pad the coverage and raise the plane-error bound; the
+// raised-vertex bound takes them vertex by vertex.
 struct VertexSlack {
-    double x = 0.0, y = 0.0, w_relative = 0.0;
-};
-
-VertexSlack vertex_slack(const ClipError& e, const detail::ScreenTriangle& t, int sample_width, int sample_height) {
-    VertexSlack s;
-    for (int k = 0; k < 3; ++k) {
-        const double ndc_x = t.p[k].x / (0.5 * sample_width) - 1.0, ndc_y = 1.0 - t.p[k].y / (0.5 * sample_height);
-        s.x = std::max(s.x, (e.x + std::abs(ndc_x) * e.w) * t.d[k] * 0.5 * sample_width);
-        s.y = std::max(s.y, (e.y + std::abs(ndc_y) * e.w) * t.d[k] * 0.5 * sample_height);
-        s.w_relative = std::max(s.w_relative, e.w * t.d[k]);
-    }
-    return s;
-}
-
-// The same per vertex of an oriented triangle: how far it may move on screen, and its 1/w.
-struct PerVertexSlack {
     double x[3], y[3], depth[3];
+    double max_x = 0.0, max_y = 0.0, w_relative = 0.0;
 };
 
-PerVertexSlack per_vertex_slack(const ClipError& e, const OrientedTriangle& t, int sample_width, int sample_height) {
-    PerVertexSlack s;
+VertexSlack vertex_slack(const ClipError& e, const OrientedTriangle& t, int sample_width, int sample_height) {
+    VertexSlack s;
     for (int k = 0; k < 3; ++k) {
         const double ndc_x = t.v[k].x / (0.5 * sample_width) - 1.0, ndc_y = 1.0 - t.v[k].y / (0.5 * sample_height);
         s.x[k] = (e.x + std::abs(ndc_x) * e.w) * t.d[k] * 0.5 * sample_width;
         s.y[k] = (e.y + std::abs(ndc_y) * e.w) * t.d[k] * 0.5 * sample_height;
-        s.depth[k] = t.d[k] * (e.w * t.d[k]);  // d = 1/w with w off by e.w
+        s.depth[k] = t.d[k] * (e.w * t.d[k]);
+        s.max_x = std::max(s.max_x, s.x[k]);
+        s.max_y = std::max(s.max_y, s.y[k]);
+        s.w_relative = std::max(s.w_relative, e.w * t.d[k]);
     }
     return s;
 }
@@ -166,10 +156,10 @@ struct SampleCounts {
 // once more than `tolerated` are visible.
 void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error, const PlaneError& depth_error, double margin,
                     const detail::SubtileView& view, int sample_width, int sample_height, std::uint64_t tolerated, SampleCounts& counts) {
-    const VertexSlack slack = vertex_slack(error, screen, sample_width, sample_height);
     OrientedTriangle tri;
-    const bool has_area = detail::orient_triangle(screen, tri);
-    const double pad_x = slack.x + margin, pad_y = slack.y + margin;
+    const bool has_area = detail::orient_triangle(screen, tri);  // its vertices and depths are set either way
+    const VertexSlack slack = vertex_slack(error, tri, sample_width, sample_height);
+    const double pad_x = slack.max_x + margin, pad_y = slack.max_y + margin;
     const glm::dvec2* v = tri.v;
     const double min_x = std::min({v[0].x, v[1].x, v[2].x}) - pad_x, max_x = std::max({v[0].x, v[1].x, v[2].x}) + pad_x;
     const double min_y = std::min({v[0].y, v[1].y, v[2].y}) - pad_y, max_y = std::max({v[0].y, v[1].y, v[2].y}) + pad_y;
@@ -211,8 +201,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
             std::uint32_t unhidden = detail::subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c));
             if (unhidden && has_area && !raised_ready) {  // the raised-vertex bound, once a triangle needs it
                 raised_ready = true;
-                const PerVertexSlack vertex = per_vertex_slack(error, tri, sample_width, sample_height);
-                depth.raised = detail::raised_vertex_plane(tri, vertex.x, vertex.y, vertex.depth, pad_x, pad_y);
+                depth.raised = detail::raised_vertex_plane(tri, slack.x, slack.y, slack.depth, pad_x, pad_y);
                 unhidden = detail::subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c));
             }
             if (view.sample_depth && unhidden) unhidden = unhidden_by_sample_depth(view, tx, ty, unhidden, depth);

@@ -7,8 +7,9 @@
 namespace homcull::detail {
 namespace {
 
-// Closed intervals of doubles. The rounding of these few operations (2^-53 relative) is
-// covered by the relative 2^-30 the caller's bound adds to E_k.
+// Closed intervals of doubles, their ends rounded to nearest: a few operations, each off by at
+// most 2^-53 of its result. The gradient bound below absorbs that: the determinant's lower
+// end is lowered by 2^-50 of its products, and E_k is raised by a relative 2^-30.
 struct Interval {
     double lo, hi;
 };
@@ -34,8 +35,9 @@ RaisedVertexPlane raised_vertex_plane(const OrientedTriangle& t, const double ve
     const Interval dd2 = around(t.d[2] - t.d[0], vertex_depth[0] + vertex_depth[2]);
     // Its gradient by Cramer's rule: (dd1 e2y - dd2 e1y, dd2 e1x - dd1 e2x) / (e1x e2y - e1y e2x).
     const Interval det = e1x * e2y - e1y * e2x;
-    if (!(det.lo > 0.0 || det.hi < 0.0)) return plane;  // the exact triangle may have no area on screen
-    const double min_det = std::min(std::abs(det.lo), std::abs(det.hi));
+    const double min_det = std::min(std::abs(det.lo), std::abs(det.hi)) -
+                           0x1.0p-50 * (magnitude(e1x) * magnitude(e2y) + magnitude(e1y) * magnitude(e2x));
+    if (!(det.lo > 0.0 || det.hi < 0.0) || !(min_det > 0.0)) return plane;  // the exact triangle may have no area on screen
     const double gx = magnitude(dd1 * e2y - dd2 * e1y) / min_det, gy = magnitude(dd2 * e1x - dd1 * e2x) / min_det;
     if (!std::isfinite(gx) || !std::isfinite(gy)) return plane;
 

@@ -28,6 +28,8 @@ struct RaisedVertexPlane {
     double outside = 0.0;  // added for samples within the pad outside the triangle
 
     // The bound at sample centre (column + 0.5, row + 0.5), before the caller's final raise.
+    // `outside` is added everywhere, inside the triangle too: one affine function plus a
+    // constant keeps a rectangle's largest value at a corner.
     double at(int column, int row) const { return d0 + dzdx * (column + 0.5 - x0) + dzdy * (row + 0.5 - y0) + outside; }
 };
 

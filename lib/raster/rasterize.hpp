@@ -124,7 +124,8 @@ struct OrientedTriangle {
     bool shared[3];
     double area2;
 };
-// False (and `out` unusable) when the triangle's area is zero.
+// False when the triangle's area is zero: `out` then holds its vertices and depths in input
+// order, but no usable area or orientation.
 bool orient_triangle(const ScreenTriangle& triangle, OrientedTriangle& out);
 
 // The three edge functions of an oriented triangle (see TriangleEdges), with the shared flags
