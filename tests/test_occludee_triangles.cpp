@@ -276,6 +276,40 @@ TEST(OccludeeTriangles, NeverHidesATriangleSeenAtASample) {
     EXPECT_EQ(hidden_by_test, hidden_by_buffer);
 }
 
+// Past its first 16 triangles an occludee is fetched and transformed 16 at a time: the
+// answers and counts must not depend on where the scan starts (it wraps at the end, batches
+// stop there), and a bad index or a non-finite vertex anywhere makes it visible.
+TEST(OccludeeTriangles, LongOccludeesGiveTheSameAnswerFromEveryStart) {
+    const OcclusionBuffer buffer = wall_at(10.0f);
+    Soup hidden, partly_seen;
+    for (int k = 0; k < 45; ++k) {  // a strip of small triangles behind the wall, a few outside the view
+        const float x = -1.4f + 0.06f * float(k);
+        hidden.add_flat(x, -0.3f, x + 0.05f, -0.3f, x + 0.02f, 0.3f, 20.0f);
+        partly_seen.add_flat(x, -0.3f, x + 0.05f, -0.3f, x + 0.02f, 0.3f, k == 37 ? 5.0f : 20.0f);  // one in front
+    }
+    const OcclusionBuffer::TriangleTest reference = buffer.test_triangles(hidden.input());
+    ASSERT_EQ(reference.visibility, Visibility::occluded);
+    for (std::size_t start = 0; start < 45; ++start) {
+        const OcclusionBuffer::TriangleTest r = buffer.test_triangles(hidden.input(), 0, start);
+        EXPECT_EQ(r.visibility, Visibility::occluded) << start;
+        EXPECT_EQ(r.samples, reference.samples) << start;
+        const OcclusionBuffer::TriangleTest seen = buffer.test_triangles(partly_seen.input(), 0, start);
+        EXPECT_EQ(seen.visibility, Visibility::visible) << start;
+        EXPECT_EQ(seen.deciding_triangle, 37u) << start;
+    }
+    for (std::size_t bad = 0; bad < 45; bad += 11) {
+        Soup with_nan = hidden;
+        with_nan.xyw[9 * bad + 4] = std::numeric_limits<float>::quiet_NaN();
+        EXPECT_EQ(buffer.test_triangles(with_nan.input(), 0, 3).visibility, Visibility::visible) << bad;
+        std::vector<std::uint32_t> indices(3 * 45);
+        for (std::uint32_t i = 0; i < indices.size(); ++i) indices[i] = i;
+        indices[3 * bad + 1] = 1000;  // out of range
+        TriangleInput in = hidden.input();
+        in.indices = indices.data();
+        EXPECT_EQ(buffer.test_triangles(in, 0, 3).visibility, Visibility::visible) << bad;
+    }
+}
+
 // A floor seen at a grazing angle, d = 1/w = -y / 2 on screen (NDC y), and a long thin
 // triangle running away from the eye at a relative depth `gap` behind it (w scaled by 1 + gap;
 // negative: in front): a wall's top face flush with a floor, as in the FZK house. The bound
