@@ -202,6 +202,15 @@ long double edge(long double ax, long double ay, long double bx, long double by,
     return (bx - ax) * (py - ay) - (by - ay) * (px - ax);
 }
 
+// The barycentric coordinates of (px, py) in the screen triangle (sx, sy), twice whose signed
+// area is `area`.
+void barycentrics(const long double sx[3], const long double sy[3], long double area, long double px, long double py, long double& l0,
+                  long double& l1, long double& l2) {
+    l0 = edge(sx[1], sy[1], sx[2], sy[2], px, py) / area;
+    l1 = edge(sx[2], sy[2], sx[0], sy[0], px, py) / area;
+    l2 = 1 - l0 - l1;
+}
+
 // Random occluders and random occludee triangles: whenever the occludee is at or in front of
 // the buffer's conservative depth at a sample centre inside it (exact, in long double, from the
 // floats given), test_triangles must not hide it. And it should hide most of those the buffer
@@ -246,9 +255,8 @@ TEST(OccludeeTriangles, NeverHidesATriangleSeenAtASample) {
                 for (int j = 0; j < sh; ++j)
                     for (int i = 0; i < sw; ++i) {
                         const long double px = i + 0.5L, py = j + 0.5L;
-                        const long double l0 = edge(sx[1], sy[1], sx[2], sy[2], px, py) / area;
-                        const long double l1 = edge(sx[2], sy[2], sx[0], sy[0], px, py) / area;
-                        const long double l2 = 1 - l0 - l1;
+                        long double l0, l1, l2;
+                        barycentrics(sx, sy, area, px, py, l0, l1, l2);
                         const long double occluder_w = bound_w[std::size_t(j) * std::size_t(sw) + std::size_t(i)];
                         if (px >= box_x0 && px <= box_x1 && py >= box_y0 && py <= box_y1)
                             hidden_with_room = hidden_with_room && occluder_w * 1.01L < nearest_w;
@@ -398,10 +406,8 @@ TEST(OccludeeTriangles, NeverHidesWhatTheExactMatrixShows) {
             if (area == 0) return closest;
             for (int j = 0; j < sh; ++j)
                 for (int i = 0; i < sw; ++i) {
-                    const long double px = i + 0.5L, py = j + 0.5L;
-                    const long double l0 = edge(sx[1], sy[1], sx[2], sy[2], px, py) / area;
-                    const long double l1 = edge(sx[2], sy[2], sx[0], sy[0], px, py) / area;
-                    const long double l2 = 1 - l0 - l1;
+                    long double l0, l1, l2;
+                    barycentrics(sx, sy, area, i + 0.5L, j + 0.5L, l0, l1, l2);
                     if (l0 < 0 || l1 < 0 || l2 < 0) continue;
                     const long double occludee_w = 1 / (l0 * d[0] + l1 * d[1] + l2 * d[2]);
                     closest = std::min(closest, occludee_w / (long double)bound_w[std::size_t(j) * std::size_t(sw) + std::size_t(i)]);
