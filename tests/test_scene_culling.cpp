@@ -183,9 +183,9 @@ std::vector<WalkTotals> walk_every_strategy(const Scene& scene, const std::vecto
         const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
         for (std::size_t c = 0; c < cullers.size(); ++c) {
             const WalkFrame f = measure_walk_frame(scene, cullers[c], camera, &truth, answers);
-            totals[c].false_culls += f.false_culls;
-            totals[c].hidden += f.hidden_in_frustum;
-            totals[c].missed += f.missed_culls;
+            totals[c].false_culls += f.truth.false_culls;
+            totals[c].hidden += f.truth.hidden_in_frustum;
+            totals[c].missed += f.truth.missed_culls();
             totals[c].objects_tested += f.work.objects_tested;
             totals[c].occluder_triangles += f.work.occluder_triangles;
             totals[c].occluder_lods += f.work.occluder_lods;

@@ -276,10 +276,10 @@ TEST(PolygonSoup, BunnyCellsHideItsBackWithoutFalseCulls) {
         const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
         const WalkFrame f = measure_walk_frame(scene, culler, camera, &truth, answers);
         ++views;
-        hidden += f.hidden_in_frustum;
-        culled += f.hidden_in_frustum - f.missed_culls;
-        false_culls += f.false_culls;
-        EXPECT_EQ(f.false_culls, 0u) << "view " << k;
+        hidden += f.truth.hidden_in_frustum;
+        culled += f.truth.hidden_in_frustum - f.truth.missed_culls();
+        false_culls += f.truth.false_culls;
+        EXPECT_EQ(f.truth.false_culls, 0u) << "view " << k;
     }
     std::printf("[ soup     ] bunny in %zu cells, %zu views: culled %zu of %zu hidden cells, %zu false culls\n",
                 scene.objects.size(), views, culled, hidden, false_culls);

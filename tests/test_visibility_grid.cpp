@@ -229,10 +229,10 @@ TEST(VisibilityGrid, BakedRankingBeatsDistanceOnTheCastle) {
             const TruthResult& truth = truths[k / 4];
             const WalkFrame d = measure_walk_frame(scene, by_distance, path.frames[k], &truth, answers);
             const WalkFrame b = measure_walk_frame(scene, baked, path.frames[k], &truth, answers);
-            hidden += d.hidden_in_frustum;
-            culled_by_distance += d.hidden_in_frustum - d.missed_culls;
-            culled_baked += b.hidden_in_frustum - b.missed_culls;
-            false_culls += d.false_culls + b.false_culls;
+            hidden += d.truth.hidden_in_frustum;
+            culled_by_distance += d.truth.hidden_in_frustum - d.truth.missed_culls();
+            culled_baked += b.truth.hidden_in_frustum - b.truth.missed_culls();
+            false_culls += d.truth.false_culls + b.truth.false_culls;
             EXPECT_LE(b.work.occluder_triangles, triangles);
         }
         std::printf("[ baked    ] castle, %zu occluder triangles: distance culls %zu, baked %zu of %zu hidden\n", triangles,

@@ -17,6 +17,24 @@ void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler
     tally_answers(scene, truth, answers, camera, tally);
 }
 
+CullingTally& CullingTally::operator+=(const CullingTally& o) {
+    views += o.views;
+    visible += o.visible;
+    hidden_in_frustum += o.hidden_in_frustum;
+    culled_hidden += o.culled_hidden;
+    hidden_through_ties += o.hidden_through_ties;
+    culled_through_ties += o.culled_through_ties;
+    false_culls += o.false_culls;
+    robust_false_culls += o.robust_false_culls;
+    most_samples_falsely_culled = std::max(most_samples_falsely_culled, o.most_samples_falsely_culled);
+    false_cull_reports.insert(false_cull_reports.end(), o.false_cull_reports.begin(), o.false_cull_reports.end());
+    total_ms.select_ms += o.total_ms.select_ms;
+    total_ms.render_ms += o.total_ms.render_ms;
+    total_ms.maps_ms += o.total_ms.maps_ms;
+    total_ms.test_ms += o.total_ms.test_ms;
+    return *this;
+}
+
 void tally_answers(const Scene& scene, const TruthResult& truth, const std::vector<OccludeeAnswer>& answers, const Camera& camera,
                    CullingTally& tally) {
     ++tally.views;

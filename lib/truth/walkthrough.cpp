@@ -26,32 +26,13 @@ WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Came
         f.triangles.after_frustum += in_frustum ? n : 0;
         f.objects.after_occlusion += kept;
         f.triangles.after_occlusion += kept ? n : 0;
-        if (!truth || object.world_bounds.empty()) continue;
-        const ObjectVisibility& t = truth->objects[id];
-        if (t.visible_samples > 0) {
+        if (truth && !object.world_bounds.empty() && truth->objects[id].visible_samples > 0) {
             f.objects.exactly_visible += 1;
             f.triangles.exactly_visible += n;
-            f.false_culls += !kept;
-            f.robust_false_culls += !kept && t.robust_samples > 0;
-        } else if (t.in_frustum) {
-            f.hidden_in_frustum += 1;
-            f.missed_culls += kept;
-            f.hidden_through_ties += t.tie_samples > 0;
-            f.missed_through_ties += kept && t.tie_samples > 0;
         }
     }
+    if (truth) tally_answers(scene, *truth, answers, camera, f.truth);
     return f;
-}
-
-void add_to_tally(const WalkFrame& f, CullingTally& tally) {
-    ++tally.views;
-    tally.visible += f.objects.exactly_visible;
-    tally.hidden_in_frustum += f.hidden_in_frustum;
-    tally.culled_hidden += f.hidden_in_frustum - f.missed_culls;
-    tally.hidden_through_ties += f.hidden_through_ties;
-    tally.culled_through_ties += f.hidden_through_ties - f.missed_through_ties;
-    tally.false_culls += f.false_culls;
-    tally.robust_false_culls += f.robust_false_culls;
 }
 
 }  // namespace homcull

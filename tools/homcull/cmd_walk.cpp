@@ -54,9 +54,9 @@ std::vector<std::pair<const char*, double>> frame_figures(const WalkFrame& f) {
     if (f.has_truth) {
         v.insert(v.end(), {{"objects_exactly_visible", double(f.objects.exactly_visible)},
                            {"triangles_exactly_visible", double(f.triangles.exactly_visible)},
-                           {"false_culls", double(f.false_culls)},
-                           {"hidden_in_frustum", double(f.hidden_in_frustum)},
-                           {"missed_culls", double(f.missed_culls)},
+                           {"false_culls", double(f.truth.false_culls)},
+                           {"hidden_in_frustum", double(f.truth.hidden_in_frustum)},
+                           {"missed_culls", double(f.truth.missed_culls())},
                            {"truth_ms", f.truth_ms}});
     }
     return v;
@@ -116,8 +116,8 @@ void run_walk(const WalkCommandOptions& o) {
                        k, f.objects.total, f.objects.after_frustum, f.objects.after_occlusion,
                        f.has_truth ? fmt::format(" / {} visible", f.objects.exactly_visible) : "", f.work.occluder_triangles,
                        f.ms.select_ms + f.ms.render_ms + f.ms.maps_ms + f.ms.test_ms, f.ms.render_ms, f.ms.maps_ms, f.ms.test_ms,
-                       f.has_truth ? fmt::format("; false culls {}, missed {} of {} hidden", f.false_culls, f.missed_culls,
-                                                 f.hidden_in_frustum)
+                       f.has_truth ? fmt::format("; false culls {}, missed {} of {} hidden", f.truth.false_culls, f.truth.missed_culls(),
+                                                 f.truth.hidden_in_frustum)
                                    : "");
         }
         if (!o.quiet) print_progress(k + 1, path.frames.size());
@@ -137,7 +137,7 @@ void run_walk(const WalkCommandOptions& o) {
     for (std::size_t i = 0; i < names.size(); ++i)
         summary[names[i].first] = {{"mean", sum[i] / double(measured.size())}, {"max", most[i]}};
     CullingTally tally;
-    for (const WalkFrame& f : measured) add_to_tally(f, tally);
+    for (const WalkFrame& f : measured) tally += f.truth;
     const double efficiency = tally.efficiency();
     if (rays) {
         summary["total_false_culls"] = tally.false_culls;

@@ -55,7 +55,7 @@ std::vector<std::string> write_walk_report(const std::string& dir, const std::st
         {"after occlusion culling", 0xd62728, per_frame(frames, [](const WalkFrame& f) { return double(f.objects.after_occlusion); })},
         {"exactly visible", 0x2ca02c,
          per_frame(frames, [&](const WalkFrame& f) { return truth ? double(f.objects.exactly_visible) : nan; })},
-        {"false culls", 0xff00ff, per_frame(frames, [&](const WalkFrame& f) { return truth ? double(f.false_culls) : nan; })}};
+        {"false culls", 0xff00ff, per_frame(frames, [&](const WalkFrame& f) { return truth ? double(f.truth.false_culls) : nan; })}};
     LinePlot times{"Time per frame", "ms", {}, 960, 360};
     times.series = {
         {"select", 0x9467bd, per_frame(frames, [](const WalkFrame& f) { return f.ms.select_ms; })},

@@ -31,6 +31,8 @@ struct CullingTally {
         const std::size_t hidden = hidden_in_frustum - hidden_through_ties;
         return hidden ? double(culled_hidden - culled_through_ties) / double(hidden) : 1.0;
     }
+    // Adds another tally's views (a walk sums its frames' tallies).
+    CullingTally& operator+=(const CullingTally& o);
 };
 
 // Tallies one view's answers (answers[id] per object) against its ground truth.

@@ -22,12 +22,9 @@ struct CullingGraphCounts {
 struct WalkFrame {
     CullingGraphCounts objects, triangles;
     bool has_truth = false;
-    std::size_t false_culls = 0;        // seen, yet culled
-    std::size_t robust_false_culls = 0; // of those, seen by a robust sample
-    std::size_t hidden_in_frustum = 0;  // in the frustum, seen by no sample
-    std::size_t missed_culls = 0;       // of those, kept
-    std::size_t hidden_through_ties = 0;  // hidden ones with tie samples (CullingTally)
-    std::size_t missed_through_ties = 0;  // of those, kept
+    // The answers against ground truth (tally_answers, one view; empty without truth): false
+    // and missed culls, ties. Its stage times are in `ms`, not here.
+    CullingTally truth;
     SceneCullTimings ms;
     SceneCullWork work;
     double truth_ms = 0.0;
@@ -37,9 +34,5 @@ struct WalkFrame {
 // the same camera at the culler's display resolution) also against ground truth.
 WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Camera& camera, const TruthResult* truth,
                              std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
-
-// Adds a measured frame's counts against ground truth to a tally (one view), so that walks
-// report efficiency with CullingTally's definitions.
-void add_to_tally(const WalkFrame& frame, CullingTally& tally);
 
 }  // namespace homcull
