@@ -313,6 +313,10 @@ TEST(Dumps, OverlayColoursEachAnswerAndShowsFalseCullsInMagenta) {
     EXPECT_GT(count([](int r, int g, int b) { return r == 255 && g == 224 && b == 0; }), 0u) << "the frustum, yellow";
     EXPECT_GT(count([](int r, int g, int b) { return b > r + 40 && b > g; }), 0u) << "occluders, blue";
     EXPECT_GT(count([](int r, int g, int b) { return r > 100 && g == 0 && r == b; }), 0u) << "the false cull, magenta";
+    // Ids that are not objects are an error, as for the overlay.
+    const std::vector<std::uint32_t> not_an_object = {std::uint32_t(wrong.size())};
+    EXPECT_THROW(render_answer_map(rays, scene.bounds(), city_camera(), display, wrong, not_an_object, {}, 400), Error);
+    EXPECT_THROW(render_answer_map(rays, scene.bounds(), city_camera(), display, wrong, {}, not_an_object, 400), Error);
 }
 
 TEST(Dumps, CullDumpWritesTheMapsAndTheOverlay) {
