@@ -188,11 +188,16 @@ TEST(Golden, OneChangedReferencePixelFailsWithADifferenceImage) {
     write_maps_exr(parts, dir + "/reference.exr");
     EXPECT_TRUE(compare_exr(dir + "/reference.exr", dir + "/current.exr", dir + "/same").same);
     // One pixel of one level: opacity.L2 at (5, 3), 0.25 more or less.
+    bool changed = false;
     for (DumpPart& part : parts)
         if (part.name == "opacity.L2") {
+            ASSERT_GT(part.width, 5);
+            ASSERT_GT(part.height, 3);
             float& v = part.values[std::size_t(3 * part.width + 5)];
             v = v > 0.5f ? v - 0.25f : v + 0.25f;
+            changed = true;
         }
+    ASSERT_TRUE(changed) << "the dump has no part opacity.L2";
     write_maps_exr(parts, dir + "/reference.exr");
     const Comparison r = compare_exr(dir + "/reference.exr", dir + "/current.exr", dir + "/changed");
     EXPECT_FALSE(r.same);

@@ -176,12 +176,6 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
 namespace homcull {
 namespace {
 
-bool same_stats(const RasterStats& a, const RasterStats& b) {
-    return a.triangles_in == b.triangles_in && a.invalid == b.invalid && a.outside == b.outside && a.near_clipped == b.near_clipped &&
-           a.too_large == b.too_large && a.backface_culled == b.backface_culled && a.degenerate == b.degenerate &&
-           a.rasterized == b.rasterized && a.subtiles_touched == b.subtiles_touched;
-}
-
 // The setup front end decides batches of triangles in SIMD lanes (invalid, outside,
 // degenerate, backfacing) and hands the rest to the one-triangle setup; indexed input with no
 // more vertices than triangles first transforms every vertex once, with its outcode. Every
@@ -256,7 +250,7 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
     EXPECT_GT(all.degenerate, 0u);
     EXPECT_GT(all.rasterized, 1000u);
     for (std::size_t k = 0; k < reference.size(); k += 2) {  // with and without the vertex cache
-        EXPECT_TRUE(same_stats(reference[k].stats(), reference[k + 1].stats())) << "buffer " << k;
+        EXPECT_TRUE(reference[k].stats() == reference[k + 1].stats()) << "buffer " << k;
         EXPECT_TRUE(same_subtiles(reference[k], reference[k + 1])) << "buffer " << k;
     }
     for (const std::string& isa : available_isas()) {
@@ -264,7 +258,7 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
         std::vector<OcclusionBuffer> buffers;
         render_all(buffers);
         for (std::size_t k = 0; k < buffers.size(); ++k) {
-            EXPECT_TRUE(same_stats(reference[k].stats(), buffers[k].stats())) << isa << ", buffer " << k;
+            EXPECT_TRUE(reference[k].stats() == buffers[k].stats()) << isa << ", buffer " << k;
             EXPECT_TRUE(same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
         }
     }
@@ -317,13 +311,13 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
     EXPECT_GT(reference.stats().rasterized, 10000u);
     EXPECT_GT(reference.stats().outside + reference.stats().backface_culled, 10000u);
     const OcclusionBuffer without_cache = render(kVertices + kUnused, {});  // more vertices than triangles: no cache
-    EXPECT_TRUE(same_stats(reference.stats(), without_cache.stats()));
+    EXPECT_TRUE(reference.stats() == without_cache.stats());
     EXPECT_TRUE(same_subtiles(reference, without_cache));
     for (const std::string& isa : available_isas()) {
         select_isa(isa);
         for (const bool threads : {false, true}) {
             const OcclusionBuffer b = render(kVertices, threads ? tbb : ParallelFor{});
-            EXPECT_TRUE(same_stats(reference.stats(), b.stats())) << isa << (threads ? ", TBB" : ", serial");
+            EXPECT_TRUE(reference.stats() == b.stats()) << isa << (threads ? ", TBB" : ", serial");
             EXPECT_TRUE(same_subtiles(reference, b)) << isa << (threads ? ", TBB" : ", serial");
         }
     }

@@ -107,14 +107,6 @@ detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) 
     return {planes, sample_width_, sample_height_, row_begin, row_end, detail::selected_rows_kernel()};
 }
 
-// Sets up triangles [begin, end) of the input and hands each triangle of their clipped fans
-// that covers a sample's bounding box to `emit`, in input order.
-template <typename Emit>
-void OcclusionBuffer::setup_for_raster(const TriangleInput& in, const detail::VertexClip* cache, std::size_t begin, std::size_t end,
-                                       RasterStats& stats, Emit&& emit) const {
-    detail::setup_triangle_range(in, cache, begin, end, config_.near_w, config_.edge_margin, sample_width_, sample_height_, stats, emit);
-}
-
 bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache) {
     if (!detail::use_vertex_cache(in)) return false;
     const std::size_t plane = in.vertex_count + detail::kVertexClipPadding;
@@ -161,7 +153,7 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t touched = 0;
     RasterStats stats;
-    setup_for_raster(in, cache, 0, in.triangle_count, stats,
+    detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, stats,
                      [&](const detail::RasterTriangle& tri) { touched += target.kernel(target, tri); });
     stats.subtiles_touched = touched;
     stats_ += stats;
@@ -188,7 +180,9 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
         for (auto& bin : chunk.bins) bin.clear();
         const std::size_t end = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
-        j.self->setup_for_raster(*j.in, j.cache, c * kChunkTriangles, end, chunk.stats, [&](const detail::RasterTriangle& tri) {
+        const OcclusionBuffer& b = *j.self;
+        detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end, b.config_.near_w, b.config_.edge_margin, b.sample_width_,
+                                     b.sample_height_, chunk.stats, [&](const detail::RasterTriangle& tri) {
             for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
                 chunk.bins[std::size_t(band)].push_back(tri);
         });

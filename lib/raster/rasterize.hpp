@@ -42,7 +42,7 @@ struct SubtilePlanes {
     std::uint32_t* mask;
     std::uint32_t* covered;
     std::size_t stride;
-    float* sample_depth;        // per sample, rows of sample_width; null when not kept
+    float* sample_depth;        // per sample, rows sample_stride apart (sample_width padded by kMaxSimdLanes); null when not kept
     std::size_t sample_stride;
 };
 

@@ -54,6 +54,8 @@ std::uint8_t outcode(const glm::dvec4& clip, double near_w);
 
 // Every vertex of an input in clip space, as planes of x, y, z, w, and its outcode. Each plane
 // has kVertexClipPadding elements past the last vertex, for whole-vector stores.
+// TransformVertices writes whole blocks of at most this many vertices (its kBlock and vectors of at
+// most 8 doubles): a caller splitting the vertices into tasks keeps task sizes multiples of it.
 constexpr std::size_t kVertexClipPadding = 8;
 struct VertexClip {
     double *x, *y, *z, *w;

@@ -62,6 +62,8 @@ void TransformVertices(const TriangleInput& in, double near_w, std::size_t begin
     const D d;
     const hn::Rebind<float, D> df;
     constexpr int kBlock = 8;
+    static_assert(kBlock <= int(kVertexClipPadding) && hn::MaxLanes(D()) <= kVertexClipPadding,
+                  "whole-block stores past a task's end stay within the padding (occlusion_buffer.cpp's tasks)");
     const int lanes = int(hn::Lanes(d));
     const V near = hn::Set(d, near_w), one = hn::Set(d, 1.0);
     std::size_t v0 = begin;

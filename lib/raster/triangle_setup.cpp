@@ -12,14 +12,15 @@
 namespace homcull::detail {
 
 void check_triangle_input(const TriangleInput& in, const char* caller) {
-    const std::string name(caller);
-    if (in.position_components != 3 && in.position_components != 4) throw Error(name + ": positions must have 3 or 4 components");
+    // The message is built only when it is thrown: test_triangles checks every occludee of a frame.
+    const auto fail = [caller](const char* why) { throw Error(std::string(caller) + ": " + why); };
+    if (in.position_components != 3 && in.position_components != 4) fail("positions must have 3 or 4 components");
     if (!in.positions || in.position_stride < sizeof(float) * std::size_t(in.position_components))
-        throw Error(name + ": positions missing, or stride smaller than one position");
+        fail("positions missing, or stride smaller than one position");
     if (!in.indices && in.vertex_count / 3 < in.triangle_count)  // (no overflow for any count)
-        throw Error(name + ": without indices, vertex_count must be at least 3 * triangle_count");
+        fail("without indices, vertex_count must be at least 3 * triangle_count");
     if (!in.indices && in.triangle_count > std::size_t(std::numeric_limits<std::uint32_t>::max()) / 3)
-        throw Error(name + ": without indices, at most 2^32 / 3 triangles per call (vertex numbers are 32-bit, as indices)");
+        fail("without indices, at most 2^32 / 3 triangles per call (vertex numbers are 32-bit, as indices)");
 }
 
 bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3]) {

@@ -85,6 +85,11 @@ struct RasterStats {
         subtiles_touched += o.subtiles_touched;
         return *this;
     }
+    bool operator==(const RasterStats& o) const {
+        return triangles_in == o.triangles_in && invalid == o.invalid && outside == o.outside && near_clipped == o.near_clipped &&
+               too_large == o.too_large && backface_culled == o.backface_culled && degenerate == o.degenerate &&
+               rasterized == o.rasterized && subtiles_touched == o.subtiles_touched;
+    }
 };
 
 // Vertex input as engines have it: positions (x, y, z, or x, y, z, w as floats) every
@@ -156,8 +161,11 @@ public:
     // rows, then each band is rasterized in submission order (so every subtile sees the same
     // sequence of triangles whatever the threads). Scratch memory (the per-chunk band bins) is
     // reused and only grows, so a frame allocates only when a bin outgrows every earlier frame's:
-    // after a few frames of a walkthrough, rarely. Statistics accumulate until
-    // clear(). Not thread-safe with itself or with tests.
+    // after a few frames of a walkthrough, rarely. Indexed input with no more vertices than
+    // triangles has every one of its vertex_count positions read and transformed once (so
+    // vertex_count must not overstate the positions), into scratch of 33 bytes a vertex (up to
+    // 4M vertices) that also only grows and stays allocated with the buffer. Statistics
+    // accumulate until clear(). Not thread-safe with itself or with tests.
     void render(const TriangleInput& input, const ParallelFor& parallel = {});
 
     // Occludee tests. Thread-safe with each other (no render in flight).
@@ -257,9 +265,6 @@ private:
     // Rendering (occlusion_buffer.cpp): without a job system straight through, with one
     // binned by bands of subtile rows; the same bits either way.
     detail::RasterTarget raster_target(int row_begin, int row_end);
-    template <typename Emit>
-    void setup_for_raster(const TriangleInput& in, const detail::VertexClip* cache, std::size_t begin, std::size_t end, RasterStats& stats,
-                          Emit&& emit) const;
     void render_serial(const TriangleInput& in, const detail::VertexClip* cache);
     void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
