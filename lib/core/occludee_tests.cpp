@@ -160,25 +160,17 @@ Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_ma
 }
 
 void OcclusionBuffer::test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const {
-    const detail::CoarseRectKernel coarse = detail::selected_coarse_rect_kernel();
-    if (!coarse) {  // the scalar reference
+    const detail::RectBlockKernel block = detail::selected_rect_block_kernel();
+    if (!block) {  // the scalar reference
         for (std::size_t k = 0; k < count; ++k)
             results[k] = test_rect(rects[k].ndc_min_x, rects[k].ndc_min_y, rects[k].ndc_max_x, rects[k].ndc_max_y, rects[k].w_min);
         return;
     }
     const detail::CoarseRectView view{pyramid_.data(), level_offset_.data(), level_width_.data(), int(levels_.size()),
                                       sample_width_,   sample_height_,       config_.near_w};
-    const detail::RectScanKernel scan = detail::selected_rect_scan_kernel();
     const detail::SubtileView subtiles = subtile_view();
-    constexpr std::size_t kBlock = 256;  // on the stack: no allocation
-    std::uint8_t codes[kBlock];
-    detail::RectQuery queries[kBlock];
-    for (std::size_t base = 0; base < count; base += kBlock) {
-        const std::size_t n = std::min(kBlock, count - base);
-        coarse(view, rects + base, n, codes, queries);
-        for (std::size_t k = 0; k < n; ++k)
-            results[base + k] = codes[k] != detail::kUndecided ? Visibility(codes[k]) : scan(subtiles, queries[k]);
-    }
+    for (std::size_t base = 0; base < count; base += detail::kRectBlock)
+        block(view, subtiles, rects + base, std::min(detail::kRectBlock, count - base), results + base);
 }
 
 void OcclusionBuffer::test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& m, Visibility* results) const {

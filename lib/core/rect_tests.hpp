@@ -106,14 +106,16 @@ ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w);
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,
                    ScreenRect& rect, Visibility& decided);
 
-// results[k] for rectangle k: a Visibility the coarse stage decided, or kUndecided.
+// The coarse stage's code for a rectangle it leaves to the exact stage.
 constexpr std::uint8_t kUndecided = 0xFF;
 
-// The coarse stage for the rectangles [0, count), in SIMD lanes for the selected instruction
-// set; for the undecided ones, queries[k] is what prepare() computes. Null when the scalar
-// reference is selected.
-using CoarseRectKernel = void (*)(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, std::uint8_t* results,
-                                  RectQuery* queries);
-CoarseRectKernel selected_coarse_rect_kernel();
+// The batched tests of rectangles [0, count), count <= kRectBlock, for the selected instruction
+// set: the coarse stage in SIMD lanes (repeating prepare() and test_rect's coarse check), then
+// the exact scan (RectScan) of the rectangles it leaves open; the answers of test_rect. Null
+// when the scalar reference is selected.
+constexpr std::size_t kRectBlock = 256;
+using RectBlockKernel = void (*)(const CoarseRectView& view, const SubtileView& subtiles, const ScreenRect* rects, std::size_t count,
+                                 Visibility* results);
+RectBlockKernel selected_rect_block_kernel();
 
 }  // namespace homcull::detail

@@ -1,9 +1,12 @@
-// The coarse stage of batched rectangle tests with one rectangle per SIMD lane, compiled per
-// instruction set with Google Highway and chosen at run time. Each lane repeats what
-// OcclusionBuffer::prepare and the coarse check at the start of OcclusionBuffer::test_rect do
-// for its rectangle, with the same double and float operations, so it decides exactly the
-// rectangles they decide there, with the same answers; the others (kUndecided) go on to
-// RectScan with the query computed here. On S1 about three rectangles in four are decided here.
+// The batched rectangle tests (OcclusionBuffer::test_rects) and the exact scan of one
+// rectangle, compiled per instruction set with Google Highway and chosen at run time.
+// - The coarse stage runs one rectangle per SIMD lane. Each lane repeats what
+//   OcclusionBuffer::prepare and the coarse check at the start of OcclusionBuffer::test_rect do
+//   for its rectangle, with the same double and float operations, so it decides exactly the
+//   rectangles they decide there, with the same answers. On S1 about three in four are decided
+//   here.
+// - The others are packed with the query computed here and go on to the exact scan (ScanRect),
+//   which test_rect also uses (RectScan).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "core/rect_tests_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -20,8 +23,20 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, std::uint8_t* results,
-                     RectQuery* queries) {
+// The open rectangles of a block, packed by the coarse stage: their positions in the block
+// and their queries, field by field (vector stores; CompressStore may write a whole vector
+// past the last one, hence the padding).
+struct OpenRects {
+    static constexpr std::size_t kPadding = 16;
+    std::int32_t index[kRectBlock + kPadding], i0[kRectBlock + kPadding], i1[kRectBlock + kPadding], j0[kRectBlock + kPadding],
+        j1[kRectBlock + kPadding];
+    float d_near[kRectBlock + kPadding];
+};
+
+// The coarse stage for rectangles [0, count), count <= kRectBlock: results[k] for the ones it
+// decides, and the others packed into `open`; returns how many are open.
+HWY_INLINE std::size_t CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, Visibility* results,
+                                       OpenRects& open_rects) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<double, 8> dd;  // one rectangle per double lane
     const hn::Rebind<float, decltype(dd)> df;
@@ -38,8 +53,21 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
     const VI code_visible = hn::Set(di, int(Visibility::visible)), code_occluded = hn::Set(di, int(Visibility::occluded));
     const VI code_view_culled = hn::Set(di, int(Visibility::view_culled)), code_undecided = hn::Set(di, kUndecided);
 
-    HWY_ALIGN std::int32_t code_out[8], i0_out[8], i1_out[8], j0_out[8], j1_out[8];
-    HWY_ALIGN float d_near_out[8];
+    // The lanes' answers into results[base, base + n): one vector store for a whole vector.
+    static_assert(sizeof(Visibility) == 1, "answers are bytes");
+    const hn::Rebind<std::uint8_t, decltype(di)> d8;
+    const auto store_codes = [&](VI code, std::size_t base, std::size_t n) {
+        const auto bytes = hn::DemoteTo(d8, code);  // codes are 0..2 and kUndecided: exact
+        if (n == lanes) {
+            hn::StoreU(bytes, d8, reinterpret_cast<std::uint8_t*>(results + base));
+            return;
+        }
+        HWY_ALIGN std::uint8_t out[8];
+        hn::Store(bytes, d8, out);
+        for (std::size_t k = 0; k < n; ++k) results[base + k] = Visibility(out[k]);
+    };
+    std::size_t open_count = 0;
+    const VI lane_index = hn::Iota(di, 0);  // once: Highway's Iota goes through memory
     static_assert(sizeof(ScreenRect) == 5 * sizeof(float), "rectangles are 5 packed floats");
     const VI field_stride = hn::Mul(hn::Iota(di, 0), hn::Set(di, 5));  // lane k reads rectangle k's fields
     for (std::size_t base = 0; base < count; base += lanes) {
@@ -93,8 +121,7 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
         // The coarse check, for the lanes still undecided (the others read cell 0).
         const auto open = hn::Eq(code, code_undecided);
         if (hn::AllFalse(di, open)) {
-            hn::Store(code, di, code_out);
-            for (std::size_t k = 0; k < n; ++k) results[base + k] = std::uint8_t(code_out[k]);
+            store_codes(code, base, n);
             continue;
         }
         const VI tx0 = hn::IfThenElseZero(open, hn::ShiftRight<3>(i0)), tx1 = hn::IfThenElseZero(open, hn::ShiftRight<3>(i1));
@@ -114,14 +141,18 @@ void CoarseRectTests(const CoarseRectView& view, const ScreenRect* rects, std::s
         const VF coarse = hn::Min(hn::Min(hn::GatherIndex(df, view.pyramid, hn::Add(row0, cx0)), hn::GatherIndex(df, view.pyramid, hn::Add(row0, cx1))),
                                   hn::Min(hn::GatherIndex(df, view.pyramid, hn::Add(row1, cx0)), hn::GatherIndex(df, view.pyramid, hn::Add(row1, cx1))));
         code = hn::IfThenElse(hn::And(open, hn::RebindMask(di, hn::Lt(d_near, coarse))), code_occluded, code);
-        hn::Store(code, di, code_out);
-        hn::Store(i0, di, i0_out), hn::Store(i1, di, i1_out), hn::Store(j0, di, j0_out), hn::Store(j1, di, j1_out);
-        hn::Store(d_near, df, d_near_out);
-        for (std::size_t k = 0; k < n; ++k) {
-            results[base + k] = std::uint8_t(code_out[k]);
-            queries[base + k] = {i0_out[k], i1_out[k], j0_out[k], j1_out[k], d_near_out[k]};
-        }
+        store_codes(code, base, n);  // the open ones' are overwritten by the scan
+        // Pack the lanes still open (lanes past n are decided: they read rectangle 0, which this
+        // block decides or packs from its own lane 0).
+        const auto still_open = hn::And(hn::Eq(code, code_undecided), hn::FirstN(di, n));
+        hn::CompressStore(hn::Add(lane_index, hn::Set(di, std::int32_t(base))), still_open, di, open_rects.index + open_count);
+        hn::CompressStore(i0, still_open, di, open_rects.i0 + open_count);
+        hn::CompressStore(i1, still_open, di, open_rects.i1 + open_count);
+        hn::CompressStore(j0, still_open, di, open_rects.j0 + open_count);
+        hn::CompressStore(j1, still_open, di, open_rects.j1 + open_count);
+        open_count += hn::CompressStore(d_near, hn::RebindMask(df, still_open), df, open_rects.d_near + open_count);
     }
+    return open_count;
 }
 
 // The lanes of a mask as bits (lane k: bit k), for at most 32 lanes: the set ones are then
@@ -172,7 +203,7 @@ HWY_INLINE bool SubtilesHide(const SubtileView& view, const RectQuery& q, const 
 // wherever it reaches it, and only the others are scanned subtile by subtile (Greene's pruned
 // search, one level deep and a vector of cells at a time). Same answers as
 // test_rect_exhaustive.
-Visibility RectScan(const SubtileView& view, const RectQuery& q) {
+HWY_INLINE Visibility ScanRect(const SubtileView& view, const RectQuery& q) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     constexpr int kCellLevel = 2, kCell = 1 << kCellLevel;
     const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
@@ -203,18 +234,34 @@ Visibility RectScan(const SubtileView& view, const RectQuery& q) {
     return Visibility::occluded;
 }
 
+// ScanRect for test_rect, one rectangle per dispatch; the batches inline it (TestRectBlock).
+Visibility RectScan(const SubtileView& view, const RectQuery& q) { return ScanRect(view, q); }
+
+// Both stages for a block of rectangles: the coarse stage one rectangle per lane, then the scan
+// of the ones it leaves open, which it has packed: no branch per rectangle on whether it is
+// open (about one in four on S1, at random: a branch mispredicted that often cost more than
+// the packing), and one dispatch per block instead of one per open rectangle.
+void TestRectBlock(const CoarseRectView& view, const SubtileView& subtiles, const ScreenRect* rects, std::size_t count,
+                   Visibility* results) {
+    OpenRects open;
+    const std::size_t open_count = CoarseRectTests(view, rects, count, results, open);
+    for (std::size_t k = 0; k < open_count; ++k)
+        results[open.index[k]] = ScanRect(subtiles, {open.i0[k], open.i1[k], open.j0[k], open.j1[k], open.d_near[k]});
+}
+
 }  // namespace homcull::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace homcull::detail {
 
-HWY_EXPORT(CoarseRectTests);
+HWY_EXPORT(TestRectBlock);
 HWY_EXPORT(RectScan);
 
 namespace {
-void dispatch_coarse(const CoarseRectView& view, const ScreenRect* rects, std::size_t count, std::uint8_t* results, RectQuery* queries) {
-    HWY_DYNAMIC_DISPATCH(CoarseRectTests)(view, rects, count, results, queries);
+void dispatch_block(const CoarseRectView& view, const SubtileView& subtiles, const ScreenRect* rects, std::size_t count,
+                    Visibility* results) {
+    HWY_DYNAMIC_DISPATCH(TestRectBlock)(view, subtiles, rects, count, results);
 }
 }  // namespace
 
@@ -223,7 +270,7 @@ Visibility dispatch_scan(const SubtileView& view, const RectQuery& q) {
     return HWY_DYNAMIC_DISPATCH(RectScan)(view, q);
 }
 
-CoarseRectKernel selected_coarse_rect_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_coarse; }
+RectBlockKernel selected_rect_block_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_block; }
 RectScanKernel selected_rect_scan_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_scan; }
 
 }  // namespace homcull::detail
