@@ -127,12 +127,14 @@ HWY_INLINE std::size_t CoarseRectTests(const CoarseRectView& view, const ScreenR
         const VI tx0 = hn::IfThenElseZero(open, hn::ShiftRight<3>(i0)), tx1 = hn::IfThenElseZero(open, hn::ShiftRight<3>(i1));
         const VI ty0 = hn::IfThenElseZero(open, hn::ShiftRight<2>(j0)), ty1 = hn::IfThenElseZero(open, hn::ShiftRight<2>(j1));
         static_assert(kW == 8 && kH == 4, "the shifts above divide by the subtile size");
-        // The level where the subtile range spans at most 2 x 2 cells (monotone in the level).
+        // The level where the subtile range spans at most 2 x 2 cells: the count of levels where
+        // it spans more, which is monotone in the level. Every level is visited: an exit when no
+        // lane spans more was a branch mispredicted often enough to cost more (1.4 % of S1's
+        // batch, seven interleaved rounds).
         VI level = hn::Zero(di);
         for (int l = 0; l + 1 < view.levels; ++l) {
             const auto wider = hn::Or(hn::Gt(hn::Sub(hn::ShiftRightSame(tx1, l), hn::ShiftRightSame(tx0, l)), hn::Set(di, 1)),
                                       hn::Gt(hn::Sub(hn::ShiftRightSame(ty1, l), hn::ShiftRightSame(ty0, l)), hn::Set(di, 1)));
-            if (hn::AllFalse(di, wider)) break;
             level = hn::Add(level, hn::IfThenElseZero(wider, hn::Set(di, 1)));
         }
         const VI offset = hn::GatherIndex(di, view.level_offset, level), row = hn::GatherIndex(di, view.level_width, level);
