@@ -84,10 +84,8 @@ bool use_vertex_cache(const TriangleInput& in) {
 
 void gather_triangle_batch(const TriangleInput& in, std::size_t first, int count, TriangleBatch& batch) {
     std::uint32_t index[3][TriangleBatch::kSize];
-    if (!in.indices) batch.indices_valid = read_indices<std::uint32_t>(nullptr, first, count, in.vertex_count, index);
-    else if (in.indices_16bit)
-        batch.indices_valid = read_indices(static_cast<const std::uint16_t*>(in.indices), first, count, in.vertex_count, index);
-    else batch.indices_valid = read_indices(static_cast<const std::uint32_t*>(in.indices), first, count, in.vertex_count, index);
+    batch.indices_valid =
+        with_typed_indices(in, [&](const auto* indices) { return read_indices(indices, first, count, in.vertex_count, index); });
     for (int t = 0; t < count; ++t) batch.triangle[t] = first + std::size_t(t);
     for (int k = 0; k < 3; ++k)
         for (int t = 0; t < TriangleBatch::kSize; ++t) {
@@ -99,9 +97,7 @@ void gather_triangle_batch(const TriangleInput& in, std::size_t first, int count
 
 std::size_t gather_cached_batch(const TriangleInput& in, const VertexClip& cache, std::size_t first, std::size_t end, TriangleBatch& batch,
                                 RasterStats& stats) {
-    if (!in.indices) return gather_cached<std::uint32_t>(nullptr, in, cache, first, end, batch, stats);
-    if (in.indices_16bit) return gather_cached(static_cast<const std::uint16_t*>(in.indices), in, cache, first, end, batch, stats);
-    return gather_cached(static_cast<const std::uint32_t*>(in.indices), in, cache, first, end, batch, stats);
+    return with_typed_indices(in, [&](const auto* indices) { return gather_cached(indices, in, cache, first, end, batch, stats); });
 }
 
 void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch) {

@@ -34,10 +34,17 @@ inline std::uint32_t vertex_index(const Index* indices, std::size_t t, int k) {
     const std::size_t n = 3 * t + std::size_t(k);
     return indices ? std::uint32_t(indices[n]) : std::uint32_t(n);
 }
+// Calls f with the input's indices as the type they have: const std::uint16_t* or const
+// std::uint32_t*, or a null const std::uint32_t* without indices (vertex_index then counts).
+// The one place that chooses among the three, for the loops that must not choose per index.
+template <class F>
+inline decltype(auto) with_typed_indices(const TriangleInput& in, F&& f) {
+    if (!in.indices) return f(static_cast<const std::uint32_t*>(nullptr));
+    if (in.indices_16bit) return f(static_cast<const std::uint16_t*>(in.indices));
+    return f(static_cast<const std::uint32_t*>(in.indices));
+}
 inline std::uint32_t vertex_index(const TriangleInput& in, std::size_t t, int k) {
-    if (!in.indices) return vertex_index<std::uint32_t>(nullptr, t, k);
-    if (in.indices_16bit) return vertex_index(static_cast<const std::uint16_t*>(in.indices), t, k);
-    return vertex_index(static_cast<const std::uint32_t*>(in.indices), t, k);
+    return with_typed_indices(in, [&](const auto* indices) { return vertex_index(indices, t, k); });
 }
 
 // The position of vertex v (below vertex_count) as (x, y, z, w), w = 1 for 3 components.
