@@ -14,6 +14,7 @@
 #include <hwy/highway.h>
 
 #include "core/rect_tests.hpp"
+#include "raster/lane_bits-inl.h"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -155,16 +156,6 @@ HWY_INLINE std::size_t CoarseRectTests(const CoarseRectView& view, const ScreenR
         open_count += hn::CompressStore(d_near, hn::RebindMask(df, still_open), df, open_rects.d_near + open_count);
     }
     return open_count;
-}
-
-// The lanes of a mask as bits (lane k: bit k), for at most 32 lanes: the set ones are then
-// visited with a count of trailing zeros instead of testing every lane.
-template <class D>
-HWY_INLINE std::uint32_t LaneBits(D d, hn::Mask<D> mask) {
-    static_assert(kMaxSimdLanes <= 32, "one 32-bit word of lane bits");
-    HWY_ALIGN std::uint8_t bytes[8] = {};
-    hn::StoreMaskBits(d, mask, bytes);
-    return std::uint32_t(bytes[0]) | std::uint32_t(bytes[1]) << 8 | std::uint32_t(bytes[2]) << 16 | std::uint32_t(bytes[3]) << 24;
 }
 
 // The exact stage on the subtiles [sx0, sx1] x [sy0, sy1] of the rectangle, row by row, a

@@ -9,6 +9,7 @@
 
 #include <hwy/highway.h>
 
+#include "raster/lane_bits-inl.h"
 #include "raster/triangle_batch.hpp"
 
 #include <cstdint>
@@ -26,12 +27,6 @@ HWY_INLINE V ClipRow(D d, const std::array<float, 16>& m, int r, V x, V y, V z, 
     return hn::Add(hn::Add(hn::Add(hn::Mul(hn::Set(d, double(m[r])), x), hn::Mul(hn::Set(d, double(m[4 + r])), y)),
                            hn::Mul(hn::Set(d, double(m[8 + r])), z)),
                    hn::Mul(hn::Set(d, double(m[12 + r])), w));
-}
-
-HWY_INLINE std::uint32_t Bits(D d, M m) {
-    std::uint8_t bytes[8] = {};
-    hn::StoreMaskBits(d, m, bytes);
-    return bytes[0];
 }
 
 // Transforms the lanes' positions (count of them, from vertex `at`) and stores their clip
@@ -157,8 +152,8 @@ void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, Raste
         stats.outside += hn::CountTrue(d, out);
         stats.degenerate += hn::CountTrue(d, degenerate);
         stats.backface_culled += hn::CountTrue(d, backfacing);
-        batch.needs_setup |= Bits(d, hn::AndNot(hn::Or(hn::Or(invalid, out), hn::Or(degenerate, backfacing)), live)) << g;
-        batch.simple |= Bits(d, hn::AndNot(hn::Or(degenerate, backfacing), open)) << g;
+        batch.needs_setup |= LaneBits(d, hn::AndNot(hn::Or(hn::Or(invalid, out), hn::Or(degenerate, backfacing)), live)) << g;
+        batch.simple |= LaneBits(d, hn::AndNot(hn::Or(degenerate, backfacing), open)) << g;
     }
 }
 
@@ -188,7 +183,7 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
         // orient_triangle: counter-clockwise, swapping vertices 1 and 2 when the area is negative.
         const V area2 = hn::Sub(hn::Mul(hn::Sub(px1, x0), hn::Sub(py2, y0)), hn::Mul(hn::Sub(py1, y0), hn::Sub(px2, x0)));
         const M flip = hn::Lt(area2, zero);
-        out.flipped |= Bits(d, flip) << g;
+        out.flipped |= LaneBits(d, flip) << g;
         const V x1 = hn::IfThenElse(flip, px2, px1), x2 = hn::IfThenElse(flip, px1, px2);
         const V y1 = hn::IfThenElse(flip, py2, py1), y2 = hn::IfThenElse(flip, py1, py2);
         const V d1 = hn::IfThenElse(flip, pd2, pd1), d2 = hn::IfThenElse(flip, pd1, pd2);
