@@ -111,8 +111,8 @@ constexpr std::uint8_t kUndecided = 0xFF;
 
 // The batched tests of rectangles [0, count), count <= kRectBlock, for the selected instruction
 // set: the coarse stage in SIMD lanes (repeating prepare() and test_rect's coarse check), then
-// the exact scan (RectScan) of the rectangles it leaves open; the answers of test_rect. Null
-// when the scalar reference is selected.
+// the exact scan (ScanRect, which RectScan runs for test_rect) of the ones it leaves open: the
+// answers of test_rect. Null when the scalar reference is selected.
 constexpr std::size_t kRectBlock = 256;
 using RectBlockKernel = void (*)(const CoarseRectView& view, const SubtileView& subtiles, const ScreenRect* rects, std::size_t count,
                                  Visibility* results);

@@ -145,8 +145,7 @@ HWY_INLINE std::size_t CoarseRectTests(const CoarseRectView& view, const ScreenR
                                   hn::Min(hn::GatherIndex(df, view.pyramid, hn::Add(row1, cx0)), hn::GatherIndex(df, view.pyramid, hn::Add(row1, cx1))));
         code = hn::IfThenElse(hn::And(open, hn::RebindMask(di, hn::Lt(d_near, coarse))), code_occluded, code);
         store_codes(code, base, n);  // the open ones' are overwritten by the scan
-        // Pack the lanes still open (lanes past n are decided: they read rectangle 0, which this
-        // block decides or packs from its own lane 0).
+        // Pack the lanes still open; lanes past n (which read rectangle `base`) are left out.
         const auto still_open = hn::And(hn::Eq(code, code_undecided), hn::FirstN(di, n));
         hn::CompressStore(hn::Add(lane_index, hn::Set(di, std::int32_t(base))), still_open, di, open_rects.index + open_count);
         hn::CompressStore(i0, still_open, di, open_rects.i0 + open_count);
