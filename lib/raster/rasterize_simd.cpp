@@ -18,19 +18,20 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2), the subtiles
-// tx..tx + columns - 1 of each row as vector lanes, float and 32-bit integer: at most 8 columns
-// (4 on SSE4 and NEON; rows are padded for kMaxSimdLanes). first and last hold the rows'
-// sample-row intervals, 4 per subtile row. Two rows at a time suit AVX-512's 16 lanes: S1's
-// triangles reach about 5 subtiles per row, and one row in 16 lanes was 10 % slower than in 8.
-// Whether this target may update two subtile rows per vector (AVX-512, and SVE when its
-// vectors are that wide); the scalar target has no half vectors.
+// Whether this target has vectors of at least 4 lanes (every one but the scalar target, which
+// updates subtiles with the reference), and whether it may update two subtile rows per vector
+// (AVX-512, and SVE when its vectors are that wide).
+#undef HOMCULL_SUBTILE_LANES
 #undef HOMCULL_PAIR_ROWS
 #if HWY_TARGET == HWY_SCALAR
+#define HOMCULL_SUBTILE_LANES 0
 #define HOMCULL_PAIR_ROWS 0
 #else
+#define HOMCULL_SUBTILE_LANES 1
 #define HOMCULL_PAIR_ROWS 1
 #endif
+
+#if HOMCULL_SUBTILE_LANES
 
 // A plane's elements of the lanes of UpdateSubtileRows: one vector from row offset row0, or
 // half a vector from each of row0 and row1.
@@ -59,6 +60,37 @@ HWY_INLINE void StoreRows(hn::Vec<D> v, D d, T* plane, std::size_t row0, std::si
     hn::StoreU(v, d, plane + row0 + tx);
 }
 
+// The index (0..24) of the highest set bit of each lane of v, for v < 2^25 (as int), from the
+// exponent of float(v): exact below 2^24, and rounding in [2^24, 2^25) cannot reach 2^25.
+template <class DU>
+HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> HighestBitIndex(DU du, hn::Vec<DU> v) {
+    const hn::RebindToSigned<DU> di;
+    const hn::RebindToFloat<DU> df;
+    const auto exponent = hn::ShiftRight<23>(hn::BitCast(di, hn::ConvertTo(df, hn::BitCast(di, v))));
+    return hn::Sub(exponent, hn::Set(di, 127));
+}
+
+// The index of the lowest set bit (lowest = all ones) or of the highest (lowest = zero) of
+// each lane of v < 2^25: the lowest set bit alone is v & ~(v - 1).
+template <class DU>
+HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v, hn::Vec<DU> lowest) {
+    return HighestBitIndex(du, hn::AndNot(hn::And(hn::Sub(v, hn::Set(du, 1u)), lowest), v));
+}
+
+// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2), the subtiles
+// tx..tx + columns - 1 of each row as vector lanes, float and 32-bit integer: at most 8 columns
+// (4 on SSE4 and NEON; rows are padded for kMaxSimdLanes). first and last hold the rows'
+// sample-row intervals, 4 per subtile row, readable for kMaxSimdLanes entries. Two rows at a
+// time suit AVX-512's 16 lanes: S1's triangles reach about 5 subtiles per row, and one row in 16
+// lanes was 10 % slower than in 8.
+//
+// The coverage masks come from sample rows (as Intel's Masked Occlusion Culling computes them):
+// before the update, lane l holds sample row l % 4 of one subtile row across 32 samples, 4
+// subtiles, one bit per sample, so that each 128-bit block holds 4 sample rows x 4 subtiles,
+// a 4 x 4 matrix of bytes. One byte shuffle per block transposes it into the 4 subtiles' masks
+// (byte j = sample row j, bit c = column c, as subtile_coverage), in the lanes where the
+// update below reads the subtiles' planes. The intervals are those of the reference, so the
+// masks are its masks.
 template <int kRows>
 HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t* first,
                                            const std::int32_t* last, const PreparedTriangle& tri, int sample_width, int sample_height) {
@@ -67,6 +99,7 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     const hn::CappedTag<float, 8 * kRows> df;
     const hn::RebindToSigned<decltype(df)> di;
     const hn::RebindToUnsigned<decltype(df)> du;
+    const hn::Repartition<std::uint8_t, decltype(du)> du8;
     const int row_lanes = int(hn::Lanes(df)) / kRows;
     using VI = hn::Vec<decltype(di)>;
     using VU = hn::Vec<decltype(du)>;
@@ -90,18 +123,22 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     const VU replicate_v = hn::BitCast(du, per_row(std::int32_t(replicate[0]), std::int32_t(replicate[kRows - 1])));
     const VI row_y = per_row(ty * kH, (ty + kRows - 1) * kH);
 
-    // Per sample row j: its interval, broadcast in the row loop below (SVE vectors are sizeless
-    // and cannot be array elements). Local copies: the stores to the planes cannot alias them.
-    std::int32_t first_l[2 * kH], last_l[2 * kH];
-    for (int j = 0; j < kRows * kH; ++j) {
-        first_l[j] = first[j];
-        last_l[j] = last[j];
-    }
+    // Before the transpose, lane l is sample row l % 4 of its subtile row: its interval, and
+    // the first sample of its 32 (the block's first subtile column, relative to tx).
+    const VI sample_row = hn::Add(hn::And(lane, hn::Set(di, kH - 1)), hn::IfThenElseZero(second_row, hn::Set(di, kH)));
+    const auto row_of_lane = hn::IndicesFromVec(di, sample_row);
+    const VI first_v = hn::TableLookupLanes(hn::LoadU(di, first), row_of_lane);
+    const VI last_v = hn::TableLookupLanes(hn::LoadU(di, last), row_of_lane);
+    const VI block_sample = hn::ShiftLeft<3>(hn::AndNot(hn::Set(di, kH - 1), lane_column));
+    // Byte 4c + j of a block takes byte 4j + c: dword c = 0x0C080400 + c * 0x01010101.
+    const VU transpose = hn::BitCast(du, hn::Add(hn::Set(di, 0x0C080400), hn::Mul(hn::And(lane, hn::Set(di, 3)), hn::Set(di, 0x01010101))));
+
     const std::size_t row0 = std::size_t(ty) * planes.stride, row1 = std::size_t(ty + kRows - 1) * planes.stride;
     const auto load = [&](auto d, const auto* plane, std::size_t tx) { return LoadRows<kRows>(d, plane, row0, row1, tx); };
     const auto store = [&](auto v, auto d, auto* plane, std::size_t tx) { StoreRows<kRows>(v, d, plane, row0, row1, tx); };
-    const VI zero_i = hn::Zero(di), seven = hn::Set(di, kW - 1), eight = hn::Set(di, kW);
-    const VU byte = hn::Set(du, 0xFFu);
+    const VI zero_i = hn::Zero(di), eight = hn::Set(di, kW), last_bit = hn::Set(di, 31);
+    const VU byte = hn::Set(du, 0xFFu), ones = hn::Set(du, ~0u);
+    const VU lowest_column = hn::Set(du, tri.far_is_left ? ~0u : 0u), lowest_row = hn::Set(du, tri.far_is_top ? ~0u : 0u);
     const VF a = hn::Set(df, tri.a), dzdx = hn::Set(df, tri.dzdx), dzdy = hn::Set(df, tri.dzdy), error = hn::Set(df, tri.error);
     const VF z_vertex_min = hn::Set(df, tri.z_vertex_min), half = hn::Set(df, 0.5f), lower = hn::Set(df, 1.0f - 0x1.0p-20f);
 
@@ -109,23 +146,15 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     for (int tx = tx_begin; tx <= tx_end; tx += row_lanes) {
         const VI column0 = hn::ShiftLeft<3>(hn::Add(lane_column, hn::Set(di, tx)));  // tx * 8 per lane
 
-        // Mask and far corner, as the reference (lanes past tx_end get empty masks).
-        VU m = hn::Zero(du);
-        VI far_column = tri.far_is_left ? eight : hn::Set(di, -1), far_row = hn::Set(di, kH);
-        for (int j = 0; j < kH; ++j) {
-            const VI lo = hn::Max(hn::Sub(per_row(first_l[j], first_l[(kRows - 1) * kH + j]), column0), zero_i);
-            const VI hi = hn::Min(hn::Sub(per_row(last_l[j], last_l[(kRows - 1) * kH + j]), column0), seven);
-            const auto empty = hn::Gt(lo, hi);
-            // Shift counts clamped to [0, 8]: only lanes with lo <= hi (both in [0, 7]) are kept.
-            const VU lo_u = hn::BitCast(du, hn::Min(lo, eight));
-            const VU right = hn::BitCast(du, hn::Min(hn::Max(hn::Sub(seven, hi), zero_i), eight));
-            const VU bits = hn::And(hn::Shr(byte, right), hn::Shl(byte, lo_u));
-            m = hn::Or(m, hn::ShiftLeftSame(hn::IfThenZeroElse(hn::RebindMask(du, empty), bits), j * kW));
-            far_column = tri.far_is_left ? hn::IfThenElse(empty, far_column, hn::Min(far_column, lo))
-                                         : hn::IfThenElse(empty, far_column, hn::Max(far_column, hi));
-            const auto take_row = tri.far_is_top ? hn::AndNot(empty, hn::Eq(far_row, hn::Set(di, kH))) : hn::Not(empty);
-            far_row = hn::IfThenElse(take_row, hn::Set(di, j), far_row);
-        }
+        // The lane's sample row over its 32 samples, then the transpose (lanes past tx_end and
+        // past the interval get no bits). Shift counts stay in [0, 31]; empty rows are zeroed.
+        const VI x0 = hn::Add(hn::Set(di, tx * kW), block_sample);
+        const VI lo = hn::Max(hn::Sub(first_v, x0), zero_i), hi = hn::Min(hn::Sub(last_v, x0), last_bit);
+        const VU from_lo = hn::Shl(ones, hn::BitCast(du, hn::Min(lo, last_bit)));
+        const VU to_hi = hn::Shr(ones, hn::BitCast(du, hn::Min(hn::Sub(last_bit, hi), last_bit)));
+        const VU row_bits32 = hn::IfThenZeroElse(hn::RebindMask(du, hn::Gt(lo, hi)), hn::And(from_lo, to_hi));
+        const VU m = hn::BitCast(du, hn::TableLookupBytes(hn::BitCast(du8, row_bits32), hn::BitCast(du8, transpose)));
+
         const auto active = hn::Ne(m, hn::Zero(du));
         if (hn::AllFalse(du, active)) continue;
         touched += hn::CountTrue(du, active);
@@ -134,6 +163,17 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
         VF d0 = load(df, planes.d0, i), d1 = load(df, planes.d1, i);
         VU mask = load(du, planes.mask, i);
         store(hn::Or(load(du, planes.covered, i), m), du, planes.covered, i);
+
+        // The corner of the covered samples' bounding rectangle where the plane is smallest
+        // (see subtile_coverage): columns from the OR of the 4 row bytes, rows from bit 8j
+        // set when row j has a sample.
+        VU columns_present = hn::Or(m, hn::ShiftRight<16>(m));
+        columns_present = hn::And(hn::Or(columns_present, hn::ShiftRight<8>(columns_present)), byte);
+        VU rows_present = hn::Or(m, hn::ShiftRight<4>(m));
+        rows_present = hn::Or(rows_present, hn::ShiftRight<2>(rows_present));
+        rows_present = hn::And(hn::Or(rows_present, hn::ShiftRight<1>(rows_present)), hn::Set(du, 0x01010101u));
+        const VI far_column = ExtremeBitIndex(du, columns_present, lowest_column);
+        const VI far_row = hn::ShiftRight<3>(ExtremeBitIndex(du, rows_present, lowest_row));
 
         // conservative_depth, lane by lane.
         const VF x = hn::Add(hn::ConvertTo(df, hn::Add(column0, far_column)), half);
@@ -166,6 +206,7 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     }
     return touched;
 }
+#endif  // HOMCULL_SUBTILE_LANES
 
 // update_sample_depth for one subtile row, the samples of a sample row as lanes: each lane
 // evaluates conservative_depth with the same float operations (the row's part, a + dzdy y,
@@ -224,7 +265,9 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
 #if HOMCULL_PAIR_ROWS
     const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
 #endif
-    HWY_ALIGN std::int32_t first[kChunkRows + 8], last[kChunkRows + 8];  // + 8: the last vector may pass the chunk's rows
+    // + kMaxSimdLanes: the last vector of the row pass may pass the chunk's rows, and the
+    // subtile-row update reads kMaxSimdLanes entries from the start of its rows.
+    HWY_ALIGN std::int32_t first[kChunkRows + kMaxSimdLanes], last[kChunkRows + kMaxSimdLanes];
     std::uint64_t touched = 0;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
@@ -250,6 +293,8 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             hn::StoreU(hn::DemoteTo(di, lo), di, first + r);
             hn::StoreU(hn::DemoteTo(di, hi), di, last + r);
         }
+        // Defined values past the chunk's rows (the update reads but never uses them).
+        for (int r = rows; r < rows + kMaxSimdLanes; ++r) first[r] = last[r] = 0;
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
@@ -273,7 +318,12 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             }
 #endif
             if (reached) {
+#if HOMCULL_SUBTILE_LANES
                 touched += UpdateSubtileRows<1>(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width, t.sample_height);
+#else
+                touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width,
+                                                        t.sample_height);
+#endif
                 if (t.planes.sample_depth) UpdateSampleDepth(t.planes, ty, row_first, row_last, tri, sample_lane);
             }
             ++ty;
