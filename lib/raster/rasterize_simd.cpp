@@ -77,12 +77,13 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
     return HighestBitIndex(du, hn::AndNot(hn::And(hn::Sub(v, hn::Set(du, 1u)), lowest), v));
 }
 
-// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2), the subtiles
-// tx..tx + columns - 1 of each row as vector lanes, float and 32-bit integer: at most 8 columns
-// (4 on SSE4 and NEON; rows are padded for kMaxSimdLanes). first and last hold the rows'
-// sample-row intervals, 4 per subtile row, readable for kMaxSimdLanes entries. Two rows at a
-// time suit AVX-512's 16 lanes: S1's triangles reach about 5 subtiles per row, and one row in 16
-// lanes was 10 % slower than in 8.
+// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2), over the subtile
+// columns their sample rows reach (as reached_subtile_columns), the subtiles tx..tx + columns - 1
+// of each row as vector lanes, float and 32-bit integer: at most 8 columns (4 on SSE4 and NEON;
+// rows are padded for kMaxSimdLanes). first and last hold the rows' sample-row intervals, 4 per
+// subtile row, readable for kMaxSimdLanes entries. Two rows at a time suit AVX-512's 16 lanes:
+// S1's triangles reach about 5 subtiles per row, and one row in 16 lanes was 10 % slower than
+// in 8. Returns the number of subtiles updated.
 //
 // The coverage masks come from sample rows (as Intel's Masked Occlusion Culling computes them):
 // before the update, lane l holds sample row l % 4 of one subtile row across 32 samples, 4
@@ -92,8 +93,8 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
 // update below reads the subtiles' planes. The intervals are those of the reference, so the
 // masks are its masks.
 template <int kRows>
-HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t* first,
-                                           const std::int32_t* last, const PreparedTriangle& tri, int sample_width, int sample_height) {
+HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, const std::int32_t* first, const std::int32_t* last,
+                                           const PreparedTriangle& tri, int sample_width, int sample_height) {
     static_assert(kRows == 1 || kRows == 2, "one or two subtile rows");
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<float, 8 * kRows> df;
@@ -129,6 +130,12 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     const auto row_of_lane = hn::IndicesFromVec(di, sample_row);
     const VI first_v = hn::TableLookupLanes(hn::LoadU(di, first), row_of_lane);
     const VI last_v = hn::TableLookupLanes(hn::LoadU(di, last), row_of_lane);
+    // The subtile columns the rows reach (reached_subtile_columns: the intervals lie within the
+    // triangle's columns, so their extremes bound its subtiles too).
+    const auto row_empty = hn::Gt(first_v, last_v);
+    if (hn::AllTrue(di, row_empty)) return 0;
+    const int tx_begin = hn::GetLane(hn::MinOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, 1 << 30), first_v))) / kW;
+    const int tx_end = hn::GetLane(hn::MaxOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, -1), last_v))) / kW;
     const VI block_sample = hn::ShiftLeft<3>(hn::AndNot(hn::Set(di, kH - 1), lane_column));
     // Byte 4c + j of a block takes byte 4j + c: dword c = 0x0C080400 + c * 0x01010101.
     const VU transpose = hn::BitCast(du, hn::Add(hn::Set(di, 0x0C080400), hn::Mul(hn::And(lane, hn::Set(di, 3)), hn::Set(di, 0x01010101))));
@@ -298,35 +305,22 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
-            int tx_begin, tx_end;
-            const bool reached = reached_subtile_columns(row_first, row_last, i0, i1, tx_begin, tx_end);
-            // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
-#if HOMCULL_PAIR_ROWS
-            {
-                int next_begin, next_end;
-                if (pair_rows && ty < ty1 && reached_subtile_columns(row_first + kH, row_last + kH, i0, i1, next_begin, next_end)) {
-                    if (!reached) tx_begin = next_begin, tx_end = next_end;
-                    touched += UpdateSubtileRows<2>(t.planes, ty, std::min(tx_begin, next_begin), std::max(tx_end, next_end), row_first,
-                                                    row_last, tri, t.sample_width, t.sample_height);
-                    if (t.planes.sample_depth) {
-                        UpdateSampleDepth(t.planes, ty, row_first, row_last, tri, sample_lane);
-                        UpdateSampleDepth(t.planes, ty + 1, row_first + kH, row_last + kH, tri, sample_lane);
-                    }
-                    ty += 2;
-                    continue;
-                }
-            }
-#endif
-            if (reached) {
 #if HOMCULL_SUBTILE_LANES
-                touched += UpdateSubtileRows<1>(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width, t.sample_height);
+            // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
+            const int rows_now = HOMCULL_PAIR_ROWS && pair_rows && ty < ty1 ? 2 : 1;
+            touched += rows_now == 2 ? UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, tri, t.sample_width, t.sample_height)
+                                     : UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, tri, t.sample_width, t.sample_height);
 #else
+            const int rows_now = 1;
+            int tx_begin, tx_end;
+            if (reached_subtile_columns(row_first, row_last, i0, i1, tx_begin, tx_end))
                 touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width,
                                                         t.sample_height);
 #endif
-                if (t.planes.sample_depth) UpdateSampleDepth(t.planes, ty, row_first, row_last, tri, sample_lane);
-            }
-            ++ty;
+            if (t.planes.sample_depth)
+                for (int r = 0; r < rows_now; ++r)
+                    UpdateSampleDepth(t.planes, ty + r, row_first + r * kH, row_last + r * kH, tri, sample_lane);
+            ty += rows_now;
         }
     }
     return touched;
