@@ -77,8 +77,10 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
     return HighestBitIndex(du, hn::AndNot(hn::And(hn::Sub(v, hn::Set(du, 1u)), lowest), v));
 }
 
-// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2), over the subtile
-// columns their sample rows reach (as reached_subtile_columns), the subtiles tx..tx + columns - 1
+// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2) of a triangle with
+// sample columns [i0, i1], over the subtile columns its sample rows reach (as
+// reached_subtile_columns, or all of the triangle's when one vector spans them; lanes without
+// samples change nothing), the subtiles tx..tx + columns - 1
 // of each row as vector lanes, float and 32-bit integer: at most 8 columns (4 on SSE4 and NEON;
 // rows are padded for kMaxSimdLanes). first and last hold the rows' sample-row intervals, 4 per
 // subtile row, readable for kMaxSimdLanes entries. Two rows at a time suit AVX-512's 16 lanes:
@@ -94,7 +96,7 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
 // masks are its masks.
 template <int kRows>
 HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, const std::int32_t* first, const std::int32_t* last,
-                                           const PreparedTriangle& tri, int sample_width, int sample_height) {
+                                           int i0, int i1, const PreparedTriangle& tri, int sample_width, int sample_height) {
     static_assert(kRows == 1 || kRows == 2, "one or two subtile rows");
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<float, 8 * kRows> df;
@@ -119,8 +121,8 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     // the last column and the last row of subtiles, as (row bits of the lane's columns) x
     // (one bit per existing row).
     std::uint32_t replicate[2] = {0, 0};
-    for (int r = 0; r < kRows; ++r)
-        for (int j = 0; j < std::min(kH, sample_height - (ty + r) * kH); ++j) replicate[r] |= 1u << (j * kW);
+    for (int r = 0; r < kRows; ++r)  // rows that exist: 1 to 4 (each subtile row has one)
+        replicate[r] = 0x01010101u >> (kW * (kH - std::min(kH, sample_height - (ty + r) * kH)));
     const VU replicate_v = hn::BitCast(du, per_row(std::int32_t(replicate[0]), std::int32_t(replicate[kRows - 1])));
     const VI row_y = per_row(ty * kH, (ty + kRows - 1) * kH);
 
@@ -130,12 +132,16 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     const auto row_of_lane = hn::IndicesFromVec(di, sample_row);
     const VI first_v = hn::TableLookupLanes(hn::LoadU(di, first), row_of_lane);
     const VI last_v = hn::TableLookupLanes(hn::LoadU(di, last), row_of_lane);
-    // The subtile columns the rows reach (reached_subtile_columns: the intervals lie within the
-    // triangle's columns, so their extremes bound its subtiles too).
+    // The subtile columns: the triangle's, when one vector spans them; else those the rows
+    // reach (reached_subtile_columns: the intervals lie within the triangle's columns [i0, i1],
+    // so their extremes bound its subtiles too).
     const auto row_empty = hn::Gt(first_v, last_v);
     if (hn::AllTrue(di, row_empty)) return 0;
-    const int tx_begin = hn::GetLane(hn::MinOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, 1 << 30), first_v))) / kW;
-    const int tx_end = hn::GetLane(hn::MaxOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, -1), last_v))) / kW;
+    int tx_begin = i0 / kW, tx_end = i1 / kW;
+    if (tx_end - tx_begin >= row_lanes) {
+        tx_begin = hn::GetLane(hn::MinOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, 1 << 30), first_v))) / kW;
+        tx_end = hn::GetLane(hn::MaxOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, -1), last_v))) / kW;
+    }
     const VI block_sample = hn::ShiftLeft<3>(hn::AndNot(hn::Set(di, kH - 1), lane_column));
     // Byte 4c + j of a block takes byte 4j + c: dword c = 0x0C080400 + c * 0x01010101.
     const VU transpose = hn::BitCast(du, hn::Add(hn::Set(di, 0x0C080400), hn::Mul(hn::And(lane, hn::Set(di, 3)), hn::Set(di, 0x01010101))));
@@ -308,8 +314,8 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
 #if HOMCULL_SUBTILE_LANES
             // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
             const int rows_now = HOMCULL_PAIR_ROWS && pair_rows && ty < ty1 ? 2 : 1;
-            touched += rows_now == 2 ? UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, tri, t.sample_width, t.sample_height)
-                                     : UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, tri, t.sample_width, t.sample_height);
+            touched += rows_now == 2 ? UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height)
+                                     : UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
 #else
             const int rows_now = 1;
             int tx_begin, tx_end;
