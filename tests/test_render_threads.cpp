@@ -152,10 +152,21 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
         config.sample_depth = true;
         out.emplace_back(config);
         out.back().render(occluders.input(clip_from_world(street, 777.0 / 333.0), Backface::none));
+        // Depths 1/w about the largest float (w from 1e-40): the float bounds of the depth plane
+        // (float_down, float_up) beyond the float range, and planes too steep for float.
+        std::vector<float> tiny_w = xyzw;
+        for (float& v : tiny_w) v *= 1e-40f;
+        config.width = 301;
+        config.height = 173;
+        config.near_w = 1e-41f;
+        out.emplace_back(config);
+        out.back().render(test::clip_space_input(tiny_w));
     };
     select_isa("scalar");
     std::vector<OcclusionBuffer> reference;
     render_all(reference);
+    EXPECT_GT(reference.back().stats().rasterized, 10000u);
+    EXPECT_GT(reference.back().stats().subtiles_touched, 100000u);
     const std::vector<std::string> isas = available_isas();
     EXPECT_GE(isas.size(), 2u) << "no SIMD instruction set available";
     for (const std::string& isa : isas) {

@@ -120,8 +120,12 @@ bool assemble_raster_triangle(const BatchSetup& s, int t, std::uint8_t shared_bi
         out.edges.shared[k] = shared[k];
         out.edges.threshold[k] = edge_threshold(shared[k], edge_margin, s.sa[k][t], s.sb[k][t]);
     }
-    const double d[3] = {s.d[0][t], s.d[1][t], s.d[2][t]};
-    out.plane = finish_depth_plane({s.dzdx[t], s.dzdy[t], s.a[t], s.magnitude[t], s.error[t]}, d);
+    PreparedTriangle& plane = out.plane;  // finish_depth_plane's, from SetupBatch
+    plane.a = s.plane_a[t], plane.dzdx = s.plane_dzdx[t], plane.dzdy = s.plane_dzdy[t], plane.error = s.plane_error[t];
+    plane.z_vertex_min = s.z_vertex_min[t];
+    plane.has_plane = (s.has_plane >> t) & 1u;
+    plane.far_is_left = plane.dzdx > 0.0f;
+    plane.far_is_top = plane.dzdy > 0.0f;
     return true;
 }
 

@@ -93,16 +93,16 @@ void classify_batch_reference(Backface backface, double near_w, TriangleBatch& b
 
 // The screen-space setup of a batch's unclipped triangles, lane by lane, as
 // setup_clip_triangle (projection to the sample grid) and setup_raster_triangle (orientation,
-// sample bounding box, edge functions, depth plane terms) compute it in double, before the
-// parts that depend on the edge flags or convert to float (assemble_raster_triangle).
+// sample bounding box, edge functions, depth plane) compute it, before the parts that depend
+// on the edge flags (assemble_raster_triangle).
 struct BatchSetup {
     static constexpr int kSize = TriangleBatch::kSize;
-    alignas(64) double d[3][kSize];                              // vertex depths, counter-clockwise
-    alignas(64) double area2[kSize];                             // twice the area; 0: nothing to rasterize
+    alignas(64) double area2[kSize];  // twice the area; 0: nothing to rasterize
     alignas(64) double ox[3][kSize], oy[3][kSize], sa[3][kSize], sb[3][kSize], inverse_sa[3][kSize];
-    alignas(64) double dzdx[kSize], dzdy[kSize], a[kSize], magnitude[kSize], error[kSize];
+    alignas(64) float plane_a[kSize], plane_dzdx[kSize], plane_dzdy[kSize], plane_error[kSize], z_vertex_min[kSize];  // PreparedTriangle's
     alignas(64) std::int32_t i0[kSize], i1[kSize], j0[kSize], j1[kSize];
-    std::uint32_t flipped = 0;  // bit t: vertices 1 and 2 were swapped to orient the triangle
+    std::uint32_t flipped = 0;    // bit t: vertices 1 and 2 were swapped to orient the triangle
+    std::uint32_t has_plane = 0;  // bit t: PreparedTriangle::has_plane
 };
 using SetupBatchKernel = void (*)(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& setup);
 

@@ -13,6 +13,7 @@
 #include "raster/triangle_batch.hpp"
 
 #include <cstdint>
+#include <limits>
 
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
@@ -157,6 +158,34 @@ void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, Raste
     }
 }
 
+// A mask of double lanes as a mask of the float lanes they demote to.
+HWY_INLINE hn::Mask<hn::Rebind<float, D>> FloatLaneMask(M m) {
+    const D d;
+    const hn::Rebind<std::int32_t, D> di;
+    return hn::RebindMask(hn::Rebind<float, D>(), hn::Lt(hn::DemoteTo(di, hn::IfThenElseZero(m, hn::Set(d, -1.0))), hn::Zero(di)));
+}
+
+// float_up (kUp) or float_down of finite doubles, lane by lane: the nearest float, then one step
+// of its bits towards the safe side when it lies on the other. Beyond the float range the
+// nearest float is the largest one or infinity, and that step gives float_up's and
+// float_down's answers there too (the largest float or infinity on the safe side).
+template <bool kUp>
+HWY_INLINE hn::Vec<hn::Rebind<float, D>> FloatOutward(V v) {
+    const D d;
+    const hn::Rebind<float, D> df;
+    const hn::Rebind<std::int32_t, D> di;
+    const auto f = hn::DemoteTo(df, v);
+    const auto wrong_side = FloatLaneMask(kUp ? hn::Lt(hn::PromoteTo(d, f), v) : hn::Gt(hn::PromoteTo(d, f), v));
+    // float_step: away from zero when the step and the sign agree, else towards it; from zero
+    // to the smallest denormal of the step's sign.
+    const auto bits = hn::BitCast(di, f);
+    const auto zero = hn::Zero(df);
+    const auto away = hn::RebindMask(di, kUp ? hn::Gt(f, zero) : hn::Lt(f, zero));
+    auto stepped = hn::IfThenElse(away, hn::Add(bits, hn::Set(di, 1)), hn::Sub(bits, hn::Set(di, 1)));
+    stepped = hn::IfThenElse(hn::RebindMask(di, hn::Eq(f, zero)), hn::Set(di, kUp ? 1 : std::int32_t(0x80000001u)), stepped);
+    return hn::IfThenElse(wrong_side, hn::BitCast(df, stepped), f);
+}
+
 // setup_clip_triangle's projection of an unclipped triangle and setup_raster_triangle's double
 // work (orient_triangle, sample_span, edge_functions, depth_plane_terms), lane by lane with
 // the same operations in the same order.
@@ -167,6 +196,7 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
     const V one = hn::Set(d, 1.0), half = hn::Set(d, 0.5), zero = hn::Zero(d), minus_one = hn::Set(d, -1.0);
     const V width = hn::Set(d, double(sample_width)), height = hn::Set(d, double(sample_height));
     out.flipped = 0;
+    out.has_plane = 0;
     for (int g = 0; g < batch.count; g += lanes) {
         // Projection to the sample grid, depth 1/w. (No arrays of vectors: SVE vectors cannot
         // be array elements.)
@@ -188,7 +218,6 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
         const V y1 = hn::IfThenElse(flip, py2, py1), y2 = hn::IfThenElse(flip, py1, py2);
         const V d1 = hn::IfThenElse(flip, pd2, pd1), d2 = hn::IfThenElse(flip, pd1, pd2);
         const V area = hn::IfThenElse(flip, hn::Neg(area2), area2);
-        hn::Store(d0, d, out.d[0] + g), hn::Store(d1, d, out.d[1] + g), hn::Store(d2, d, out.d[2] + g);
         hn::Store(area, d, out.area2 + g);
 
         // sample_span of the bounding box (min and max are exact).
@@ -229,8 +258,16 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
         const V magnitude = hn::Add(hn::Add(hn::Abs(a), hn::Mul(hn::Abs(dzdx), width)), hn::Mul(hn::Abs(dzdy), height));
         const V terms = hn::Add(hn::Add(hn::Abs(d0), hn::Abs(hn::Mul(dzdx, x0))), hn::Abs(hn::Mul(dzdy, y0)));
         const V error = hn::Add(hn::Mul(hn::Set(d, 0x1.0p-20), magnitude), hn::Mul(hn::Set(d, 0x1.0p-40), terms));
-        hn::Store(dzdx, d, out.dzdx + g), hn::Store(dzdy, d, out.dzdy + g), hn::Store(a, d, out.a + g);
-        hn::Store(magnitude, d, out.magnitude + g), hn::Store(error, d, out.error + g);
+        // finish_depth_plane: the plane in float where it is usable, else none.
+        const hn::Rebind<float, D> df;
+        const M usable = hn::And(hn::Lt(hn::Abs(error), hn::Set(d, HUGE_VAL)), hn::Lt(magnitude, hn::Set(d, 0x1.0p100)));
+        const auto usable_f = FloatLaneMask(usable);
+        hn::Store(hn::IfThenElseZero(usable_f, hn::DemoteTo(df, a)), df, out.plane_a + g);
+        hn::Store(hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdx)), df, out.plane_dzdx + g);
+        hn::Store(hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdy)), df, out.plane_dzdy + g);
+        hn::Store(hn::IfThenElseZero(usable_f, FloatOutward<true>(hn::IfThenElseZero(usable, error))), df, out.plane_error + g);
+        hn::Store(FloatOutward<false>(hn::Min(hn::Min(d0, d1), d2)), df, out.z_vertex_min + g);
+        out.has_plane |= LaneBits(d, usable) << g;
     }
 }
 
