@@ -24,38 +24,45 @@ std::uint32_t read_indices(const Index* indices, std::size_t first, int count, s
 template <typename Index>
 std::size_t gather_cached(const Index* indices, const TriangleInput& in, const VertexClip& cache, std::size_t first, std::size_t end,
                           TriangleBatch& batch, RasterStats& stats) {
-    batch.count = 0;
-    batch.indices_valid = 0;
+    // Counters, the vertex count and the cache's planes in locals: the stores to the batch
+    // could alias them, and were reloaded and stored for every triangle.
+    const VertexClip c = cache;
+    const std::size_t vertex_count = in.vertex_count;
+    std::uint64_t invalid = 0, outside = 0;
+    int count = 0;
     std::size_t t = first;
-    for (; t < end && batch.count < TriangleBatch::kSize; ++t) {
-        ++stats.triangles_in;
+    for (; t < end && count < TriangleBatch::kSize; ++t) {
         std::uint32_t v[3];
         bool valid = true;
         for (int k = 0; k < 3; ++k) {
             v[k] = vertex_index(indices, t, k);
-            valid = valid && v[k] < in.vertex_count;
+            valid = valid && v[k] < vertex_count;
         }
         if (!valid) {
-            ++stats.invalid;
+            ++invalid;
             continue;
         }
-        const std::uint8_t a = cache.outcode[v[0]], b = cache.outcode[v[1]], c = cache.outcode[v[2]];
-        if ((a | b | c) & kNotFinite) {
-            ++stats.invalid;
+        const std::uint8_t a = c.outcode[v[0]], b = c.outcode[v[1]], o = c.outcode[v[2]];
+        if ((a | b | o) & kNotFinite) {
+            ++invalid;
             continue;
         }
-        if (a & b & c & kOutsidePlanes) {
-            ++stats.outside;
+        if (a & b & o & kOutsidePlanes) {
+            ++outside;
             continue;
         }
-        const int lane = batch.count++;
+        const int lane = count++;
         batch.triangle[lane] = t;
-        batch.indices_valid |= 1u << lane;
         for (int k = 0; k < 3; ++k) {
-            batch.cx[k][lane] = cache.x[v[k]], batch.cy[k][lane] = cache.y[v[k]];
-            batch.cz[k][lane] = cache.z[v[k]], batch.cw[k][lane] = cache.w[v[k]];
+            batch.cx[k][lane] = c.x[v[k]], batch.cy[k][lane] = c.y[v[k]];
+            batch.cz[k][lane] = c.z[v[k]], batch.cw[k][lane] = c.w[v[k]];
         }
     }
+    stats.triangles_in += t - first;
+    stats.invalid += invalid;
+    stats.outside += outside;
+    batch.count = count;
+    batch.indices_valid = count == 32 ? ~0u : (1u << count) - 1u;
     return t;
 }
 
