@@ -298,7 +298,8 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
                 }
                 const auto x = hn::Add(hn::Set(d, e.ox[k]), hn::Mul(c, hn::Set(d, e.inverse_sa[k])));
                 const auto v = hn::Sub(x, half);
-                const auto xs = hn::IfThenElse(hn::Lt(v, lo_clamp), lo_clamp, hn::IfThenElse(hn::Lt(hi_clamp, v), hi_clamp, v));
+                // std::clamp: v is finite, and a zero of either sign gives the same integer.
+                const auto xs = hn::Min(hn::Max(v, lo_clamp), hi_clamp);
                 if (e.sa[k] > 0.0) lo = hn::Max(lo, e.shared[k] ? hn::Ceil(xs) : hn::Add(hn::Floor(xs), one));
                 else hi = hn::Min(hi, e.shared[k] ? hn::Floor(xs) : hn::Sub(hn::Ceil(xs), one));
             }
