@@ -63,7 +63,7 @@ HWY_INLINE void StoreRows(hn::Vec<D> v, D d, T* plane, std::size_t row0, std::si
 // The index (0..24) of the highest set bit of each lane of v, for v < 2^25 (as int), from the
 // exponent of float(v): exact below 2^24, and rounding in [2^24, 2^25) cannot reach 2^25.
 template <class DU>
-HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> HighestBitIndex(DU du, hn::Vec<DU> v) {
+HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> HighestBitIndex(DU /* du */, hn::Vec<DU> v) {
     const hn::RebindToSigned<DU> di;
     const hn::RebindToFloat<DU> df;
     const auto exponent = hn::ShiftRight<23>(hn::BitCast(di, hn::ConvertTo(df, hn::BitCast(di, v))));
