@@ -80,12 +80,11 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
 // The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2) of a triangle with
 // sample columns [i0, i1], over the subtile columns its sample rows reach (as
 // reached_subtile_columns, or all of the triangle's when one vector spans them; lanes without
-// samples change nothing), the subtiles tx..tx + columns - 1
-// of each row as vector lanes, float and 32-bit integer: at most 8 columns (4 on SSE4 and NEON;
-// rows are padded for kMaxSimdLanes). first and last hold the rows' sample-row intervals, 4 per
-// subtile row, readable for kMaxSimdLanes entries. Two rows at a time suit AVX-512's 16 lanes:
-// S1's triangles reach about 5 subtiles per row, and one row in 16 lanes was 10 % slower than
-// in 8. Returns the number of subtiles updated.
+// samples change nothing). The subtiles tx..tx + columns - 1 of each row are the vector lanes,
+// float and 32-bit integer: at most 8 columns (4 on SSE4 and NEON; rows are padded for
+// kMaxSimdLanes). first and last hold the rows' sample-row intervals, 4 per subtile row. Two
+// rows at a time suit AVX-512's 16 lanes: S1's triangles reach about 5 subtiles per row, and
+// one row in 16 lanes was 10 % slower than in 8. Returns the number of subtiles updated.
 //
 // The coverage masks come from sample rows (as Intel's Masked Occlusion Culling computes them):
 // before the update, lane l holds sample row l % 4 of one subtile row across 32 samples, 4
@@ -128,10 +127,19 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
 
     // Before the transpose, lane l is sample row l % 4 of its subtile row: its interval, and
     // the first sample of its 32 (the block's first subtile column, relative to tx).
-    const VI sample_row = hn::Add(hn::And(lane, hn::Set(di, kH - 1)), hn::IfThenElseZero(second_row, hn::Set(di, kH)));
-    const auto row_of_lane = hn::IndicesFromVec(di, sample_row);
-    const VI first_v = hn::TableLookupLanes(hn::LoadU(di, first), row_of_lane);
-    const VI last_v = hn::TableLookupLanes(hn::LoadU(di, last), row_of_lane);
+    // Each subtile row's 4 intervals repeated in every block of its lanes, by 128-bit loads
+    // that lie within one store of the row pass (a wider load across two of its stores waited
+    // for them to retire: no store forwarding).
+    const auto row_intervals = [&](const std::int32_t* rows) {
+#if HOMCULL_PAIR_ROWS
+        if constexpr (kRows == 2) {
+            const hn::Half<decltype(di)> dh;
+            return hn::Combine(di, hn::LoadDup128(dh, rows + kH), hn::LoadDup128(dh, rows));
+        }
+#endif
+        return hn::LoadDup128(di, rows);
+    };
+    const VI first_v = row_intervals(first), last_v = row_intervals(last);
     // The subtile columns: the triangle's, when one vector spans them; else those the rows
     // reach (reached_subtile_columns: the intervals lie within the triangle's columns [i0, i1],
     // so their extremes bound its subtiles too).
@@ -278,9 +286,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
 #if HOMCULL_PAIR_ROWS
     const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
 #endif
-    // + kMaxSimdLanes: the last vector of the row pass may pass the chunk's rows, and the
-    // subtile-row update reads kMaxSimdLanes entries from the start of its rows.
-    HWY_ALIGN std::int32_t first[kChunkRows + kMaxSimdLanes], last[kChunkRows + kMaxSimdLanes];
+    HWY_ALIGN std::int32_t first[kChunkRows + 8], last[kChunkRows + 8];  // + 8: the last vector may pass the chunk's rows
     std::uint64_t touched = 0;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
@@ -307,8 +313,6 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             hn::StoreU(hn::DemoteTo(di, lo), di, first + r);
             hn::StoreU(hn::DemoteTo(di, hi), di, last + r);
         }
-        // Defined values past the chunk's rows (the update reads but never uses them).
-        for (int r = rows; r < rows + kMaxSimdLanes; ++r) first[r] = last[r] = 0;
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
