@@ -125,11 +125,10 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     const VU replicate_v = hn::BitCast(du, per_row(std::int32_t(replicate[0]), std::int32_t(replicate[kRows - 1])));
     const VI row_y = per_row(ty * kH, (ty + kRows - 1) * kH);
 
-    // Before the transpose, lane l is sample row l % 4 of its subtile row: its interval, and
-    // the first sample of its 32 (the block's first subtile column, relative to tx).
-    // Each subtile row's 4 intervals repeated in every block of its lanes, by 128-bit loads
-    // that lie within one store of the row pass (a wider load across two of its stores waited
-    // for them to retire: no store forwarding).
+    // Before the transpose, lane l is sample row l % 4 of its subtile row: each subtile row's
+    // 4 intervals repeated in every block of its lanes, by 128-bit loads that lie within one
+    // store of the row pass (a wider load across two of its stores waited for them to retire:
+    // no store forwarding).
     const auto row_intervals = [&](const std::int32_t* rows) {
 #if HOMCULL_PAIR_ROWS
         if constexpr (kRows == 2) {
@@ -150,6 +149,7 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
         tx_begin = hn::GetLane(hn::MinOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, 1 << 30), first_v))) / kW;
         tx_end = hn::GetLane(hn::MaxOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, -1), last_v))) / kW;
     }
+    // The first sample of a lane's 32, relative to tx * 8: its block's first subtile column.
     const VI block_sample = hn::ShiftLeft<3>(hn::AndNot(hn::Set(di, kH - 1), lane_column));
     // Byte 4c + j of a block takes byte 4j + c: dword c = 0x0C080400 + c * 0x01010101.
     const VU transpose = hn::BitCast(du, hn::Add(hn::Set(di, 0x0C080400), hn::Mul(hn::And(lane, hn::Set(di, 3)), hn::Set(di, 0x01010101))));
