@@ -62,7 +62,7 @@ std::size_t gather_cached(const Index* indices, const TriangleInput& in, const V
     stats.invalid += invalid;
     stats.outside += outside;
     batch.count = count;
-    batch.indices_valid = count == 32 ? ~0u : (1u << count) - 1u;
+    batch.indices_valid = (1u << count) - 1u;  // count <= kSize < 32
     return t;
 }
 
