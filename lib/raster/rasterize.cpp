@@ -67,8 +67,7 @@ PreparedTriangle finish_depth_plane(const DepthPlaneTerms& t, const double d[3])
         tri.a = tri.dzdx = tri.dzdy = tri.error = 0.0f;
         tri.has_plane = false;
     }
-    tri.far_is_left = tri.dzdx > 0.0f;
-    tri.far_is_top = tri.dzdy > 0.0f;
+    set_far_corner(tri);
     return tri;
 }
 

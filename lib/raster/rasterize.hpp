@@ -72,6 +72,12 @@ struct PreparedTriangle {
     bool has_plane;                // false: too steep for float, a, dzdx, dzdy and error are 0
 };
 
+// Where a prepared plane is smallest (its far corner), from the signs of its float slopes.
+inline void set_far_corner(PreparedTriangle& tri) {
+    tri.far_is_left = tri.dzdx > 0.0f;
+    tri.far_is_top = tri.dzdy > 0.0f;
+}
+
 // The depth plane of a triangle with vertices p[k] and depths d[k] (counter-clockwise,
 // twice its area `area2` > 0), for a sample grid of width x height.
 PreparedTriangle prepare_depth_plane(const glm::dvec2 p[3], const double d[3], double area2, int width, int height);

@@ -98,6 +98,10 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
                                            int i0, int i1, const PreparedTriangle& tri, int sample_width, int sample_height) {
     static_assert(kRows == 1 || kRows == 2, "one or two subtile rows");
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    // The byte transpose below takes subtiles of 4 rows of 8 samples (a byte per sample row),
+    // 4 of them (32 samples) per 128-bit block.
+    static_assert(kW == 8 && kH == 4, "the transpose assumes 8 x 4 subtiles");
+    constexpr int kSubtilesPerBlock = 4;
     const hn::CappedTag<float, 8 * kRows> df;
     const hn::RebindToSigned<decltype(df)> di;
     const hn::RebindToUnsigned<decltype(df)> du;
@@ -150,9 +154,10 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
         tx_end = hn::GetLane(hn::MaxOfLanes(di, hn::IfThenElse(row_empty, hn::Set(di, -1), last_v))) / kW;
     }
     // The first sample of a lane's 32, relative to tx * 8: its block's first subtile column.
-    const VI block_sample = hn::ShiftLeft<3>(hn::AndNot(hn::Set(di, kH - 1), lane_column));
+    const VI block_sample = hn::ShiftLeft<3>(hn::AndNot(hn::Set(di, kSubtilesPerBlock - 1), lane_column));
     // Byte 4c + j of a block takes byte 4j + c: dword c = 0x0C080400 + c * 0x01010101.
-    const VU transpose = hn::BitCast(du, hn::Add(hn::Set(di, 0x0C080400), hn::Mul(hn::And(lane, hn::Set(di, 3)), hn::Set(di, 0x01010101))));
+    const VU transpose = hn::BitCast(
+        du, hn::Add(hn::Set(di, 0x0C080400), hn::Mul(hn::And(lane, hn::Set(di, kSubtilesPerBlock - 1)), hn::Set(di, 0x01010101))));
 
     const std::size_t row0 = std::size_t(ty) * planes.stride, row1 = std::size_t(ty + kRows - 1) * planes.stride;
     const auto load = [&](auto d, const auto* plane, std::size_t tx) { return LoadRows<kRows>(d, plane, row0, row1, tx); };

@@ -131,8 +131,7 @@ bool assemble_raster_triangle(const BatchSetup& s, int t, std::uint8_t shared_bi
     plane.a = s.plane_a[t], plane.dzdx = s.plane_dzdx[t], plane.dzdy = s.plane_dzdy[t], plane.error = s.plane_error[t];
     plane.z_vertex_min = s.z_vertex_min[t];
     plane.has_plane = (s.has_plane >> t) & 1u;
-    plane.far_is_left = plane.dzdx > 0.0f;
-    plane.far_is_top = plane.dzdy > 0.0f;
+    set_far_corner(plane);
     return true;
 }
 
