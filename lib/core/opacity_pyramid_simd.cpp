@@ -87,18 +87,15 @@ int Level0SingleSample(const Level0Maps& m) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "raster/resolved_kernel.hpp"
+
 namespace homcull::detail {
 
 HWY_EXPORT(ReducePyramidRow);
 HWY_EXPORT(Level0SingleSample);
 
-namespace {
-int dispatch_reduce(const PyramidRows& rows, int pairs) { return HWY_DYNAMIC_DISPATCH(ReducePyramidRow)(rows, pairs); }
-int dispatch_level0(const Level0Maps& maps) { return HWY_DYNAMIC_DISPATCH(Level0SingleSample)(maps); }
-}  // namespace
-
-PyramidRowKernel selected_pyramid_row_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_reduce; }
-Level0Kernel selected_level0_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_level0; }
+PyramidRowKernel selected_pyramid_row_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(ReducePyramidRow); }
+Level0Kernel selected_level0_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(Level0SingleSample); }
 
 }  // namespace homcull::detail
 #endif  // HWY_ONCE

@@ -245,25 +245,15 @@ void TestRectBlock(const CoarseRectView& view, const SubtileView& subtiles, cons
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "raster/resolved_kernel.hpp"
+
 namespace homcull::detail {
 
 HWY_EXPORT(TestRectBlock);
 HWY_EXPORT(RectScan);
 
-namespace {
-void dispatch_block(const CoarseRectView& view, const SubtileView& subtiles, const ScreenRect* rects, std::size_t count,
-                    Visibility* results) {
-    HWY_DYNAMIC_DISPATCH(TestRectBlock)(view, subtiles, rects, count, results);
-}
-}  // namespace
-
-
-Visibility dispatch_scan(const SubtileView& view, const RectQuery& q) {
-    return HWY_DYNAMIC_DISPATCH(RectScan)(view, q);
-}
-
-RectBlockKernel selected_rect_block_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_block; }
-RectScanKernel selected_rect_scan_kernel() { return scalar_reference_selected() ? nullptr : &dispatch_scan; }
+RectBlockKernel selected_rect_block_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(TestRectBlock); }
+RectScanKernel selected_rect_scan_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(RectScan); }
 
 }  // namespace homcull::detail
 #endif  // HWY_ONCE

@@ -348,6 +348,8 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 #include <homcull/error.hpp>
 
+#include "raster/resolved_kernel.hpp"
+
 #include <atomic>
 #include <string>
 
@@ -361,10 +363,6 @@ namespace {
 // The selected kernel: the reference, or Highway's choice among the allowed targets.
 std::atomic<bool> use_reference{false};
 
-std::uint64_t dispatch(const RasterTarget& t, const RasterTriangle& triangle) {
-    return HWY_DYNAMIC_DISPATCH(RasterizeRows)(t, triangle);
-}
-
 struct NamedTarget {
     const char* name;
     std::int64_t bits;
@@ -374,7 +372,7 @@ const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4
 
 }  // namespace
 
-TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_rows_reference : &dispatch; }
+TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_rows_reference : HOMCULL_RESOLVED_KERNEL(RasterizeRows); }
 bool scalar_reference_selected() { return use_reference; }
 
 }  // namespace detail

@@ -275,6 +275,8 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "raster/resolved_kernel.hpp"
+
 namespace homcull::detail {
 
 HWY_EXPORT(TransformVertices);
@@ -282,23 +284,11 @@ HWY_EXPORT(TransformBatch);
 HWY_EXPORT(ClassifyBatch);
 HWY_EXPORT(SetupBatch);
 
-namespace {
-void dispatch_transform_vertices(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache) {
-    HWY_DYNAMIC_DISPATCH(TransformVertices)(in, near_w, begin, end, cache);
-}
-void dispatch_transform_batch(const TriangleInput& in, TriangleBatch& batch) { HWY_DYNAMIC_DISPATCH(TransformBatch)(in, batch); }
-void dispatch_classify(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
-    HWY_DYNAMIC_DISPATCH(ClassifyBatch)(backface, near_w, batch, stats);
-}
-void dispatch_setup(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& setup) {
-    HWY_DYNAMIC_DISPATCH(SetupBatch)(batch, sample_width, sample_height, setup);
-}
-}  // namespace
-
 FrontEndKernels selected_front_end_kernels() {
     if (scalar_reference_selected())
         return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr};
-    return {&dispatch_transform_vertices, &dispatch_transform_batch, &dispatch_classify, &dispatch_setup};
+    return {HOMCULL_RESOLVED_KERNEL(TransformVertices), HOMCULL_RESOLVED_KERNEL(TransformBatch), HOMCULL_RESOLVED_KERNEL(ClassifyBatch),
+            HOMCULL_RESOLVED_KERNEL(SetupBatch)};
 }
 
 }  // namespace homcull::detail
