@@ -4,6 +4,8 @@
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 
+#include <hwy/cache_control.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -13,6 +15,17 @@ namespace {
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 constexpr std::size_t kChunkTriangles = 2048;  // triangles set up per task
 constexpr int kBandSubtileRows = 16;          // subtile rows rasterized per task (64 sample rows)
+
+// A band reads its bins' triangles in order, but they were written by whichever thread set up
+// their chunk, and a kernel call per triangle is too short for the hardware prefetcher to
+// follow: they are prefetched this many triangles ahead (S1 at 1080p, two threads: 14.0 ->
+// 13.2 ms; 2, 8 and 16 ahead were within noise of each other).
+constexpr std::size_t kPrefetchTriangles = 8;
+
+void prefetch_triangle(const detail::RasterTriangle& tri) {
+    const char* bytes = reinterpret_cast<const char*>(&tri);
+    for (std::size_t offset = 0; offset < sizeof tri; offset += 64) hwy::Prefetch(bytes + offset);
+}
 
 }  // namespace
 
@@ -194,8 +207,13 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         const int row_begin = int(band) * kBandSubtileRows;
         const detail::RasterTarget target = b.raster_target(row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_));
         std::uint64_t touched = 0;
-        for (std::size_t c = 0; c < j.chunk_count; ++c)
-            for (const detail::RasterTriangle& tri : b.chunks_[c].bins[band]) touched += target.kernel(target, tri);
+        for (std::size_t c = 0; c < j.chunk_count; ++c) {
+            const std::vector<detail::RasterTriangle>& bin = b.chunks_[c].bins[band];
+            for (std::size_t k = 0; k < bin.size(); ++k) {
+                if (k + kPrefetchTriangles < bin.size()) prefetch_triangle(bin[k + kPrefetchTriangles]);
+                touched += target.kernel(target, bin[k]);
+            }
+        }
         b.band_touched_[band] = touched;
     }, &job);
 
