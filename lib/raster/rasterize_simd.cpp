@@ -18,17 +18,14 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// Whether this target has vectors of at least 4 lanes (every one but the scalar target, which
-// updates subtiles with the reference), and whether it may update two subtile rows per vector
-// (AVX-512, and SVE when its vectors are that wide).
+// Whether this target has vectors of at least 4 lanes: every one but the scalar target, which
+// updates subtiles with the reference. (Whether it updates two subtile rows per vector is
+// decided at run time, from its float lanes: 16 on AVX-512, and on SVE when that wide.)
 #undef HOMCULL_SUBTILE_LANES
-#undef HOMCULL_PAIR_ROWS
 #if HWY_TARGET == HWY_SCALAR
 #define HOMCULL_SUBTILE_LANES 0
-#define HOMCULL_PAIR_ROWS 0
 #else
 #define HOMCULL_SUBTILE_LANES 1
-#define HOMCULL_PAIR_ROWS 1
 #endif
 
 #if HOMCULL_SUBTILE_LANES
@@ -37,25 +34,21 @@ namespace hn = hwy::HWY_NAMESPACE;
 // half a vector from each of row0 and row1.
 template <int kRows, class D, typename T>
 HWY_INLINE hn::Vec<D> LoadRows(D d, const T* plane, std::size_t row0, std::size_t row1, std::size_t tx) {
-#if HOMCULL_PAIR_ROWS
     if constexpr (kRows == 2) {
         const hn::Half<D> dh;
         return hn::Combine(d, hn::LoadU(dh, plane + row1 + tx), hn::LoadU(dh, plane + row0 + tx));
     }
-#endif
     (void)row1;
     return hn::LoadU(d, plane + row0 + tx);
 }
 template <int kRows, class D, typename T>
 HWY_INLINE void StoreRows(hn::Vec<D> v, D d, T* plane, std::size_t row0, std::size_t row1, std::size_t tx) {
-#if HOMCULL_PAIR_ROWS
     if constexpr (kRows == 2) {
         const hn::Half<D> dh;
         hn::StoreU(hn::LowerHalf(dh, v), dh, plane + row0 + tx);
         hn::StoreU(hn::UpperHalf(dh, v), dh, plane + row1 + tx);
         return;
     }
-#endif
     (void)row1;
     hn::StoreU(v, d, plane + row0 + tx);
 }
@@ -134,12 +127,10 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     // store of the row pass (a wider load across two of its stores waited for them to retire:
     // no store forwarding).
     const auto row_intervals = [&](const std::int32_t* rows) {
-#if HOMCULL_PAIR_ROWS
         if constexpr (kRows == 2) {
             const hn::Half<decltype(di)> dh;
             return hn::Combine(di, hn::LoadDup128(dh, rows + kH), hn::LoadDup128(dh, rows));
         }
-#endif
         return hn::LoadDup128(di, rows);
     };
     const VI first_v = row_intervals(first), last_v = row_intervals(last);
@@ -288,7 +279,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     const auto sample_lane = hn::Iota(hn::CappedTag<std::int32_t, kMaxSimdLanes>(), 0);
 
     constexpr int kChunkSubtileRows = 16, kChunkRows = kChunkSubtileRows * kH;
-#if HOMCULL_PAIR_ROWS
+#if HOMCULL_SUBTILE_LANES
     const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
 #endif
     HWY_ALIGN std::int32_t first[kChunkRows + 8], last[kChunkRows + 8];  // + 8: the last vector may pass the chunk's rows
@@ -323,7 +314,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             const std::int32_t* row_last = last + (ty - ty0) * kH;
 #if HOMCULL_SUBTILE_LANES
             // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
-            const int rows_now = HOMCULL_PAIR_ROWS && pair_rows && ty < ty1 ? 2 : 1;
+            const int rows_now = pair_rows && ty < ty1 ? 2 : 1;
             touched += rows_now == 2 ? UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height)
                                      : UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
 #else
