@@ -121,9 +121,13 @@ bool setup_raster_triangle(const ScreenTriangle& triangle, double edge_margin, i
     sample_span(std::min({v[0].y, v[1].y, v[2].y}), std::max({v[0].y, v[1].y, v[2].y}), sample_height, out.j0, out.j1);
     if (out.i0 > out.i1 || out.j0 > out.j1) return false;
 
-    out.edges = edge_functions(tri);
+    TriangleEdges edges = edge_functions(tri);
     for (int k = 0; k < 3; ++k)  // inner margin on silhouette edges (see the top of this file)
-        out.edges.threshold[k] = edge_threshold(out.edges.shared[k], edge_margin, out.edges.sa[k], out.edges.sb[k]);
+        edges.threshold[k] = edge_threshold(edges.shared[k], edge_margin, edges.sa[k], edges.sb[k]);
+    FloatRowEdges float_edges;
+    out.float_rows = prepare_float_row_edges(edges, out.i0, out.i1, float_edges);
+    if (out.float_rows) out.float_edges = float_edges;
+    else out.edges = edges;
     out.plane = prepare_depth_plane(tri.v, tri.d, tri.area2, sample_width, sample_height);
     return true;
 }
@@ -147,15 +151,60 @@ void sample_row_interval(const TriangleEdges& edges, int row, int i0, int i1, st
     }
 }
 
+bool prepare_float_row_edges(const TriangleEdges& e, int i0, int i1, FloatRowEdges& out) {
+    constexpr double kLimit = 0x1.0p22, kMaxError = 0x1.0p-8;
+    for (int k = 0; k < 3; ++k) {
+        if (e.shared[k] || e.sa[k] == 0.0) return false;
+        const double ox = e.ox[k], oy = e.oy[k];
+        if (!(std::abs(ox) < kLimit && std::abs(oy) < kLimit)) return false;
+        const double ox_int = floor_int(ox), oy_int = floor_int(oy);  // exact: |ox|, |oy| < 2^22
+        const double slope = e.sb[k] * e.inverse_sa[k], offset = e.threshold[k] * e.inverse_sa[k];
+        // The rows whose boundary lies within [i0 - 3, i1 + 3] have |x_k - ox| <= reach.
+        const double reach = std::max(std::abs(ox - (i0 - 3)), std::abs(ox - (i1 + 3))) + 1.0;
+        const double error = 0x1.0p-20 * (reach + std::abs(slope) + std::abs(offset) + 2.0);
+        if (!(error <= kMaxError)) return false;
+        const bool lower = e.sa[k] > 0.0;
+        const double h = lower ? 0.5 - error : 0.5 + error;
+        out.row_origin[k] = float(oy_int);
+        out.y_offset[k] = float((oy - oy_int) - 0.5);  // exact in double: frac(oy) is a multiple of oy's ulp
+        out.slope[k] = float(slope);
+        out.base[k] = float((ox - ox_int) + offset - h);
+        out.lo_clamp[k] = float(i0 - 2 - ox_int);
+        out.hi_clamp[k] = float(i1 + 2 - ox_int);
+        out.column_shift[k] = float(lower ? 1.0 + ox_int : ox_int - 1.0);
+        out.lower[k] = lower;
+    }
+    return true;
+}
+
+void float_sample_row_interval(const FloatRowEdges& e, int row, int i0, int i1, std::int32_t& first, std::int32_t& last) {
+    float lo = float(i0), hi = float(i1);
+    const float y = float(row);
+    for (int k = 0; k < 3; ++k) {
+        const float v = e.base[k] - e.slope[k] * ((y - e.row_origin[k]) - e.y_offset[k]);
+        const float clamped = std::min(std::max(v, e.lo_clamp[k]), e.hi_clamp[k]);
+        if (e.lower[k]) lo = std::max(lo, std::floor(clamped) + e.column_shift[k]);
+        else hi = std::min(hi, std::ceil(clamped) + e.column_shift[k]);
+    }
+    first = std::int32_t(lo);
+    last = std::int32_t(hi);
+}
+
 std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriangle& triangle) {
-    const TriangleEdges& edges = triangle.edges;
     const PreparedTriangle& prepared = triangle.plane;
     const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
     std::uint64_t touched = 0;
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         // The covered interval [first, last] of each of the subtile row's sample rows.
         std::int32_t first[kH], last[kH];
-        subtile_row_intervals(&edges, ty, i0, i1, j0, j1, first, last);
+        if (!triangle.float_rows) subtile_row_intervals(&triangle.edges, ty, i0, i1, j0, j1, first, last);
+        else
+            for (int j = 0; j < kH; ++j) {
+                const int row = ty * kH + j;
+                first[j] = i0;
+                last[j] = i0 - 1;
+                if (row >= j0 && row <= j1) float_sample_row_interval(triangle.float_edges, row, i0, i1, first[j], last[j]);
+            }
         int tx_begin, tx_end;
         if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, first, last, prepared, t.sample_width, t.sample_height);

@@ -256,59 +256,94 @@ HWY_INLINE void UpdateSampleDepth(const SubtilePlanes& planes, int ty, const std
     }
 }
 
-// The reference's row loop, in two passes over chunks of up to 16 subtile rows: first the
-// coverage interval of every sample row of the chunk, the sample rows as vector lanes (8 on
-// AVX-512, 4 on AVX2, 2 on SSE4), each lane evaluating rasterize_rows_reference's formula for
-// its row; then the subtile-row updates. (One subtile row at a time, 4 lanes of intervals
-// then the update, cost twice as much per row on S1.)
-std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangle) {
+// The coverage intervals [first[r], last[r]] of sample rows row0 + r, r in [0, rows), by the
+// double rule (sample_row_interval), the rows as lanes: 8 on AVX-512, 4 on AVX2, 2 on SSE4.
+// Writes up to a vector past `rows`.
+HWY_INLINE void DoubleRowIntervals(const RasterTriangle& triangle, int row0, int rows, std::int32_t* first, std::int32_t* last) {
     const TriangleEdges& e = triangle.edges;
-    const PreparedTriangle& tri = triangle.plane;
-    const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
-    constexpr int kH = OcclusionBuffer::kSubtileHeight;
-    const int ty_first = std::max(j0 / kH, t.row_begin), ty_last = std::min(j1 / kH, t.row_end - 1);
-    if (ty_first > ty_last) return 0;
-
     const hn::CappedTag<double, 8> d;
     const hn::Rebind<std::int32_t, decltype(d)> di;
     const int lanes = int(hn::Lanes(d));
-    const auto lo_clamp = hn::Set(d, double(i0) - 2.0), hi_clamp = hn::Set(d, double(i1) + 2.0);
+    const auto lo_clamp = hn::Set(d, double(triangle.i0) - 2.0), hi_clamp = hn::Set(d, double(triangle.i1) + 2.0);
     const auto half = hn::Set(d, 0.5), one = hn::Set(d, 1.0), zero = hn::Zero(d);
-    const auto row_min = hn::Set(d, double(j0)), row_max = hn::Set(d, double(j1));
+    const auto row_min = hn::Set(d, double(triangle.j0)), row_max = hn::Set(d, double(triangle.j1));
     const auto lane = hn::Iota(d, 0.0);  // once: Highway's Iota goes through memory
+    for (int r = 0; r < rows; r += lanes) {
+        const auto sy = hn::Add(lane, hn::Set(d, double(row0 + r)));  // exact: small integers
+        const auto py = hn::Add(sy, half);
+        auto lo = hn::Set(d, double(triangle.i0)), hi = hn::Set(d, double(triangle.i1));
+        auto empty = hn::Or(hn::Lt(sy, row_min), hn::Gt(sy, row_max));
+        for (int k = 0; k < 3; ++k) {
+            const auto c = hn::Sub(hn::Set(d, e.threshold[k]), hn::Mul(hn::Set(d, e.sb[k]), hn::Sub(py, hn::Set(d, e.oy[k]))));
+            if (e.sa[k] == 0.0) {
+                empty = hn::Or(empty, e.shared[k] ? hn::Gt(c, zero) : hn::Ge(c, zero));
+                continue;
+            }
+            const auto x = hn::Add(hn::Set(d, e.ox[k]), hn::Mul(c, hn::Set(d, e.inverse_sa[k])));
+            const auto v = hn::Sub(x, half);
+            // std::clamp: v is finite, and a zero of either sign gives the same integer.
+            const auto xs = hn::Min(hn::Max(v, lo_clamp), hi_clamp);
+            if (e.sa[k] > 0.0) lo = hn::Max(lo, e.shared[k] ? hn::Ceil(xs) : hn::Add(hn::Floor(xs), one));
+            else hi = hn::Min(hi, e.shared[k] ? hn::Floor(xs) : hn::Sub(hn::Ceil(xs), one));
+        }
+        hi = hn::IfThenElse(empty, hn::Sub(lo, one), hi);
+        hn::StoreU(hn::DemoteTo(di, lo), di, first + r);
+        hn::StoreU(hn::DemoteTo(di, hi), di, last + r);
+    }
+}
+
+// The same by the float rule (float_sample_row_interval): twice the rows per vector, 16 on
+// AVX-512. Writes up to a vector past `rows`.
+HWY_INLINE void FloatRowIntervals(const RasterTriangle& triangle, int row0, int rows, std::int32_t* first, std::int32_t* last) {
+    const FloatRowEdges& e = triangle.float_edges;
+    const hn::CappedTag<float, kMaxSimdLanes> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const int lanes = int(hn::Lanes(df));
+    const auto row_min = hn::Set(df, float(triangle.j0)), row_max = hn::Set(df, float(triangle.j1)), one = hn::Set(df, 1.0f);
+    const auto lane = hn::Iota(df, 0.0f);
+    for (int r = 0; r < rows; r += lanes) {
+        const auto y = hn::Add(lane, hn::Set(df, float(row0 + r)));  // exact: small integers
+        auto lo = hn::Set(df, float(triangle.i0)), hi = hn::Set(df, float(triangle.i1));
+        for (int k = 0; k < 3; ++k) {
+            const auto dy = hn::Sub(hn::Sub(y, hn::Set(df, e.row_origin[k])), hn::Set(df, e.y_offset[k]));
+            const auto v = hn::Sub(hn::Set(df, e.base[k]), hn::Mul(hn::Set(df, e.slope[k]), dy));
+            const auto clamped = hn::Min(hn::Max(v, hn::Set(df, e.lo_clamp[k])), hn::Set(df, e.hi_clamp[k]));
+            const auto shift = hn::Set(df, e.column_shift[k]);
+            if (e.lower[k]) lo = hn::Max(lo, hn::Add(hn::Floor(clamped), shift));
+            else hi = hn::Min(hi, hn::Add(hn::Ceil(clamped), shift));
+        }
+        const auto empty = hn::Or(hn::Lt(y, row_min), hn::Gt(y, row_max));
+        hi = hn::IfThenElse(empty, hn::Sub(lo, one), hi);
+        hn::StoreU(hn::ConvertTo(di, lo), di, first + r);
+        hn::StoreU(hn::ConvertTo(di, hi), di, last + r);
+    }
+}
+
+// The reference's row loop, in two passes over chunks of up to 16 subtile rows: first the
+// coverage interval of every sample row of the chunk (DoubleRowIntervals, or
+// FloatRowIntervals for the triangles set up for it), each lane evaluating
+// rasterize_rows_reference's formula for its row; then the subtile-row updates. (One subtile
+// row at a time, 4 lanes of intervals then the update, cost twice as much per row on S1.)
+std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangle) {
+    const PreparedTriangle& tri = triangle.plane;
+    const int i0 = triangle.i0, i1 = triangle.i1, j1 = triangle.j1;
+    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    const int ty_first = std::max(triangle.j0 / kH, t.row_begin), ty_last = std::min(j1 / kH, t.row_end - 1);
+    if (ty_first > ty_last) return 0;
     const auto sample_lane = hn::Iota(hn::CappedTag<std::int32_t, kMaxSimdLanes>(), 0);
 
     constexpr int kChunkSubtileRows = 16, kChunkRows = kChunkSubtileRows * kH;
 #if HOMCULL_SUBTILE_LANES
     const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
 #endif
-    HWY_ALIGN std::int32_t first[kChunkRows + 8], last[kChunkRows + 8];  // + 8: the last vector may pass the chunk's rows
+    // + kMaxSimdLanes: the last vector may pass the chunk's rows
+    HWY_ALIGN std::int32_t first[kChunkRows + kMaxSimdLanes], last[kChunkRows + kMaxSimdLanes];
     std::uint64_t touched = 0;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         const int row0 = ty0 * kH, rows = (ty1 - ty0 + 1) * kH;
-        for (int r = 0; r < rows; r += lanes) {
-            const auto sy = hn::Add(lane, hn::Set(d, double(row0 + r)));  // exact: small integers
-            const auto py = hn::Add(sy, half);
-            auto lo = hn::Set(d, double(i0)), hi = hn::Set(d, double(i1));
-            auto empty = hn::Or(hn::Lt(sy, row_min), hn::Gt(sy, row_max));
-            for (int k = 0; k < 3; ++k) {
-                const auto c = hn::Sub(hn::Set(d, e.threshold[k]), hn::Mul(hn::Set(d, e.sb[k]), hn::Sub(py, hn::Set(d, e.oy[k]))));
-                if (e.sa[k] == 0.0) {
-                    empty = hn::Or(empty, e.shared[k] ? hn::Gt(c, zero) : hn::Ge(c, zero));
-                    continue;
-                }
-                const auto x = hn::Add(hn::Set(d, e.ox[k]), hn::Mul(c, hn::Set(d, e.inverse_sa[k])));
-                const auto v = hn::Sub(x, half);
-                // std::clamp: v is finite, and a zero of either sign gives the same integer.
-                const auto xs = hn::Min(hn::Max(v, lo_clamp), hi_clamp);
-                if (e.sa[k] > 0.0) lo = hn::Max(lo, e.shared[k] ? hn::Ceil(xs) : hn::Add(hn::Floor(xs), one));
-                else hi = hn::Min(hi, e.shared[k] ? hn::Floor(xs) : hn::Sub(hn::Ceil(xs), one));
-            }
-            hi = hn::IfThenElse(empty, hn::Sub(lo, one), hi);
-            hn::StoreU(hn::DemoteTo(di, lo), di, first + r);
-            hn::StoreU(hn::DemoteTo(di, hi), di, last + r);
-        }
+        if (triangle.float_rows) FloatRowIntervals(triangle, row0, rows, first, last);
+        else DoubleRowIntervals(triangle, row0, rows, first, last);
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;

@@ -121,11 +121,23 @@ bool assemble_raster_triangle(const BatchSetup& s, int t, std::uint8_t shared_bi
     if (out.i0 > out.i1 || out.j0 > out.j1) return false;
     bool shared[3] = {(shared_bits & 1u) != 0, (shared_bits & 2u) != 0, (shared_bits & 4u) != 0};
     if ((s.flipped >> t) & 1u) std::swap(shared[0], shared[2]);  // edges 0->2, 2->1, 1->0 were edges 2, 1, 0
-    for (int k = 0; k < 3; ++k) {
-        out.edges.ox[k] = s.ox[k][t], out.edges.oy[k] = s.oy[k][t];
-        out.edges.sa[k] = s.sa[k][t], out.edges.sb[k] = s.sb[k][t], out.edges.inverse_sa[k] = s.inverse_sa[k][t];
-        out.edges.shared[k] = shared[k];
-        out.edges.threshold[k] = edge_threshold(shared[k], edge_margin, s.sa[k][t], s.sb[k][t]);
+    // prepare_float_row_edges' answer: the batch's floats when no edge is shared.
+    out.float_rows = !shared[0] && !shared[1] && !shared[2] && ((s.float_ready >> t) & 1u);
+    if (out.float_rows) {
+        FloatRowEdges& f = out.float_edges;
+        for (int k = 0; k < 3; ++k) {
+            f.row_origin[k] = s.row_origin[k][t], f.y_offset[k] = s.y_offset[k][t], f.slope[k] = s.slope[k][t];
+            f.base[k] = s.base[k][t], f.lo_clamp[k] = s.lo_clamp[k][t], f.hi_clamp[k] = s.hi_clamp[k][t];
+            f.column_shift[k] = s.column_shift[k][t];
+            f.lower[k] = s.sa[k][t] > 0.0;
+        }
+    } else {
+        for (int k = 0; k < 3; ++k) {
+            out.edges.ox[k] = s.ox[k][t], out.edges.oy[k] = s.oy[k][t];
+            out.edges.sa[k] = s.sa[k][t], out.edges.sb[k] = s.sb[k][t], out.edges.inverse_sa[k] = s.inverse_sa[k][t];
+            out.edges.shared[k] = shared[k];
+            out.edges.threshold[k] = edge_threshold(shared[k], edge_margin, s.sa[k][t], s.sb[k][t]);
+        }
     }
     PreparedTriangle& plane = out.plane;  // finish_depth_plane's, from SetupBatch
     plane.a = s.plane_a[t], plane.dzdx = s.plane_dzdx[t], plane.dzdy = s.plane_dzdy[t], plane.error = s.plane_error[t];

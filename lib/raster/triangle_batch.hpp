@@ -101,10 +101,17 @@ struct BatchSetup {
     alignas(64) double ox[3][kSize], oy[3][kSize], sa[3][kSize], sb[3][kSize], inverse_sa[3][kSize];
     alignas(64) float plane_a[kSize], plane_dzdx[kSize], plane_dzdy[kSize], plane_error[kSize], z_vertex_min[kSize];  // PreparedTriangle's
     alignas(64) std::int32_t i0[kSize], i1[kSize], j0[kSize], j1[kSize];
+    // prepare_float_row_edges' floats for edge k, as if no edge were shared (the thresholds of
+    // silhouette edges), and in float_ready, bit t, whether it accepted all three edges.
+    alignas(64) float row_origin[3][kSize], y_offset[3][kSize], slope[3][kSize], base[3][kSize];
+    alignas(64) float lo_clamp[3][kSize], hi_clamp[3][kSize], column_shift[3][kSize];
+    std::uint32_t float_ready = 0;
     std::uint32_t flipped = 0;    // bit t: vertices 1 and 2 were swapped to orient the triangle
     std::uint32_t has_plane = 0;  // bit t: PreparedTriangle::has_plane
 };
-using SetupBatchKernel = void (*)(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& setup);
+// silhouette_only, bit t: lane t has no shared edge (only such lanes can be float_ready).
+using SetupBatchKernel = void (*)(const TriangleBatch& batch, int sample_width, int sample_height, double edge_margin,
+                                  std::uint32_t silhouette_only, BatchSetup& setup);
 
 // The RasterTriangle of simple lane t, as setup_raster_triangle makes it from the projected
 // triangle with edge flags `shared_bits`; false when it has no area or covers no sample's box.
@@ -141,7 +148,17 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             first += std::size_t(batch.count);
         }
         kernels.classify(in.backface, near_w, batch, stats);
-        if (batch.simple) kernels.setup(batch, sample_width, sample_height, simple);
+        if (batch.simple) {
+            // The float row rule needs three silhouette edges: the setup skips it for groups of
+            // lanes that all have a shared edge (most of a closed mesh's).
+            std::uint32_t silhouette_only = batch.simple;
+            if (in.shared_edges)
+                for (std::uint32_t bits = batch.simple; bits != 0; bits &= bits - 1) {
+                    const int t = __builtin_ctz(bits);
+                    if (in.shared_edges[batch.triangle[t]] != 0) silhouette_only &= ~(1u << t);
+                }
+            kernels.setup(batch, sample_width, sample_height, edge_margin, silhouette_only, simple);
+        }
         for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
             const int t = __builtin_ctz(bits);
             const std::size_t index = batch.triangle[t];

@@ -186,10 +186,37 @@ HWY_INLINE hn::Vec<hn::Rebind<float, D>> FloatOutward(V v) {
     return hn::IfThenElse(wrong_side, hn::BitCast(df, stepped), f);
 }
 
+// prepare_float_row_edges for edge k of lanes [g, g + lanes), as a silhouette edge (threshold
+// edge_threshold(false, ...)): the same double operations lane by lane. Returns the lanes it
+// accepts.
+HWY_INLINE M FloatRowEdge(int k, int g, V ox, V oy, V sa, V sb, V inverse_sa, double edge_margin, V i0, V i1, BatchSetup& out) {
+    const D d;
+    const hn::Rebind<float, D> df;
+    const V zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
+    const V threshold = hn::Mul(hn::Set(d, edge_margin), hn::Add(hn::Abs(sa), hn::Abs(sb)));
+    const V limit = hn::Set(d, 0x1.0p22);
+    const M in_range = hn::And(hn::Lt(hn::Abs(ox), limit), hn::Lt(hn::Abs(oy), limit));
+    const V ox_int = hn::Floor(ox), oy_int = hn::Floor(oy);
+    const V slope = hn::Mul(sb, inverse_sa), offset = hn::Mul(threshold, inverse_sa);
+    const V reach = hn::Add(hn::Max(hn::Abs(hn::Sub(ox, hn::Sub(i0, hn::Set(d, 3.0)))), hn::Abs(hn::Sub(ox, hn::Add(i1, hn::Set(d, 3.0))))), one);
+    const V error = hn::Mul(hn::Set(d, 0x1.0p-20), hn::Add(hn::Add(hn::Add(reach, hn::Abs(slope)), hn::Abs(offset)), hn::Set(d, 2.0)));
+    const M lower = hn::Gt(sa, zero);
+    const V h = hn::IfThenElse(lower, hn::Sub(half, error), hn::Add(half, error));
+    hn::Store(hn::DemoteTo(df, oy_int), df, out.row_origin[k] + g);
+    hn::Store(hn::DemoteTo(df, hn::Sub(hn::Sub(oy, oy_int), half)), df, out.y_offset[k] + g);
+    hn::Store(hn::DemoteTo(df, slope), df, out.slope[k] + g);
+    hn::Store(hn::DemoteTo(df, hn::Sub(hn::Add(hn::Sub(ox, ox_int), offset), h)), df, out.base[k] + g);
+    hn::Store(hn::DemoteTo(df, hn::Sub(hn::Sub(i0, hn::Set(d, 2.0)), ox_int)), df, out.lo_clamp[k] + g);
+    hn::Store(hn::DemoteTo(df, hn::Sub(hn::Add(i1, hn::Set(d, 2.0)), ox_int)), df, out.hi_clamp[k] + g);
+    hn::Store(hn::DemoteTo(df, hn::IfThenElse(lower, hn::Add(ox_int, one), hn::Sub(ox_int, one))), df, out.column_shift[k] + g);
+    return hn::AndNot(hn::Eq(sa, zero), hn::And(in_range, hn::Le(error, hn::Set(d, 0x1.0p-8))));
+}
+
 // setup_clip_triangle's projection of an unclipped triangle and setup_raster_triangle's double
 // work (orient_triangle, sample_span, edge_functions, depth_plane_terms), lane by lane with
 // the same operations in the same order.
-void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& out) {
+void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height, double edge_margin, std::uint32_t silhouette_only,
+                BatchSetup& out) {
     const D d;
     const hn::Rebind<std::int32_t, D> di;
     const int lanes = int(hn::Lanes(d));
@@ -197,6 +224,7 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
     const V width = hn::Set(d, double(sample_width)), height = hn::Set(d, double(sample_height));
     out.flipped = 0;
     out.has_plane = 0;
+    out.float_ready = 0;
     for (int g = 0; g < batch.count; g += lanes) {
         // Projection to the sample grid, depth 1/w. (No arrays of vectors: SVE vectors cannot
         // be array elements.)
@@ -231,6 +259,9 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
         };
         span(hn::Min(hn::Min(x0, x1), x2), hn::Max(hn::Max(x0, x1), x2), width, out.i0, out.i1);
         span(hn::Min(hn::Min(y0, y1), y2), hn::Max(hn::Max(y0, y1), y2), height, out.j0, out.j1);
+        const V i0 = hn::PromoteTo(d, hn::Load(di, out.i0 + g)), i1 = hn::PromoteTo(d, hn::Load(di, out.i1 + g));
+        const bool any_float = ((silhouette_only >> g) & ((1u << lanes) - 1u)) != 0;  // lanes <= 8
+        M float_ready = hn::FirstN(d, any_float ? std::size_t(lanes) : 0);
 
         // edge_functions: edge k from vertex k to vertex k + 1, measured from its lower end (by
         // y, then x), its normal signed to be positive inside.
@@ -245,7 +276,9 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
             hn::Store(lo_y, d, out.oy[k] + g);
             hn::Store(sa, d, out.sa[k] + g);
             hn::Store(sb, d, out.sb[k] + g);
-            hn::Store(hn::IfThenElse(hn::Eq(sa, zero), zero, hn::Div(one, sa)), d, out.inverse_sa[k] + g);
+            const V inverse_sa = hn::IfThenElse(hn::Eq(sa, zero), zero, hn::Div(one, sa));
+            hn::Store(inverse_sa, d, out.inverse_sa[k] + g);
+            if (any_float) float_ready = hn::And(float_ready, FloatRowEdge(k, g, lo_x, lo_y, sa, sb, inverse_sa, edge_margin, i0, i1, out));
         };
         edge(0, x0, y0, x1, y1);
         edge(1, x1, y1, x2, y2);
@@ -268,6 +301,7 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
         hn::Store(hn::IfThenElseZero(usable_f, FloatOutward<true>(hn::IfThenElseZero(usable, error))), df, out.plane_error + g);
         hn::Store(FloatOutward<false>(hn::Min(hn::Min(d0, d1), d2)), df, out.z_vertex_min + g);
         out.has_plane |= LaneBits(d, usable) << g;
+        out.float_ready |= LaneBits(d, float_ready) << g;
     }
 }
 
