@@ -28,7 +28,7 @@ void compare_rules(const ScreenTriangle& tri, int width, int height, RuleCompari
     for (int k = 0; k < 3; ++k) edges.threshold[k] = edge_threshold(edges.shared[k], 1.0 / 1024.0, edges.sa[k], edges.sb[k]);
     FloatRowEdges float_edges;
     const bool in_float = prepare_float_row_edges(edges, raster.i0, raster.i1, float_edges);
-    ASSERT_EQ(in_float, raster.float_rows);
+    ASSERT_EQ(in_float, raster.plane.float_rows);
     if (!in_float) return;
     ++out.triangles_in_float;
     for (int row = raster.j0; row <= raster.j1; ++row) {
@@ -88,7 +88,7 @@ TEST(FloatRowRule, SharedHorizontalAndFarEdgesKeepTheDoubleRule) {
     const auto setup = [](ScreenTriangle tri) {
         RasterTriangle raster;
         EXPECT_TRUE(setup_raster_triangle(tri, 1.0 / 1024.0, 640, 480, raster));
-        return raster.float_rows;
+        return raster.plane.float_rows;
     };
     ScreenTriangle tri{{{10.3, 20.7}, {50.1, 22.9}, {30.6, 60.2}}, {1.0, 1.0, 1.0}};
     EXPECT_TRUE(setup(tri));

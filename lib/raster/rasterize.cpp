@@ -56,6 +56,7 @@ DepthPlaneTerms depth_plane_terms(const glm::dvec2 p[3], const double d[3], doub
 
 PreparedTriangle finish_depth_plane(const DepthPlaneTerms& t, const double d[3]) {
     PreparedTriangle tri;
+    tri.float_rows = false;
     tri.z_vertex_min = float_down(std::min({d[0], d[1], d[2]}));
     if (std::isfinite(t.error) && t.magnitude < 0x1.0p100) {
         tri.a = float(t.a);
@@ -124,11 +125,11 @@ bool setup_raster_triangle(const ScreenTriangle& triangle, double edge_margin, i
     TriangleEdges edges = edge_functions(tri);
     for (int k = 0; k < 3; ++k)  // inner margin on silhouette edges (see the top of this file)
         edges.threshold[k] = edge_threshold(edges.shared[k], edge_margin, edges.sa[k], edges.sb[k]);
-    FloatRowEdges float_edges;
-    out.float_rows = prepare_float_row_edges(edges, out.i0, out.i1, float_edges);
-    if (out.float_rows) out.float_edges = float_edges;
-    else out.edges = edges;
     out.plane = prepare_depth_plane(tri.v, tri.d, tri.area2, sample_width, sample_height);
+    FloatRowEdges float_edges;
+    out.plane.float_rows = prepare_float_row_edges(edges, out.i0, out.i1, float_edges);
+    if (out.plane.float_rows) out.float_edges = float_edges;
+    else out.edges = edges;
     return true;
 }
 
@@ -197,7 +198,7 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriang
     for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
         // The covered interval [first, last] of each of the subtile row's sample rows.
         std::int32_t first[kH], last[kH];
-        if (!triangle.float_rows) subtile_row_intervals(&triangle.edges, ty, i0, i1, j0, j1, first, last);
+        if (!triangle.plane.float_rows) subtile_row_intervals(&triangle.edges, ty, i0, i1, j0, j1, first, last);
         else
             for (int j = 0; j < kH; ++j) {
                 const int row = ty * kH + j;

@@ -70,6 +70,9 @@ struct PreparedTriangle {
     float a, dzdx, dzdy, error, z_vertex_min;
     bool far_is_left, far_is_top;  // where the plane is smallest: towards lower X, lower Y
     bool has_plane;                // false: too steep for float, a, dzdx, dzdy and error are 0
+    // Not the plane's: whether a RasterTriangle holds float_edges (its rows by the float rule).
+    // Kept here, in the plane's spare byte, so that the binned RasterTriangle stays 192 bytes.
+    bool float_rows;
 };
 
 // Where a prepared plane is smallest (its far corner), from the signs of its float slopes.
@@ -115,16 +118,15 @@ inline float conservative_depth(const PreparedTriangle& tri, int column, int row
 // interval lies inside the double interval). Lower edges (sa > 0) keep the samples from
 // floor(v) + 1 + ox_int on, upper ones up to ceil(v) - 1 + ox_int, v clamped first to the
 // columns [i0 - 2, i1 + 2] - ox_int. Every float operation is exact but those 4.
-// (Four elements per array: the SIMD preparation stores the three edges and a padding lane.)
 struct FloatRowEdges {
-    alignas(16) float row_origin[4];    // oy_int
-    alignas(16) float y_offset[4];      // frac(oy) - 0.5
-    alignas(16) float slope[4];         // sb / sa
-    alignas(16) float base[4];          // frac(ox) + threshold / sa - h
-    alignas(16) float lo_clamp[4];      // i0 - 2 - ox_int
-    alignas(16) float hi_clamp[4];      // i1 + 2 - ox_int
-    alignas(16) float column_shift[4];  // 1 + ox_int on a lower edge, ox_int - 1 on an upper one
-    bool lower[3];                      // sa > 0: the edge bounds the row's samples from below
+    float row_origin[3];    // oy_int
+    float y_offset[3];      // frac(oy) - 0.5
+    float slope[3];         // sb / sa
+    float base[3];          // frac(ox) + threshold / sa - h
+    float lo_clamp[3];      // i0 - 2 - ox_int
+    float hi_clamp[3];      // i1 + 2 - ox_int
+    float column_shift[3];  // 1 + ox_int on a lower edge, ox_int - 1 on an upper one
+    bool lower[3];          // sa > 0: the edge bounds the row's samples from below
 };
 // False (use the double rule) when an edge is shared or horizontal, an endpoint lies 2^22
 // samples or more from the origin, or the float error would exceed 2^-8 samples.
@@ -137,17 +139,17 @@ void float_sample_row_interval(const FloatRowEdges& edges, int row, int i0, int 
 // edge functions with the coverage thresholds (or their float form), its depth plane, and the
 // samples [i0, i1] x [j0, j1] whose centres lie in its bounding box.
 struct RasterTriangle {
-    // The row rule's terms: in float where prepare_float_row_edges allows (float_rows), else the
-    // double edge functions. One or the other: the bins of the two-thread render copy every
+    // The row rule's terms: in float where prepare_float_row_edges allows (plane.float_rows),
+    // else the double edge functions. One or the other: the bins of the two-thread render copy every
     // triangle, and this keeps the copy at 192 bytes.
     union {
-        TriangleEdges edges;
-        FloatRowEdges float_edges;
+        TriangleEdges edges;        // when !plane.float_rows
+        FloatRowEdges float_edges;  // when plane.float_rows
     };
-    bool float_rows;
     PreparedTriangle plane;
     int i0, i1, j0, j1;
 };
+static_assert(sizeof(RasterTriangle) == 192, "the two-thread render copies every binned triangle");
 
 // The coverage threshold of an edge with sign-normalized normal (sa, sb): an inner margin of
 // edge_margin samples (times the normal's L1 length) on a silhouette edge, none on a shared one.

@@ -342,7 +342,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         const int row0 = ty0 * kH, rows = (ty1 - ty0 + 1) * kH;
-        if (triangle.float_rows) FloatRowIntervals(triangle, row0, rows, first, last);
+        if (triangle.plane.float_rows) FloatRowIntervals(triangle, row0, rows, first, last);
         else DoubleRowIntervals(triangle, row0, rows, first, last);
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;

@@ -122,8 +122,8 @@ bool assemble_raster_triangle(const BatchSetup& s, int t, std::uint8_t shared_bi
     bool shared[3] = {(shared_bits & 1u) != 0, (shared_bits & 2u) != 0, (shared_bits & 4u) != 0};
     if ((s.flipped >> t) & 1u) std::swap(shared[0], shared[2]);  // edges 0->2, 2->1, 1->0 were edges 2, 1, 0
     // prepare_float_row_edges' answer: the batch's floats when no edge is shared.
-    out.float_rows = !shared[0] && !shared[1] && !shared[2] && ((s.float_ready >> t) & 1u);
-    if (out.float_rows) {
+    out.plane.float_rows = !shared[0] && !shared[1] && !shared[2] && ((s.float_ready >> t) & 1u);
+    if (out.plane.float_rows) {
         FloatRowEdges& f = out.float_edges;
         for (int k = 0; k < 3; ++k) {
             f.row_origin[k] = s.row_origin[k][t], f.y_offset[k] = s.y_offset[k][t], f.slope[k] = s.slope[k][t];
