@@ -2,10 +2,17 @@
 // rule it stands in for: on every row, the float interval lies inside the double interval
 // (so it inherits its conservative coverage) and loses at most one sample at each end.
 #include "raster/rasterize.hpp"
+#include "support.hpp"
+
+#include <homcull/camera.hpp>
+#include <homcull/io/scene_io.hpp>
+#include <homcull/truth/ray_scene.hpp>
+#include <homcull/world_triangles.hpp>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 #include <cstdio>
 #include <random>
 
@@ -101,6 +108,45 @@ TEST(FloatRowRule, SharedHorizontalAndFarEdgesKeepTheDoubleRule) {
     ScreenTriangle far = tri;
     far.p[2] = {-60000.0, 5.0};  // an edge starts far beyond the screen: float would round too coarsely
     EXPECT_FALSE(setup(far));
+}
+
+// The float rule on a real scene against Embree: fzk_haus's triangles drawn without their
+// shared-edge flags, so that every triangle has three silhouette edges and takes the float
+// rule (unless an edge is flat or starts far off the screen). Wherever the buffer claims an
+// occluder, a ray through the sample's centre must hit something at or before the buffer's
+// depth bound (the ray parameter is the view depth; 10^-5 absorbs Embree's float rounding).
+TEST(FloatRowRule, ClaimedSamplesOfARealSceneAreBehindEmbreeHits) {
+    const std::string path = test::shared_scene("fzk_haus.glb");
+    if (path.empty()) GTEST_SKIP() << "fzk_haus.glb is missing from " << test::shared_scenes_dir();
+    const Scene scene = load_scene(path);
+    const RayScene rays(scene);
+    const WorldTriangles occluders = gather_world_triangles(scene, objects_with_role(scene, ""));
+    Camera camera;
+    camera.eye = {-12, 3, 10};
+    camera.target = {6, 2, -5};
+    const CameraBasis basis = camera_basis(camera);
+    long claimed = 0;
+    for (const auto& [width, height, samples] : {std::tuple{640, 360, 1}, {160, 90, 4}}) {
+        OcclusionBuffer buffer(test::buffer_config(width, height, samples, float(camera.near_plane)));
+        const double aspect = double(width) / double(height);
+        TriangleInput in = occluders.input(clip_from_world(camera, aspect), Backface::none);
+        in.shared_edges = nullptr;
+        buffer.render(in);
+        std::vector<float> bound_w;
+        buffer.read_depth(bound_w);
+        const int sw = buffer.sample_width(), sh = buffer.sample_height();
+        for (int j = 0; j < sh; ++j)
+            for (int i = 0; i < sw; ++i) {
+                const float w = bound_w[std::size_t(j) * std::size_t(sw) + std::size_t(i)];
+                if (!std::isfinite(w)) continue;
+                ++claimed;
+                const glm::vec3 direction(ray_direction(camera, basis, aspect, pixel_to_ndc({sw, sh}, i + 0.5, j + 0.5)));
+                const RayHit hit = rays.intersect(glm::vec3(camera.eye), direction, float(camera.near_plane), float(camera.far_plane));
+                ASSERT_TRUE(hit.hit()) << "sample " << i << "," << j << " (S = " << samples << ") claimed with nothing behind it";
+                ASSERT_LE(double(hit.t), double(w) * (1.0 + 1e-5)) << "sample " << i << "," << j << ": occluder claimed nearer than it is";
+            }
+    }
+    EXPECT_GT(claimed, 40000);  // the house covers about an eighth of both sample grids
 }
 
 }  // namespace

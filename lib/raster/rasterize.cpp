@@ -9,6 +9,9 @@
 // SIMD kernels evaluate it the same way and get the same bits. The two triangles of a shared
 // edge compute bit-identical x_k (negation is exact), one keeping samples at or right of it and
 // the other at or left of it, so every sample near a shared edge lands in at least one.
+// Triangles whose three edges are silhouette edges (no neighbour to match bit for bit) use a
+// float form of it instead, whose boundary is moved inwards by its own rounding bound: see
+// prepare_float_row_edges in rasterize.hpp.
 //
 #include "raster/rasterize.hpp"
 

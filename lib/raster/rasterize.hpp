@@ -110,14 +110,15 @@ inline float conservative_depth(const PreparedTriangle& tri, int column, int row
 // (ox_int, oy_int) below its lower endpoint, so that every float holds a small number:
 //     v = base_k - slope_k * ((row - oy_int) - y_offset_k)
 // with slope = sb / sa, y_offset = frac(oy) - 0.5 and base = frac(ox) + threshold / sa - h,
-// is x_k - ox_int - h (x_k of the double rule), evaluated with 4 roundings. Its error is less
+// is x_k - ox_int - h (x_k of the double rule): three roundings per row besides those of
+// y_offset, slope and base to float, every other float operation exact. Its error is less
 // than `error` = 2^-20 (reach + |slope| + |threshold / sa| + 2), reach bounding |x_k - ox| over
 // the rows whose x_k falls near the triangle's columns (the others are clamped away whatever
 // the rounding); h = 0.5 -+ error shifts the boundary inwards by that much, so a sample kept
 // here is kept by the exact rule (and by the double one: the tests check that every float
 // interval lies inside the double interval). Lower edges (sa > 0) keep the samples from
 // floor(v) + 1 + ox_int on, upper ones up to ceil(v) - 1 + ox_int, v clamped first to the
-// columns [i0 - 2, i1 + 2] - ox_int. Every float operation is exact but those 4.
+// columns [i0 - 2, i1 + 2] - ox_int (integers below 2^24: exact in float).
 struct FloatRowEdges {
     float row_origin[3];    // oy_int
     float y_offset[3];      // frac(oy) - 0.5

@@ -1,4 +1,4 @@
-// SIMD kernels of the row loop (coverage intervals of a subtile row's 4 sample rows as lanes)
+// SIMD kernels of the row loop (coverage intervals of up to 64 sample rows, rows as lanes)
 // and of the subtile-row update (subtiles as lanes, 4 on SSE4, 8 on AVX2, 16 on AVX-512),
 // compiled once per instruction set with Google Highway and chosen at run time. Each lane
 // computes exactly what the reference (rasterize_rows_reference, update_subtile_row_reference)

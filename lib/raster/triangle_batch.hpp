@@ -148,21 +148,20 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             first += std::size_t(batch.count);
         }
         kernels.classify(in.backface, near_w, batch, stats);
-        if (batch.simple) {
-            // The float row rule needs three silhouette edges: the setup skips it for groups of
-            // lanes that all have a shared edge (most of a closed mesh's).
-            std::uint32_t silhouette_only = batch.simple;
-            if (in.shared_edges)
-                for (std::uint32_t bits = batch.simple; bits != 0; bits &= bits - 1) {
-                    const int t = __builtin_ctz(bits);
-                    if (in.shared_edges[batch.triangle[t]] != 0) silhouette_only &= ~(1u << t);
-                }
-            kernels.setup(batch, sample_width, sample_height, edge_margin, silhouette_only, simple);
-        }
+        // Each lane's shared-edge bits, read once. The float row rule needs three silhouette
+        // edges: the setup skips it for groups of lanes that all have a shared edge (most of
+        // a closed mesh's).
+        std::uint8_t lane_shared[TriangleBatch::kSize];
+        std::uint32_t silhouette_only = 0;
         for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
             const int t = __builtin_ctz(bits);
-            const std::size_t index = batch.triangle[t];
-            const std::uint8_t shared = in.shared_edges ? in.shared_edges[index] : 0;
+            lane_shared[t] = in.shared_edges ? in.shared_edges[batch.triangle[t]] : 0;
+            silhouette_only |= std::uint32_t(lane_shared[t] == 0) << t;
+        }
+        if (batch.simple) kernels.setup(batch, sample_width, sample_height, edge_margin, silhouette_only & batch.simple, simple);
+        for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
+            const int t = __builtin_ctz(bits);
+            const std::uint8_t shared = lane_shared[t];
             if ((batch.simple >> t) & 1u) {
                 ++stats.rasterized;  // what setup_clip_triangle counts for it
                 RasterTriangle tri;
