@@ -40,6 +40,14 @@ bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
     return depth_a == depth_b;
 }
 
+// The pyramids of the rectangle tests (built band by band with a job system).
+bool same_pyramid(const OcclusionBuffer& a, const OcclusionBuffer& b) {
+    std::vector<float> x, y;
+    a.read_pyramid(x);
+    b.read_pyramid(y);
+    return x == y;
+}
+
 TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     // Many overlapping random triangles (more than one chunk) at several depths.
     const std::vector<float> xyzw = test::random_clip_triangles(5, 9000, 0.3f);
@@ -58,6 +66,8 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     shuffled.render(in, ParallelFor{run_shuffled, &order_rng});
     EXPECT_TRUE(same_subtiles(serial, threaded));
     EXPECT_TRUE(same_subtiles(serial, shuffled));
+    EXPECT_TRUE(same_pyramid(serial, threaded));
+    EXPECT_TRUE(same_pyramid(serial, shuffled));
     EXPECT_EQ(serial.stats().subtiles_touched, threaded.stats().subtiles_touched);
     EXPECT_EQ(serial.stats().rasterized, shuffled.stats().rasterized);
     // A second frame into the same buffers reuses the scratch and still agrees.
@@ -66,6 +76,57 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     serial.render(in);
     threaded.render(in, tbb_parallel_for());
     EXPECT_TRUE(same_subtiles(serial, threaded));
+}
+
+// render_frame is clear() then render(): the same bits with and without a job system, over a
+// buffer that still holds another frame, and the same statistics.
+TEST(RenderThreads, RenderFrameIsClearThenRender) {
+    const std::vector<float> first = test::random_clip_triangles(21, 7000, 0.4f), second = test::random_clip_triangles(22, 5000, 0.3f);
+    BufferConfig config;
+    config.width = 301;  // odd sizes: partial subtiles, a last band of a few rows, odd pyramid levels
+    config.height = 277;
+    config.samples = 2;
+    config.near_w = 1.0f;
+    config.sample_depth = true;
+    std::mt19937_64 order_rng(5);
+    for (const ParallelFor& parallel : {ParallelFor{}, tbb_parallel_for(), ParallelFor{run_shuffled, &order_rng}}) {
+        OcclusionBuffer reference(config), framed(config);
+        reference.render(test::clip_space_input(first));
+        framed.render(test::clip_space_input(first), parallel);
+        reference.clear();
+        reference.render(test::clip_space_input(second));
+        framed.render_frame(test::clip_space_input(second), parallel);
+        EXPECT_TRUE(same_subtiles(reference, framed));
+        EXPECT_TRUE(same_pyramid(reference, framed));
+        EXPECT_EQ(reference.stats().rasterized, framed.stats().rasterized);
+        EXPECT_EQ(reference.stats().triangles_in, framed.stats().triangles_in);
+        EXPECT_EQ(reference.stats().subtiles_touched, framed.stats().subtiles_touched);
+        // No triangles: an empty frame.
+        TriangleInput none = test::clip_space_input(second);
+        none.triangle_count = 0;
+        framed.render_frame(none, parallel);
+        OcclusionBuffer empty(config);
+        EXPECT_TRUE(same_subtiles(empty, framed));
+        EXPECT_TRUE(same_pyramid(empty, framed));
+        EXPECT_EQ(framed.stats().triangles_in, 0u);
+    }
+}
+
+// Input render() refuses leaves the last frame in place.
+TEST(RenderThreads, RenderFrameThrowsBeforeClearing) {
+    BufferConfig config;
+    config.width = 64;
+    config.height = 48;
+    config.near_w = 1.0f;
+    OcclusionBuffer buffer(config), reference(config);
+    const std::vector<float> xyzw = test::random_clip_triangles(3, 500, 0.5f);
+    buffer.render(test::clip_space_input(xyzw));
+    reference.render(test::clip_space_input(xyzw));
+    TriangleInput bad = test::clip_space_input(xyzw);
+    bad.position_components = 2;
+    EXPECT_THROW(buffer.render_frame(bad, tbb_parallel_for()), Error);
+    EXPECT_TRUE(same_subtiles(reference, buffer));
+    EXPECT_TRUE(same_pyramid(reference, buffer));
 }
 
 TEST(RenderThreads, CityFromAboveSameBits) {
@@ -83,6 +144,7 @@ TEST(RenderThreads, CityFromAboveSameBits) {
     serial.render(occluders.input(clip));
     threaded.render(occluders.input(clip), tbb_parallel_for());
     EXPECT_TRUE(same_subtiles(serial, threaded));
+    EXPECT_TRUE(same_pyramid(serial, threaded));
 }
 
 }  // namespace

@@ -18,6 +18,12 @@ constexpr std::size_t kChunkTriangles = 2048;  // triangles set up per task
 // is set up once but entered once per band (16 rows: S1 at 1080p, two threads, 13.5 ms and
 // castle C0 1.02 ms; 32 rows: 12.8 and 0.96 ms; 64 rows: 3 bands at 720p, castle 1.12 ms).
 constexpr int kBandSubtileRows = 32;
+// The pyramid levels a band builds from its own rows, right after rasterizing them: the cells
+// of level l span 2^l subtile rows, within one band while 2^l divides the band's rows. Built on
+// the calling thread instead, they had to read every band's d0 from the other core's cache
+// (castle C0, two threads: 0.15 ms of 1.0).
+constexpr int kBandPyramidLevels = 5;
+static_assert((1 << kBandPyramidLevels) == kBandSubtileRows, "a band's rows hold whole cells of its levels");
 
 // A band reads its bins' triangles in order, but they were written by whichever thread set up
 // their chunk, and a kernel call per triangle is too short for the hardware prefetcher to
@@ -84,32 +90,50 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
 }
 
 void OcclusionBuffer::clear() {
-    std::fill(d0_.begin(), d0_.end(), 0.0f);
-    std::fill(d1_.begin(), d1_.end(), 0.0f);
-    std::fill(mask_.begin(), mask_.end(), 0u);
-    std::fill(covered_.begin(), covered_.end(), 0u);
-    std::fill(sample_depth_.begin(), sample_depth_.end(), 0.0f);
+    clear_rows(0, subtiles_y_);
     std::fill(pyramid_.begin(), pyramid_.end(), 0.0f);
     stats_ = RasterStats{};
 }
 
-void OcclusionBuffer::build_pyramid() {
-    for (int ty = 0; ty < subtiles_y_; ++ty)
+void OcclusionBuffer::clear_rows(int row_begin, int row_end) {
+    const auto zero = [](auto& plane, std::size_t begin, std::size_t end) {
+        std::fill(plane.begin() + std::ptrdiff_t(begin), plane.begin() + std::ptrdiff_t(end), 0);
+    };
+    const std::size_t begin = std::size_t(row_begin) * stride_, end = std::size_t(row_end) * stride_;
+    zero(d0_, begin, end);
+    zero(d1_, begin, end);
+    zero(mask_, begin, end);
+    zero(covered_, begin, end);
+    if (!sample_depth_.empty())
+        zero(sample_depth_, std::size_t(row_begin * kH) * sample_depth_stride_,
+             std::size_t(std::min(row_end * kH, sample_height_)) * sample_depth_stride_);
+}
+
+void OcclusionBuffer::build_pyramid_rows(int row_begin, int row_end, int last_level) {
+    for (int ty = row_begin; ty < row_end; ++ty)
         std::copy_n(d0_.begin() + std::ptrdiff_t(at(0, ty)), subtiles_x_, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_);
-    for (std::size_t level = 1; level < levels_.size(); ++level) {
-        const detail::PyramidLevel& below = levels_[level - 1];
-        const detail::PyramidLevel& here = levels_[level];
-        for (int y = 0; y < here.height; ++y)
-            for (int x = 0; x < here.width; ++x) {
-                float m = min_d0(int(level) - 1, 2 * x, 2 * y);
-                if (2 * x + 1 < below.width) m = std::min(m, min_d0(int(level) - 1, 2 * x + 1, 2 * y));
-                if (2 * y + 1 < below.height) {
-                    m = std::min(m, min_d0(int(level) - 1, 2 * x, 2 * y + 1));
-                    if (2 * x + 1 < below.width) m = std::min(m, min_d0(int(level) - 1, 2 * x + 1, 2 * y + 1));
-                }
-                pyramid_[here.offset + std::size_t(y) * std::size_t(here.width) + std::size_t(x)] = m;
+    for (int level = 1; level <= last_level; ++level)
+        reduce_pyramid_rows(level, row_begin >> level, std::min(levels_[std::size_t(level)].height, (row_end + (1 << level) - 1) >> level));
+}
+
+void OcclusionBuffer::reduce_pyramid_rows(int level, int y_begin, int y_end) {
+    const detail::PyramidLevel& below = levels_[std::size_t(level) - 1];
+    const detail::PyramidLevel& here = levels_[std::size_t(level)];
+    for (int y = y_begin; y < y_end; ++y)
+        for (int x = 0; x < here.width; ++x) {
+            float m = min_d0(level - 1, 2 * x, 2 * y);
+            if (2 * x + 1 < below.width) m = std::min(m, min_d0(level - 1, 2 * x + 1, 2 * y));
+            if (2 * y + 1 < below.height) {
+                m = std::min(m, min_d0(level - 1, 2 * x, 2 * y + 1));
+                if (2 * x + 1 < below.width) m = std::min(m, min_d0(level - 1, 2 * x + 1, 2 * y + 1));
             }
-    }
+            pyramid_[here.offset + std::size_t(y) * std::size_t(here.width) + std::size_t(x)] = m;
+        }
+}
+
+void OcclusionBuffer::read_pyramid(std::vector<float>& cells) const {
+    const detail::PyramidLevel& top = levels_.back();
+    cells.assign(pyramid_.begin(), pyramid_.begin() + std::ptrdiff_t(top.offset + std::size_t(top.width) * std::size_t(top.height)));
 }
 
 detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) {
@@ -154,18 +178,31 @@ bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const Parallel
 
 void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& parallel) {
     if (in.triangle_count == 0) return;
+    render_rows(in, parallel, false);
+}
+
+void OcclusionBuffer::render_frame(const TriangleInput& in, const ParallelFor& parallel) {
+    if (in.triangle_count == 0) {
+        clear();
+        return;
+    }
+    render_rows(in, parallel, true);
+}
+
+void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first) {
     detail::check_triangle_input(in, "render");
+    if (clear_first) stats_ = RasterStats{};
     detail::VertexClip storage;
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;
-    if (parallel.run) render_binned(in, parallel, cache);
-    else render_serial(in, cache);
-    build_pyramid();
+    if (parallel.run) render_binned(in, parallel, cache, clear_first);
+    else render_serial(in, cache, clear_first);
 }
 
 // One thread: each triangle is rasterized over the whole buffer as soon as it is set up, in
 // input order; nothing is binned. Every subtile sees the triangles in the same order as in
 // render_binned, so both give the same bits.
-void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache) {
+void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first) {
+    if (clear_first) clear_rows(0, subtiles_y_);
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t touched = 0;
     RasterStats stats;
@@ -173,11 +210,12 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
                      [&](const detail::RasterTriangle& tri) { touched += target.kernel(target, tri); });
     stats.subtiles_touched = touched;
     stats_ += stats;
+    build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
 }
 
 // With a job system: phase 1 sets up and bins chunks of triangles in parallel, phase 2
 // rasterizes bands of subtile rows in parallel, each band its triangles in input order.
-void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache) {
+void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_touched_.size();
     if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
@@ -187,7 +225,8 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         const TriangleInput* in;
         const detail::VertexClip* cache;
         std::size_t chunk_count, bands;
-    } job{this, &in, cache, chunk_count, bands};
+        bool clear_first;
+    } job{this, &in, cache, chunk_count, bands, clear_first};
 
     parallel.run(parallel.user, chunk_count, [](void* data, std::size_t c) {
         const Job& j = *static_cast<Job*>(data);
@@ -207,8 +246,9 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
     parallel.run(parallel.user, bands, [](void* data, std::size_t band) {
         const Job& j = *static_cast<Job*>(data);
         OcclusionBuffer& b = *j.self;
-        const int row_begin = int(band) * kBandSubtileRows;
-        const detail::RasterTarget target = b.raster_target(row_begin, std::min(row_begin + kBandSubtileRows, b.subtiles_y_));
+        const int row_begin = int(band) * kBandSubtileRows, row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);
+        if (j.clear_first) b.clear_rows(row_begin, row_end);
+        const detail::RasterTarget target = b.raster_target(row_begin, row_end);
         std::uint64_t touched = 0;
         for (std::size_t c = 0; c < j.chunk_count; ++c) {
             const std::vector<detail::RasterTriangle>& bin = b.chunks_[c].bins[band];
@@ -218,7 +258,9 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
             }
         }
         b.band_touched_[band] = touched;
+        b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
     }, &job);
+    for (int level = kBandPyramidLevels + 1; level < int(levels_.size()); ++level) reduce_pyramid_rows(level, 0, levels_[std::size_t(level)].height);
 
     for (std::size_t c = 0; c < chunk_count; ++c) stats_ += chunks_[c].stats;
     for (std::uint64_t touched : band_touched_) stats_.subtiles_touched += touched;

@@ -117,8 +117,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
     frame_occluders_.clear();
     frame_indices_.clear();
     frame_shared_.clear();
-    frame_rendered_ = 0;
-    buffer_.clear();
+    frame_rendered_ = 0;  // the buffer is cleared by the frame's first render (render_frame), or by build_maps
 
     // one_pass (and temporal's first frame): the candidates in the frustum. temporal: those not
     // found occluded last frame. progressive draws as it traverses.
@@ -265,7 +264,8 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
     in.indices = frame_indices_.data() + 3 * frame_rendered_;
     in.triangle_count = count;
     in.shared_edges = frame_shared_.data() + frame_rendered_;
-    buffer_.render(in, parallel);
+    if (frame_rendered_ == 0) buffer_.render_frame(in, parallel);  // clears each band where it is rasterized
+    else buffer_.render(in, parallel);
     frame_rendered_ += count;
     ++work_.renders;
     timings_.render_ms += ms_since(start);
@@ -275,6 +275,7 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
 // occluders' boxes.
 void SceneCuller::build_maps(const Frame& frame) {
     const auto start = Clock::now();
+    if (frame_rendered_ == 0) buffer_.clear();  // nothing drawn yet this frame: it still holds the last one
     maps_.clear();
     if (config_.maps.depth == DepthTest::deb)
         for (std::uint32_t id : frame_occluders_) maps_.add_occluder_box(scene_->objects[id].world_bounds, frame.clip);

@@ -167,6 +167,12 @@ public:
     // 4M vertices) that also only grows and stays allocated with the buffer. Statistics
     // accumulate until clear(). Not thread-safe with itself or with tests.
     void render(const TriangleInput& input, const ParallelFor& parallel = {});
+    // clear() then render(), for the frame's first (or only) occluders: the same bits, but with
+    // a job system each band's rows are cleared by the task that then rasterizes them, so that
+    // they are written on one core instead of first on the caller's (castle view C0, two
+    // threads: about 10 % faster than clear() and render()). Throws, as render() does, before
+    // anything is cleared.
+    void render_frame(const TriangleInput& input, const ParallelFor& parallel = {});
 
     // Occludee tests. Thread-safe with each other (no render in flight).
     // Screen rectangle in NDC (y up) with the nearest clip w of the occludee. Occluded when
@@ -227,6 +233,10 @@ public:
     // bound, or the per-sample depth where that is nearer (BufferConfig::sample_depth).
     void read_coverage(std::vector<std::uint8_t>& covered) const;
     void read_depth(std::vector<float>& w) const;
+    // The farthest-depth pyramid the rectangle tests use, every level one after the other:
+    // level 0 the subtiles' d0, level l the minimum over cells of 2^l x 2^l subtiles, each
+    // ceil(subtiles_x / 2^l) x ceil(subtiles_y / 2^l) cells, row-major, down to 1 x 1.
+    void read_pyramid(std::vector<float>& cells) const;
 
 private:
     friend class OcclusionMaps;  // reads the subtiles and shares the rectangle preparation
@@ -251,7 +261,13 @@ private:
     std::vector<detail::PyramidLevel> levels_;
     std::vector<float> pyramid_;
     std::vector<std::int32_t> level_offset_, level_width_;  // levels_ as arrays, for SIMD gathers
-    void build_pyramid();
+    // Level 0 for subtile rows [row_begin, row_end) and levels 1..last_level above them (row_begin
+    // a multiple of 2^last_level: each cell's subtiles are then among these rows).
+    void build_pyramid_rows(int row_begin, int row_end, int last_level);
+    // Rows [y_begin, y_end) of pyramid level `level` >= 1 from the level below.
+    void reduce_pyramid_rows(int level, int y_begin, int y_end);
+    // Zeroes the subtiles (and per-sample depths) of subtile rows [row_begin, row_end).
+    void clear_rows(int row_begin, int row_end);
     float min_d0(int level, int x, int y) const {
         const detail::PyramidLevel& l = levels_[std::size_t(level)];
         return pyramid_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)];
@@ -265,8 +281,10 @@ private:
     // Rendering (occlusion_buffer.cpp): without a job system straight through, with one
     // binned by bands of subtile rows; the same bits either way.
     detail::RasterTarget raster_target(int row_begin, int row_end);
-    void render_serial(const TriangleInput& in, const detail::VertexClip* cache);
-    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache);
+    // clear_first: render_frame, which clears the rows where it rasterizes them.
+    void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
+    void render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first);
+    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
     bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
