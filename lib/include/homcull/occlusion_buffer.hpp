@@ -165,7 +165,7 @@ public:
     // triangles has every one of its vertex_count positions read and transformed once (so
     // vertex_count must not overstate the positions), into scratch of 33 bytes a vertex (up to
     // 4M vertices) that also only grows and stays allocated with the buffer. Statistics
-    // accumulate until clear(). Not thread-safe with itself or with tests.
+    // accumulate until clear() or render_frame(). Not thread-safe with itself or with tests.
     void render(const TriangleInput& input, const ParallelFor& parallel = {});
     // clear() then render(), for the frame's first (or only) occluders: the same bits, but with
     // a job system each band's rows are cleared by the task that then rasterizes them, so that
