@@ -74,7 +74,7 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     covered_.assign(plane, 0u);
     sample_depth_stride_ = std::size_t(sample_width_) + detail::kMaxSimdLanes;
     if (config.sample_depth) sample_depth_.assign(sample_depth_stride_ * std::size_t(sample_height_), 0.0f);
-    band_touched_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
+    band_updated_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
     std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
     while (levels_.back().width > 1 || levels_.back().height > 1) {
@@ -204,11 +204,11 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
 void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first) {
     if (clear_first) clear_rows(0, subtiles_y_);
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
-    std::uint64_t touched = 0;
+    std::uint64_t updated = 0;
     RasterStats stats;
     detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, stats,
-                     [&](const detail::RasterTriangle& tri) { touched += target.kernel(target, tri); });
-    stats.subtiles_touched = touched;
+                     [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); });
+    stats.subtiles_updated = updated;
     stats_ += stats;
     build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
 }
@@ -217,7 +217,7 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
 // rasterizes bands of subtile rows in parallel, each band its triangles in input order.
 void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
-    const std::size_t bands = band_touched_.size();
+    const std::size_t bands = band_updated_.size();
     if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
 
     struct Job {
@@ -249,21 +249,21 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         const int row_begin = int(band) * kBandSubtileRows, row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);
         if (j.clear_first) b.clear_rows(row_begin, row_end);
         const detail::RasterTarget target = b.raster_target(row_begin, row_end);
-        std::uint64_t touched = 0;
+        std::uint64_t updated = 0;
         for (std::size_t c = 0; c < j.chunk_count; ++c) {
             const std::vector<detail::RasterTriangle>& bin = b.chunks_[c].bins[band];
             for (std::size_t k = 0; k < bin.size(); ++k) {
                 if (k + kPrefetchTriangles < bin.size()) prefetch_triangle(bin[k + kPrefetchTriangles]);
-                touched += target.kernel(target, bin[k]);
+                updated += target.kernel(target, bin[k]);
             }
         }
-        b.band_touched_[band] = touched;
+        b.band_updated_[band] = updated;
         b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
     }, &job);
     for (int level = kBandPyramidLevels + 1; level < int(levels_.size()); ++level) reduce_pyramid_rows(level, 0, levels_[std::size_t(level)].height);
 
     for (std::size_t c = 0; c < chunk_count; ++c) stats_ += chunks_[c].stats;
-    for (std::uint64_t touched : band_touched_) stats_.subtiles_touched += touched;
+    for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
 }
 
 OcclusionBuffer::Subtile OcclusionBuffer::subtile(int tx, int ty) const {

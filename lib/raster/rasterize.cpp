@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace homcull::detail {
 namespace {
@@ -194,27 +195,46 @@ void float_sample_row_interval(const FloatRowEdges& e, int row, int i0, int i1, 
     last = std::int32_t(hi);
 }
 
+bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest) {
+    // d0 >= max(nearest, the smallest positive float) is d0 >= nearest and d0 > 0.
+    nearest = std::max(nearest, std::numeric_limits<float>::denorm_min());
+    for (int ty = ty0; ty <= ty1; ++ty) {
+        const float* d0 = planes.d0 + std::size_t(ty) * planes.stride;
+        for (int tx = tx0; tx <= tx1; ++tx)
+            if (d0[tx] < nearest) return false;
+    }
+    return true;
+}
+
 std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriangle& triangle) {
     const PreparedTriangle& prepared = triangle.plane;
     const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
-    std::uint64_t touched = 0;
-    for (int ty = std::max(j0 / kH, t.row_begin); ty <= std::min(j1 / kH, t.row_end - 1); ++ty) {
-        // The covered interval [first, last] of each of the subtile row's sample rows.
-        std::int32_t first[kH], last[kH];
-        if (!triangle.plane.float_rows) subtile_row_intervals(&triangle.edges, ty, i0, i1, j0, j1, first, last);
-        else
-            for (int j = 0; j < kH; ++j) {
-                const int row = ty * kH + j;
-                first[j] = i0;
-                last[j] = i0 - 1;
-                if (row >= j0 && row <= j1) float_sample_row_interval(triangle.float_edges, row, i0, i1, first[j], last[j]);
-            }
-        int tx_begin, tx_end;
-        if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
-        touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, first, last, prepared, t.sample_width, t.sample_height);
-        if (t.planes.sample_depth) update_sample_depth(t.planes, ty, first, last, prepared);
+    const int ty_first = std::max(j0 / kH, t.row_begin), ty_last = std::min(j1 / kH, t.row_end - 1);
+    std::uint64_t updated = 0;
+    for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
+        const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
+        if (!t.planes.sample_depth &&
+            hidden_behind_reference_layer(t.planes, i0 / kW, i1 / kW, ty0, ty1,
+                                          nearest_conservative_depth(prepared, i0, i1, std::max(j0, ty0 * kH), std::min(j1, ty1 * kH + kH - 1))))
+            continue;
+        for (int ty = ty0; ty <= ty1; ++ty) {
+            // The covered interval [first, last] of each of the subtile row's sample rows.
+            std::int32_t first[kH], last[kH];
+            if (!triangle.plane.float_rows) subtile_row_intervals(&triangle.edges, ty, i0, i1, j0, j1, first, last);
+            else
+                for (int j = 0; j < kH; ++j) {
+                    const int row = ty * kH + j;
+                    first[j] = i0;
+                    last[j] = i0 - 1;
+                    if (row >= j0 && row <= j1) float_sample_row_interval(triangle.float_edges, row, i0, i1, first[j], last[j]);
+                }
+            int tx_begin, tx_end;
+            if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
+            updated += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, first, last, prepared, t.sample_width, t.sample_height);
+            if (t.planes.sample_depth) update_sample_depth(t.planes, ty, first, last, prepared);
+        }
     }
-    return touched;
+    return updated;
 }
 
 void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t first[4], const std::int32_t last[4],
@@ -254,14 +274,13 @@ SubtileCoverage subtile_coverage(const std::int32_t first[4], const std::int32_t
 
 std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                            const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height) {
-    std::uint64_t touched = 0;
+    std::uint64_t updated = 0;
     for (int tx = tx_begin; tx <= tx_end; ++tx) {
         // The coverage mask, and the column and row of its bounding rectangle where the depth
         // plane is smallest.
         const SubtileCoverage c = subtile_coverage(first, last, tx);
         const std::uint32_t m = c.mask;
         if (m == 0) continue;
-        ++touched;
         const int far_column = tri.far_is_left ? c.column_lo : c.column_hi, far_row = tri.far_is_top ? c.row_lo : c.row_hi;
         const std::size_t i = std::size_t(ty) * planes.stride + std::size_t(tx);
         planes.covered[i] |= m;
@@ -270,6 +289,7 @@ std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, 
         float d0 = planes.d0[i], d1 = planes.d1[i];
         std::uint32_t mask = planes.mask[i];
         if (!(d_tri > d0)) continue;  // behind what is already known (or no bound): nothing to add
+        ++updated;
 
         // Quick mask: drop the working layer when the triangle is farther in front of it than
         // it is in front of the reference layer (d_tri - d1 > d1 - d0), then merge, and
@@ -286,7 +306,7 @@ std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, 
         planes.d1[i] = d1;
         planes.mask[i] = mask;
     }
-    return touched;
+    return updated;
 }
 
 }  // namespace homcull::detail

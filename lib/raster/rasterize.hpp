@@ -28,7 +28,8 @@ struct RasterTriangle;
 
 // Rasterizes the rows of a set-up triangle: for each subtile row in the target's band and the
 // triangle's sample rows [j0, j1], the coverage interval of each sample row (within columns
-// [i0, i1]), then the subtile-row update. Returns the number of subtiles updated.
+// [i0, i1]), then the subtile-row update. Returns the number of subtiles updated (those where
+// the triangle covers a sample and is in front of the reference layer).
 using TriangleRowsKernel = std::uint64_t (*)(const RasterTarget& target, const RasterTriangle& triangle);
 
 // The widest SIMD vector the kernels use, in 32-bit lanes: subtile rows are padded so that a
@@ -103,6 +104,28 @@ inline float conservative_depth(const PreparedTriangle& tri, int column, int row
     const float bound = std::max(plane - tri.error, tri.z_vertex_min);
     return bound * (1.0f - 0x1.0p-20f);
 }
+
+// The largest conservative_depth(tri, column, row) over the samples of the box of columns
+// [i0, i1] and rows [r0, r1]: its value at the box's corner where the plane is largest (the
+// corner opposite far_is_left / far_is_top). Exact, not only a bound: every operation of
+// conservative_depth (the products by x and y, the sums, the max and the product) rounds
+// monotonically, so its float value never decreases towards that corner, whatever the
+// roundings.
+inline float nearest_conservative_depth(const PreparedTriangle& tri, int i0, int i1, int r0, int r1) {
+    return conservative_depth(tri, tri.far_is_left ? i1 : i0, tri.far_is_top ? r1 : r0);
+}
+
+// Early rejection of hidden triangles, as Greene's hierarchical Z-buffer rejects primitives
+// (Greene, Kass and Miller, "Hierarchical Z-Buffer Visibility", SIGGRAPH 1993), here against
+// the reference layer: whether every subtile of columns [tx0, tx1] and rows [ty0, ty1] has
+// d0 > 0 and d0 >= nearest (nearest_conservative_depth of the triangle over those samples).
+// Then rasterizing the triangle there changes nothing, bit for bit: a subtile takes a triangle
+// only when its conservative depth is > d0, and `covered` already holds every sample of a
+// subtile with d0 > 0 (d0 is only set by promoting a full working layer, and every mask merged
+// into the layer was first added to `covered`). Per-sample depth is not covered by this
+// argument: callers skip nothing when planes.sample_depth is kept. The SIMD kernels make the
+// same test with vectors of subtiles (pure comparisons: the same answer).
+bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
 
 // The row rule in float, for triangles whose three edges are silhouette edges (no shared
 // edge needs its bits matched by a neighbour) and near enough to the screen: 16 rows per
@@ -290,6 +313,11 @@ std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_hei
 // reference; the SIMD kernels repeat its float operations lane by lane (UpdateSampleDepth).
 void update_sample_depth(const SubtilePlanes& planes, int ty, const std::int32_t first[4], const std::int32_t last[4],
                          const PreparedTriangle& tri);
+
+// The rows of a triangle are taken in chunks of this many subtile rows: the SIMD row loop
+// computes a chunk's sample-row intervals in one pass, and every row loop first skips a chunk
+// where the triangle is hidden behind the reference layer (hidden_behind_reference_layer).
+constexpr int kChunkSubtileRows = 16;
 
 // The reference row loop: scalar intervals and update_subtile_row_reference.
 std::uint64_t rasterize_rows_reference(const RasterTarget& target, const RasterTriangle& triangle);

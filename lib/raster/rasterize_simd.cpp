@@ -13,6 +13,7 @@
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
+#include <limits>
 
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
@@ -77,7 +78,8 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
 // float and 32-bit integer: at most 8 columns (4 on SSE4 and NEON; rows are padded for
 // kMaxSimdLanes). first and last hold the rows' sample-row intervals, 4 per subtile row. Two
 // rows at a time suit AVX-512's 16 lanes: S1's triangles reach about 5 subtiles per row, and
-// one row in 16 lanes was 10 % slower than in 8. Returns the number of subtiles updated.
+// one row in 16 lanes was 10 % slower than in 8. Returns the number of subtiles updated
+// (covered and in front of the reference layer).
 //
 // The coverage masks come from sample rows (as Intel's Masked Occlusion Culling computes them):
 // before the update, lane l holds sample row l % 4 of one subtile row across 32 samples, 4
@@ -159,7 +161,7 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     const VF a = hn::Set(df, tri.a), dzdx = hn::Set(df, tri.dzdx), dzdy = hn::Set(df, tri.dzdy), error = hn::Set(df, tri.error);
     const VF z_vertex_min = hn::Set(df, tri.z_vertex_min), half = hn::Set(df, 0.5f), lower = hn::Set(df, 1.0f - 0x1.0p-20f);
 
-    std::uint64_t touched = 0;
+    std::uint64_t updated = 0;
     for (int tx = tx_begin; tx <= tx_end; tx += row_lanes) {
         const VI column0 = hn::ShiftLeft<3>(hn::Add(lane_column, hn::Set(di, tx)));  // tx * 8 per lane
 
@@ -174,7 +176,6 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
 
         const auto active = hn::Ne(m, hn::Zero(du));
         if (hn::AllFalse(du, active)) continue;
-        touched += hn::CountTrue(du, active);
 
         const std::size_t i = std::size_t(tx);
         VF d0 = load(df, planes.d0, i), d1 = load(df, planes.d1, i);
@@ -202,6 +203,7 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
 
         const auto update = hn::And(hn::RebindMask(df, active), hn::Gt(d_tri, d0));
         if (hn::AllFalse(df, update)) continue;
+        updated += hn::CountTrue(df, update);
         // Quick mask, lane by lane as the reference.
         const auto mask_nonzero = hn::RebindMask(df, hn::Ne(mask, hn::Zero(du)));
         const auto discard = hn::And(mask_nonzero, hn::Lt(hn::Sub(hn::Mul(hn::Set(df, 2.0f), d1), hn::Add(d_tri, d0)), hn::Zero(df)));
@@ -221,7 +223,7 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
         store(hn::IfThenElse(update, d1_new, d1), df, planes.d1, i);
         store(hn::IfThenElse(hn::RebindMask(du, update), mask_new, mask), du, planes.mask, i);
     }
-    return touched;
+    return updated;
 }
 #endif  // HOMCULL_SUBTILE_LANES
 
@@ -319,7 +321,25 @@ HWY_INLINE void FloatRowIntervals(const RasterTriangle& triangle, int row0, int 
     }
 }
 
-// The reference's row loop, in two passes over chunks of up to 16 subtile rows: first the
+// hidden_behind_reference_layer with a vector of subtiles per step: the same comparisons, so
+// the same answer.
+HWY_INLINE bool HiddenBehindReferenceLayer(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest) {
+    const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many
+    const int lanes = int(hn::Lanes(df));
+    const auto bound = hn::Set(df, std::max(nearest, std::numeric_limits<float>::denorm_min()));
+    for (int ty = ty0; ty <= ty1; ++ty) {
+        const float* d0 = planes.d0 + std::size_t(ty) * planes.stride;
+        for (int tx = tx0; tx <= tx1; tx += lanes) {
+            const auto in_box = hn::FirstN(df, std::size_t(tx1 - tx + 1));
+            if (!hn::AllFalse(df, hn::And(in_box, hn::Lt(hn::LoadU(df, d0 + tx), bound)))) return false;
+        }
+    }
+    return true;
+}
+
+// The reference's row loop, over chunks of up to kChunkSubtileRows subtile rows. A chunk where
+// the triangle is hidden behind the reference layer is skipped (HiddenBehindReferenceLayer; on
+// S1 that is most of them). Otherwise two passes: first the
 // coverage interval of every sample row of the chunk (DoubleRowIntervals, or
 // FloatRowIntervals for the triangles set up for it), each lane evaluating
 // rasterize_rows_reference's formula for its row; then the subtile-row updates. (One subtile
@@ -332,16 +352,20 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     if (ty_first > ty_last) return 0;
     const auto sample_lane = hn::Iota(hn::CappedTag<std::int32_t, kMaxSimdLanes>(), 0);
 
-    constexpr int kChunkSubtileRows = 16, kChunkRows = kChunkSubtileRows * kH;
+    constexpr int kChunkRows = kChunkSubtileRows * kH, kW = OcclusionBuffer::kSubtileWidth;
 #if HOMCULL_SUBTILE_LANES
     const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
 #endif
     // + kMaxSimdLanes: the last vector may pass the chunk's rows
     HWY_ALIGN std::int32_t first[kChunkRows + kMaxSimdLanes], last[kChunkRows + kMaxSimdLanes];
-    std::uint64_t touched = 0;
+    std::uint64_t updated = 0;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         const int row0 = ty0 * kH, rows = (ty1 - ty0 + 1) * kH;
+        if (!t.planes.sample_depth &&
+            HiddenBehindReferenceLayer(t.planes, i0 / kW, i1 / kW, ty0, ty1,
+                                       nearest_conservative_depth(tri, i0, i1, std::max(triangle.j0, row0), std::min(j1, row0 + rows - 1))))
+            continue;
         if (triangle.plane.float_rows) FloatRowIntervals(triangle, row0, rows, first, last);
         else DoubleRowIntervals(triangle, row0, rows, first, last);
         for (int ty = ty0; ty <= ty1;) {
@@ -350,13 +374,13 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
 #if HOMCULL_SUBTILE_LANES
             // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
             const int rows_now = pair_rows && ty < ty1 ? 2 : 1;
-            touched += rows_now == 2 ? UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height)
+            updated += rows_now == 2 ? UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height)
                                      : UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
 #else
             const int rows_now = 1;
             int tx_begin, tx_end;
             if (reached_subtile_columns(row_first, row_last, i0, i1, tx_begin, tx_end))
-                touched += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width,
+                updated += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width,
                                                         t.sample_height);
 #endif
             if (t.planes.sample_depth)
@@ -365,7 +389,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             ty += rows_now;
         }
     }
-    return touched;
+    return updated;
 }
 
 }  // namespace homcull::detail::HWY_NAMESPACE

@@ -112,7 +112,7 @@ struct SetupResult {
 
 // Sets up a triangle already fetched and in clip space (fetch_clip_triangle), with its shared-edge
 // bits: clipping, backface culling, projection to the sample grid of sample_width x sample_height.
-// Counts the setup statistics but triangles_in, invalid and subtiles_touched.
+// Counts the setup statistics but triangles_in, invalid and subtiles_updated.
 SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
                                 int sample_height, RasterStats& stats);
 

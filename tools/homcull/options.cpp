@@ -86,7 +86,7 @@ nlohmann::json camera_json(const Camera& c) {
 nlohmann::json stats_json(const RasterStats& s) {
     return {{"triangles_in", s.triangles_in}, {"invalid", s.invalid},   {"outside", s.outside},
             {"near_clipped", s.near_clipped}, {"too_large", s.too_large}, {"backface_culled", s.backface_culled},
-            {"degenerate", s.degenerate},     {"rasterized", s.rasterized}, {"subtiles_touched", s.subtiles_touched}};
+            {"degenerate", s.degenerate},     {"rasterized", s.rasterized}, {"subtiles_updated", s.subtiles_updated}};
 }
 
 Resolution parse_resolution(const std::string& text) {

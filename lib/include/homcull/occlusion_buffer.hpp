@@ -77,18 +77,23 @@ struct RasterStats {
     std::uint64_t backface_culled = 0;
     std::uint64_t degenerate = 0;         // zero area after projection
     std::uint64_t rasterized = 0;         // triangles (after clipping) that reached the buffer
-    std::uint64_t subtiles_touched = 0;   // subtile updates
+    // (triangle, subtile) pairs where the triangle covers a sample and is in front of the
+    // subtile's reference layer, so that it enters the subtile's layers. Triangles hidden
+    // behind the reference layer are skipped before their samples are found: counting only
+    // the subtiles they update keeps the figure the same with or without that skip, and
+    // with any number of threads.
+    std::uint64_t subtiles_updated = 0;
 
     RasterStats& operator+=(const RasterStats& o) {
         triangles_in += o.triangles_in, invalid += o.invalid, outside += o.outside, near_clipped += o.near_clipped;
         too_large += o.too_large, backface_culled += o.backface_culled, degenerate += o.degenerate, rasterized += o.rasterized;
-        subtiles_touched += o.subtiles_touched;
+        subtiles_updated += o.subtiles_updated;
         return *this;
     }
     bool operator==(const RasterStats& o) const {
         return triangles_in == o.triangles_in && invalid == o.invalid && outside == o.outside && near_clipped == o.near_clipped &&
                too_large == o.too_large && backface_culled == o.backface_culled && degenerate == o.degenerate &&
-               rasterized == o.rasterized && subtiles_touched == o.subtiles_touched;
+               rasterized == o.rasterized && subtiles_updated == o.subtiles_updated;
     }
 };
 
@@ -292,7 +297,7 @@ private:
     // Render scratch, reused across frames (grown, never shrunk).
     struct Chunk;
     std::vector<Chunk> chunks_;
-    std::vector<std::uint64_t> band_touched_;
+    std::vector<std::uint64_t> band_updated_;
     std::vector<double> vertex_clip_;           // four planes of vertex_count + padding
     std::vector<std::uint8_t> vertex_outcode_;
 
