@@ -202,7 +202,9 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
         const VF d_tri = hn::Mul(bound, lower);
 
         const auto update = hn::And(hn::RebindMask(df, active), hn::Gt(d_tri, d0));
-        if (hn::AllFalse(df, update)) continue;
+        // No branch on whether any lane updates: on S1 about half the vectors do not, in no
+        // pattern a predictor learns, and the mispredictions cost more than computing the update
+        // and writing back the unchanged values (S1 14.55 -> 13.87 ms, castle 1.43 -> 1.40 ms).
         updated += hn::CountTrue(df, update);
         // Quick mask, lane by lane as the reference.
         const auto mask_nonzero = hn::RebindMask(df, hn::Ne(mask, hn::Zero(du)));
