@@ -13,6 +13,7 @@
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
+#include <type_traits>
 #include <limits>
 
 HWY_BEFORE_NAMESPACE();
@@ -305,22 +306,34 @@ HWY_INLINE void FloatRowIntervals(const RasterTriangle& triangle, int row0, int 
     const int lanes = int(hn::Lanes(df));
     const auto row_min = hn::Set(df, float(triangle.j0)), row_max = hn::Set(df, float(triangle.j1)), one = hn::Set(df, 1.0f);
     const auto lane = hn::Iota(df, 0.0f);
-    for (int r = 0; r < rows; r += lanes) {
-        const auto y = hn::Add(lane, hn::Set(df, float(row0 + r)));  // exact: small integers
-        auto lo = hn::Set(df, float(triangle.i0)), hi = hn::Set(df, float(triangle.i1));
-        for (int k = 0; k < 3; ++k) {
-            const auto dy = hn::Sub(hn::Sub(y, hn::Set(df, e.row_origin[k])), hn::Set(df, e.y_offset[k]));
-            const auto v = hn::Sub(hn::Set(df, e.base[k]), hn::Mul(hn::Set(df, e.slope[k]), dy));
-            const auto clamped = hn::Min(hn::Max(v, hn::Set(df, e.lo_clamp[k])), hn::Set(df, e.hi_clamp[k]));
-            const auto shift = hn::Set(df, e.column_shift[k]);
-            if (e.lower[k]) lo = hn::Max(lo, hn::Add(hn::Floor(clamped), shift));
-            else hi = hn::Min(hi, hn::Add(hn::Ceil(clamped), shift));
+    // The edges in the order lower edges first (a triangle without a horizontal edge has one
+    // or two of each), so that the loop below branches once on which kind edge 1 is, not on
+    // every edge: lo and hi are a max and a min, the same in any order.
+    static constexpr std::int8_t kOrder[8][3] = {{0, 1, 2}, {0, 1, 2}, {1, 0, 2}, {0, 1, 2}, {2, 0, 1}, {0, 2, 1}, {1, 2, 0}, {0, 1, 2}};
+    const int pattern = int(e.lower[0]) | int(e.lower[1]) << 1 | int(e.lower[2]) << 2;
+    const std::int8_t* order = kOrder[pattern];
+    const auto edge_value = [&](int k, auto y) {
+        const int o = order[k];
+        const auto dy = hn::Sub(hn::Sub(y, hn::Set(df, e.row_origin[o])), hn::Set(df, e.y_offset[o]));
+        const auto v = hn::Sub(hn::Set(df, e.base[o]), hn::Mul(hn::Set(df, e.slope[o]), dy));
+        return hn::Min(hn::Max(v, hn::Set(df, e.lo_clamp[o])), hn::Set(df, e.hi_clamp[o]));
+    };
+    const auto shift = [&](int k) { return hn::Set(df, e.column_shift[order[k]]); };
+    const auto run = [&](auto two_lower) {
+        for (int r = 0; r < rows; r += lanes) {
+            const auto y = hn::Add(lane, hn::Set(df, float(row0 + r)));  // exact: small integers
+            auto lo = hn::Max(hn::Set(df, float(triangle.i0)), hn::Add(hn::Floor(edge_value(0, y)), shift(0)));
+            auto hi = hn::Min(hn::Set(df, float(triangle.i1)), hn::Add(hn::Ceil(edge_value(2, y)), shift(2)));
+            if constexpr (decltype(two_lower)::value) lo = hn::Max(lo, hn::Add(hn::Floor(edge_value(1, y)), shift(1)));
+            else hi = hn::Min(hi, hn::Add(hn::Ceil(edge_value(1, y)), shift(1)));
+            const auto empty = hn::Or(hn::Lt(y, row_min), hn::Gt(y, row_max));
+            hi = hn::IfThenElse(empty, hn::Sub(lo, one), hi);
+            hn::StoreU(hn::ConvertTo(di, lo), di, first + r);
+            hn::StoreU(hn::ConvertTo(di, hi), di, last + r);
         }
-        const auto empty = hn::Or(hn::Lt(y, row_min), hn::Gt(y, row_max));
-        hi = hn::IfThenElse(empty, hn::Sub(lo, one), hi);
-        hn::StoreU(hn::ConvertTo(di, lo), di, first + r);
-        hn::StoreU(hn::ConvertTo(di, hi), di, last + r);
-    }
+    };
+    if (pattern == 3 || pattern == 5 || pattern == 6) run(std::true_type{});
+    else run(std::false_type{});
 }
 
 // hidden_behind_reference_layer with a vector of subtiles per step: the same comparisons, so
