@@ -32,27 +32,40 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 #if HOMCULL_SUBTILE_LANES
 
-// A plane's elements of the lanes of UpdateSubtileRows: one vector from row offset row0, or
-// half a vector from each of row0 and row1.
+// A plane's elements of the lanes of UpdateSubtileRows: one vector from row offset row[0],
+// or a half vector from each of row[0] and row[1], or a quarter from each of row[0..3].
 template <int kRows, class D, typename T>
-HWY_INLINE hn::Vec<D> LoadRows(D d, const T* plane, std::size_t row0, std::size_t row1, std::size_t tx) {
-    if constexpr (kRows == 2) {
+HWY_INLINE hn::Vec<D> LoadRows(D d, const T* plane, const std::size_t* row, std::size_t tx) {
+    if constexpr (kRows == 4) {
         const hn::Half<D> dh;
-        return hn::Combine(d, hn::LoadU(dh, plane + row1 + tx), hn::LoadU(dh, plane + row0 + tx));
+        const hn::Half<decltype(dh)> dq;
+        return hn::Combine(d, hn::Combine(dh, hn::LoadU(dq, plane + row[3] + tx), hn::LoadU(dq, plane + row[2] + tx)),
+                           hn::Combine(dh, hn::LoadU(dq, plane + row[1] + tx), hn::LoadU(dq, plane + row[0] + tx)));
+    } else if constexpr (kRows == 2) {
+        const hn::Half<D> dh;
+        return hn::Combine(d, hn::LoadU(dh, plane + row[1] + tx), hn::LoadU(dh, plane + row[0] + tx));
+    } else {
+        return hn::LoadU(d, plane + row[0] + tx);
     }
-    (void)row1;
-    return hn::LoadU(d, plane + row0 + tx);
 }
 template <int kRows, class D, typename T>
-HWY_INLINE void StoreRows(hn::Vec<D> v, D d, T* plane, std::size_t row0, std::size_t row1, std::size_t tx) {
-    if constexpr (kRows == 2) {
+HWY_INLINE void StoreRows(hn::Vec<D> v, D d, T* plane, const std::size_t* row, std::size_t tx) {
+    if constexpr (kRows == 4) {
         const hn::Half<D> dh;
-        hn::StoreU(hn::LowerHalf(dh, v), dh, plane + row0 + tx);
-        hn::StoreU(hn::UpperHalf(dh, v), dh, plane + row1 + tx);
-        return;
+        const hn::Half<decltype(dh)> dq;
+        const auto lo = hn::LowerHalf(dh, v), hi = hn::UpperHalf(dh, v);
+        hn::StoreU(hn::LowerHalf(dq, lo), dq, plane + row[0] + tx);
+        hn::StoreU(hn::UpperHalf(dq, lo), dq, plane + row[1] + tx);
+        hn::StoreU(hn::LowerHalf(dq, hi), dq, plane + row[2] + tx);
+        hn::StoreU(hn::UpperHalf(dq, hi), dq, plane + row[3] + tx);
+    } else if constexpr (kRows == 2) {
+        const hn::Half<D> dh;
+        hn::StoreU(hn::LowerHalf(dh, v), dh, plane + row[0] + tx);
+        hn::StoreU(hn::UpperHalf(dh, v), dh, plane + row[1] + tx);
+    } else {
+        (void)d;
+        hn::StoreU(v, d, plane + row[0] + tx);
     }
-    (void)row1;
-    hn::StoreU(v, d, plane + row0 + tx);
 }
 
 // The index (0..24) of the highest set bit of each lane of v, for v < 2^25 (as int), from the
@@ -72,15 +85,17 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
     return HighestBitIndex(du, hn::AndNot(hn::And(hn::Sub(v, hn::Set(du, 1u)), lowest), v));
 }
 
-// The subtile-row update of kRows consecutive subtile rows ty.. (1 or 2) of a triangle with
+// The subtile-row update of kRows consecutive subtile rows ty.. (1, 2 or 4) of a triangle with
 // sample columns [i0, i1], over the subtile columns its sample rows reach (as
 // reached_subtile_columns, or all of the triangle's when one vector spans them; lanes without
 // samples change nothing). The subtiles tx..tx + columns - 1 of each row are the vector lanes,
 // float and 32-bit integer: at most 8 columns (4 on SSE4 and NEON; rows are padded for
 // kMaxSimdLanes). first and last hold the rows' sample-row intervals, 4 per subtile row. Two
 // rows at a time suit AVX-512's 16 lanes: S1's triangles reach about 5 subtiles per row, and
-// one row in 16 lanes was 10 % slower than in 8. Returns the number of subtiles updated
-// (covered and in front of the reference layer).
+// one row in 16 lanes was 10 % slower than in 8. Four rows of 4 subtiles (one 128-bit block per
+// row) suit triangles that span at most 4 subtile columns: most of the castle's, which filled
+// about 4 of the 16 lanes in two rows of 8 (castle C0 1.405 -> 1.358 ms). Returns the number of
+// subtiles updated (covered and in front of the reference layer).
 //
 // The coverage masks come from sample rows (as Intel's Masked Occlusion Culling computes them):
 // before the update, lane l holds sample row l % 4 of one subtile row across 32 samples, 4
@@ -92,13 +107,14 @@ HWY_INLINE hn::Vec<hn::RebindToSigned<DU>> ExtremeBitIndex(DU du, hn::Vec<DU> v,
 template <int kRows>
 HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, const std::int32_t* first, const std::int32_t* last,
                                            int i0, int i1, const PreparedTriangle& tri, int sample_width, int sample_height) {
-    static_assert(kRows == 1 || kRows == 2, "one or two subtile rows");
+    static_assert(kRows == 1 || kRows == 2 || kRows == 4, "one, two or four subtile rows");
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     // The byte transpose below takes subtiles of 4 rows of 8 samples (a byte per sample row),
     // 4 of them (32 samples) per 128-bit block.
     static_assert(kW == 8 && kH == 4, "the transpose assumes 8 x 4 subtiles");
     constexpr int kSubtilesPerBlock = 4;
-    const hn::CappedTag<float, 8 * kRows> df;
+    // Rows of 8 subtiles; four rows take 4 subtiles each (one 128-bit block per row).
+    const hn::CappedTag<float, kRows == 4 ? 16 : 8 * kRows> df;
     const hn::RebindToSigned<decltype(df)> di;
     const hn::RebindToUnsigned<decltype(df)> du;
     const hn::Repartition<std::uint8_t, decltype(du)> du8;
@@ -110,27 +126,28 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     // Highway's Iota goes through memory (a store-forwarding stall per call): built once.
     const VI lane = hn::Iota(di, 0);
     const VI lane_column = kRows == 1 ? lane : hn::And(lane, hn::Set(di, row_lanes - 1));
-    const auto second_row = hn::Gt(lane, hn::Set(di, kRows == 1 ? 1 << 30 : row_lanes - 1));  // lanes of row ty + 1
-    // A value per lane from its row's: a for row ty, b for row ty + 1.
-    const auto per_row = [&](std::int32_t a, std::int32_t b) {
-        return kRows == 1 ? hn::Set(di, a) : hn::IfThenElse(second_row, hn::Set(di, b), hn::Set(di, a));
-    };
+    // The lane's subtile row, from ty: lane / row_lanes (row_lanes = 8 with two rows, 4 with four).
+    const VI lane_row = kRows == 4 ? hn::ShiftRight<2>(lane) : kRows == 2 ? hn::VecFromMask(di, hn::Gt(lane, hn::Set(di, row_lanes - 1))) : hn::Zero(di);
+    const VI row_of_lane = kRows == 2 ? hn::Neg(lane_row) : lane_row;  // VecFromMask gives -1
+    const VI row_y = hn::Add(hn::Set(di, ty * kH), hn::ShiftLeft<2>(row_of_lane));  // kH = 4
 
     // The valid-sample mask of each row's subtiles (see valid_sample_mask): all ones except in
     // the last column and the last row of subtiles, as (row bits of the lane's columns) x
-    // (one bit per existing row).
-    std::uint32_t replicate[2] = {0, 0};
-    for (int r = 0; r < kRows; ++r)  // rows that exist: 1 to 4 (each subtile row has one)
-        replicate[r] = 0x01010101u >> (kW * (kH - std::min(kH, sample_height - (ty + r) * kH)));
-    const VU replicate_v = hn::BitCast(du, per_row(std::int32_t(replicate[0]), std::int32_t(replicate[kRows - 1])));
-    const VI row_y = per_row(ty * kH, (ty + kRows - 1) * kH);
+    // (one bit per existing row: 1 to 4, each subtile row has one).
+    const VI rows_existing = hn::Min(hn::Sub(hn::Set(di, sample_height), row_y), hn::Set(di, kH));
+    const VU replicate_v = hn::Shr(hn::Set(du, 0x01010101u), hn::BitCast(du, hn::ShiftLeft<3>(hn::Sub(hn::Set(di, kH), rows_existing))));
 
     // Before the transpose, lane l is sample row l % 4 of its subtile row: each subtile row's
     // 4 intervals repeated in every block of its lanes, by 128-bit loads that lie within one
     // store of the row pass (a wider load across two of its stores waited for them to retire:
     // no store forwarding).
     const auto row_intervals = [&](const std::int32_t* rows) {
-        if constexpr (kRows == 2) {
+        if constexpr (kRows == 4) {  // a block per row: its 4 intervals, one 128-bit load each
+            const hn::Half<decltype(di)> dh;
+            const hn::Half<decltype(dh)> dq;
+            return hn::Combine(di, hn::Combine(dh, hn::LoadU(dq, rows + 3 * kH), hn::LoadU(dq, rows + 2 * kH)),
+                               hn::Combine(dh, hn::LoadU(dq, rows + kH), hn::LoadU(dq, rows)));
+        } else if constexpr (kRows == 2) {
             const hn::Half<decltype(di)> dh;
             return hn::Combine(di, hn::LoadDup128(dh, rows + kH), hn::LoadDup128(dh, rows));
         }
@@ -153,9 +170,10 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
     const VU transpose = hn::BitCast(
         du, hn::Add(hn::Set(di, 0x0C080400), hn::Mul(hn::And(lane, hn::Set(di, kSubtilesPerBlock - 1)), hn::Set(di, 0x01010101))));
 
-    const std::size_t row0 = std::size_t(ty) * planes.stride, row1 = std::size_t(ty + kRows - 1) * planes.stride;
-    const auto load = [&](auto d, const auto* plane, std::size_t tx) { return LoadRows<kRows>(d, plane, row0, row1, tx); };
-    const auto store = [&](auto v, auto d, auto* plane, std::size_t tx) { StoreRows<kRows>(v, d, plane, row0, row1, tx); };
+    std::size_t row[kRows];
+    for (int r = 0; r < kRows; ++r) row[r] = std::size_t(ty + r) * planes.stride;
+    const auto load = [&](auto d, const auto* plane, std::size_t tx) { return LoadRows<kRows>(d, plane, row, tx); };
+    const auto store = [&](auto v, auto d, auto* plane, std::size_t tx) { StoreRows<kRows>(v, d, plane, row, tx); };
     const VI zero_i = hn::Zero(di), eight = hn::Set(di, kW), last_bit = hn::Set(di, 31);
     const VU byte = hn::Set(du, 0xFFu), ones = hn::Set(du, ~0u);
     const VU lowest_column = hn::Set(du, tri.far_is_left ? ~0u : 0u), lowest_row = hn::Set(du, tri.far_is_top ? ~0u : 0u);
@@ -370,6 +388,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     constexpr int kChunkRows = kChunkSubtileRows * kH, kW = OcclusionBuffer::kSubtileWidth;
 #if HOMCULL_SUBTILE_LANES
     const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
+    const bool narrow = pair_rows && i1 / OcclusionBuffer::kSubtileWidth - i0 / OcclusionBuffer::kSubtileWidth < 4;
 #endif
     // + kMaxSimdLanes: the last vector may pass the chunk's rows
     HWY_ALIGN std::int32_t first[kChunkRows + kMaxSimdLanes], last[kChunkRows + kMaxSimdLanes];
@@ -388,9 +407,12 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             const std::int32_t* row_last = last + (ty - ty0) * kH;
 #if HOMCULL_SUBTILE_LANES
             // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
-            const int rows_now = pair_rows && ty < ty1 ? 2 : 1;
-            updated += rows_now == 2 ? UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height)
-                                     : UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
+            // Four subtile rows at a time when the triangle spans at most 4 subtile columns (the
+            // castle's small triangles filled 4 of 16 lanes in two rows of 8).
+            const int rows_now = narrow && ty + 3 <= ty1 ? 4 : pair_rows && ty < ty1 ? 2 : 1;
+            if (rows_now == 4) updated += UpdateSubtileRows<4>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
+            else if (rows_now == 2) updated += UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
+            else updated += UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
 #else
             const int rows_now = 1;
             int tx_begin, tx_end;
