@@ -387,8 +387,13 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
 
     constexpr int kChunkRows = kChunkSubtileRows * kH, kW = OcclusionBuffer::kSubtileWidth;
 #if HOMCULL_SUBTILE_LANES
-    const bool pair_rows = hn::Lanes(hn::CappedTag<float, 16>()) == 16;
-    const bool narrow = pair_rows && i1 / OcclusionBuffer::kSubtileWidth - i0 / OcclusionBuffer::kSubtileWidth < 4;
+    // How many subtile rows one update vector takes: rows of 8 subtiles, or of 4 for a triangle
+    // that spans at most 4 subtile columns (the castle's small triangles filled 4 of 16 lanes
+    // in two rows of 8). 16 lanes (AVX-512): 2 rows of 8 or 4 rows of 4; 8 lanes (AVX2): 1 row
+    // of 8 or 2 rows of 4; fewer: 1 row.
+    const int vector_lanes = int(hn::Lanes(hn::CappedTag<float, 16>()));
+    const bool narrow = i1 / kW - i0 / kW < 4;
+    const int rows_per_vector = vector_lanes >= 16 ? (narrow ? 4 : 2) : vector_lanes == 8 && narrow ? 2 : 1;
 #endif
     // + kMaxSimdLanes: the last vector may pass the chunk's rows
     HWY_ALIGN std::int32_t first[kChunkRows + kMaxSimdLanes], last[kChunkRows + kMaxSimdLanes];
@@ -406,10 +411,8 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
 #if HOMCULL_SUBTILE_LANES
-            // Two subtile rows at a time where vectors have room for two rows of 8 subtiles.
-            // Four subtile rows at a time when the triangle spans at most 4 subtile columns (the
-            // castle's small triangles filled 4 of 16 lanes in two rows of 8).
-            const int rows_now = narrow && ty + 3 <= ty1 ? 4 : pair_rows && ty < ty1 ? 2 : 1;
+            // rows_per_vector where the chunk has that many rows left, else fewer.
+            const int rows_now = rows_per_vector == 4 && ty + 3 <= ty1 ? 4 : rows_per_vector >= 2 && ty < ty1 ? 2 : 1;
             if (rows_now == 4) updated += UpdateSubtileRows<4>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
             else if (rows_now == 2) updated += UpdateSubtileRows<2>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
             else updated += UpdateSubtileRows<1>(t.planes, ty, row_first, row_last, i0, i1, tri, t.sample_width, t.sample_height);
