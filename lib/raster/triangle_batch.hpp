@@ -124,7 +124,19 @@ struct FrontEndKernels {
     TransformBatchKernel transform_batch;
     ClassifyBatchKernel classify;
     SetupBatchKernel setup;  // null for the scalar reference, whose classify marks no lane simple
+    // gather_triangle_batch for a full batch of an input that gather_direct_ready accepts; null
+    // for the scalar reference.
+    void (*gather_direct)(const TriangleInput& in, std::size_t first, TriangleBatch& batch);
 };
+
+// Whether triangles [first, first + TriangleBatch::kSize) of the input are consecutive
+// vertices of 4 floats each (aligned as floats), all within vertex_count:
+// FrontEndKernels::gather_direct's input.
+inline bool gather_direct_ready(const TriangleInput& in, std::size_t first, std::size_t end) {
+    return !in.indices && in.position_components == 4 && in.position_stride >= 16 && in.position_stride % alignof(float) == 0 &&
+           reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0 && end - first >= std::size_t(TriangleBatch::kSize) &&
+           3 * (first + std::size_t(TriangleBatch::kSize)) <= in.vertex_count;
+}
 FrontEndKernels selected_front_end_kernels();
 
 // Sets up triangles [begin, end) of the input in batches and hands every triangle of their
@@ -142,7 +154,8 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             first = gather_cached_batch(in, *cache, first, end, batch, stats);
         } else {
             batch.count = int(std::min<std::size_t>(TriangleBatch::kSize, end - first));
-            gather_triangle_batch(in, first, batch.count, batch);
+            if (kernels.gather_direct && gather_direct_ready(in, first, end)) kernels.gather_direct(in, first, batch);
+            else gather_triangle_batch(in, first, batch.count, batch);
             kernels.transform_batch(in, batch);
             stats.triangles_in += std::uint64_t(batch.count);
             first += std::size_t(batch.count);

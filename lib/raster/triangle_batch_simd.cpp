@@ -13,6 +13,7 @@
 #include "raster/triangle_batch.hpp"
 
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 HWY_BEFORE_NAMESPACE();
@@ -84,6 +85,49 @@ void TransformVertices(const TriangleInput& in, double near_w, std::size_t begin
             StoreVertexClips(in, near, hn::Load(d, p[0] + g), hn::Load(d, p[1] + g), hn::Load(d, p[2] + g), hn::Load(d, p[3] + g),
                              v0 + std::size_t(g), std::size_t(std::min(lanes, n - g)), cache);
     }
+}
+
+// gather_triangle_batch for a full batch of triangles without indices and with 4 float
+// components per vertex (engines' clip-space soups, workload S1): four vertices at a time,
+// one 128-bit load each, a 4 x 4 transpose into x, y, z and w, widened to double. The same
+// values as the scalar gather (float to double is exact).
+void GatherDirectBatch(const TriangleInput& in, std::size_t first, TriangleBatch& batch) {
+    constexpr int kSize = TriangleBatch::kSize;
+    const unsigned char* positions = static_cast<const unsigned char*>(in.positions);
+    const std::size_t stride = in.position_stride;
+    const auto vertex = [&](int t, int k) {
+        return reinterpret_cast<const float*>(positions + (3 * (first + std::size_t(t)) + std::size_t(k)) * stride);
+    };
+#if HWY_TARGET == HWY_SCALAR
+    for (int k = 0; k < 3; ++k)
+        for (int t = 0; t < kSize; ++t) {
+            float p[4];
+            std::memcpy(p, vertex(t, k), sizeof p);
+            batch.px[k][t] = p[0], batch.py[k][t] = p[1], batch.pz[k][t] = p[2], batch.pw[k][t] = p[3];
+        }
+#else
+    const hn::Full128<float> d4;
+    const hn::Full64<float> d2;
+    const hn::Full128<double> dd;
+    const auto store = [&](hn::Vec<decltype(d4)> v, double* out) {  // 4 floats as 4 doubles
+        hn::Store(hn::PromoteTo(dd, hn::LowerHalf(d2, v)), dd, out);
+        hn::Store(hn::PromoteTo(dd, hn::UpperHalf(d2, v)), dd, out + 2);
+    };
+    for (int k = 0; k < 3; ++k)
+        for (int t = 0; t < kSize; t += 4) {
+            const auto v0 = hn::LoadU(d4, vertex(t, k)), v1 = hn::LoadU(d4, vertex(t + 1, k));
+            const auto v2 = hn::LoadU(d4, vertex(t + 2, k)), v3 = hn::LoadU(d4, vertex(t + 3, k));
+            const auto xy01 = hn::InterleaveLower(d4, v0, v1), xy23 = hn::InterleaveLower(d4, v2, v3);  // x0 x1 y0 y1
+            const auto zw01 = hn::InterleaveUpper(d4, v0, v1), zw23 = hn::InterleaveUpper(d4, v2, v3);  // z0 z1 w0 w1
+            store(hn::ConcatLowerLower(d4, xy23, xy01), batch.px[k] + t);
+            store(hn::ConcatUpperUpper(d4, xy23, xy01), batch.py[k] + t);
+            store(hn::ConcatLowerLower(d4, zw23, zw01), batch.pz[k] + t);
+            store(hn::ConcatUpperUpper(d4, zw23, zw01), batch.pw[k] + t);
+        }
+#endif
+    batch.count = kSize;
+    batch.indices_valid = (1u << kSize) - 1u;
+    for (int t = 0; t < kSize; ++t) batch.triangle[t] = first + std::size_t(t);
 }
 
 void TransformBatch(const TriangleInput& in, TriangleBatch& batch) {
@@ -315,14 +359,15 @@ namespace homcull::detail {
 
 HWY_EXPORT(TransformVertices);
 HWY_EXPORT(TransformBatch);
+HWY_EXPORT(GatherDirectBatch);
 HWY_EXPORT(ClassifyBatch);
 HWY_EXPORT(SetupBatch);
 
 FrontEndKernels selected_front_end_kernels() {
     if (scalar_reference_selected())
-        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr};
+        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr};
     return {HOMCULL_RESOLVED_KERNEL(TransformVertices), HOMCULL_RESOLVED_KERNEL(TransformBatch), HOMCULL_RESOLVED_KERNEL(ClassifyBatch),
-            HOMCULL_RESOLVED_KERNEL(SetupBatch)};
+            HOMCULL_RESOLVED_KERNEL(SetupBatch), HOMCULL_RESOLVED_KERNEL(GatherDirectBatch)};
 }
 
 }  // namespace homcull::detail
