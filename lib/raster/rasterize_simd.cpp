@@ -13,8 +13,8 @@
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
-#include <type_traits>
 #include <limits>
+#include <type_traits>
 
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
