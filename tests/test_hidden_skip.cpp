@@ -1,5 +1,6 @@
 // The early skip of triangles hidden behind the reference layer (hidden_behind_reference_layer,
-// nearest_conservative_depth): it must change no bit of the buffer and no statistic.
+// nearest_conservative_depth): it must change no bit of the buffer, of its per-sample depth,
+// and no statistic.
 #include "raster/rasterize.hpp"
 #include "support.hpp"
 
@@ -69,27 +70,47 @@ TEST(HiddenTriangleSkip, NearestDepthIsTheLargestOverTheBox) {
     EXPECT_GT(samples, 1000000);
 }
 
-// The layers and the statistics are the same with and without the skip. A buffer that keeps
-// per-sample depth skips nothing (the argument for the skip does not cover that depth), so it
-// is the oracle: its subtiles must equal those of a buffer without it, which skips.
+// The layers, the per-sample depth and the statistics are the same with and without the skip
+// (set_hidden_skip(false) is the oracle), on every instruction set, one thread and two, with
+// and without per-sample depth.
 void expect_same_with_and_without_skip(const TriangleInput& in, int width, int height, int samples, float near_w) {
     ASSERT_GT(in.triangle_count, 0u);
     for (const std::string& isa : available_isas()) {
         select_isa(isa);
-        for (bool threads : {false, true}) {
-            OcclusionBuffer skipping(test::buffer_config(width, height, samples, near_w, false));
-            OcclusionBuffer oracle(test::buffer_config(width, height, samples, near_w, true));
-            const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
-            skipping.render_frame(in, parallel);
-            oracle.render_frame(in, parallel);
-            const auto a = skipping.subtiles(), b = oracle.subtiles();
-            ASSERT_EQ(a.size(), b.size());
-            std::size_t differing = 0;
-            for (std::size_t i = 0; i < a.size(); ++i)
-                differing += a[i].d0 != b[i].d0 || a[i].d1 != b[i].d1 || a[i].mask != b[i].mask || a[i].covered != b[i].covered;
-            EXPECT_EQ(differing, 0u) << isa << (threads ? ", two threads" : ", one thread");
-            EXPECT_TRUE(skipping.stats() == oracle.stats()) << isa;
-        }
+        for (bool sample_depth : {false, true})
+            for (bool threads : {false, true}) {
+                const std::string where = isa + (threads ? ", two threads" : ", one thread") + (sample_depth ? ", per-sample depth" : "");
+                const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+                OcclusionBuffer skipping(test::buffer_config(width, height, samples, near_w, sample_depth));
+                OcclusionBuffer oracle(test::buffer_config(width, height, samples, near_w, sample_depth));
+                skipping.render_frame(in, parallel);
+                set_hidden_skip(false);
+                oracle.render_frame(in, parallel);
+                set_hidden_skip(true);
+                const auto a = skipping.subtiles(), b = oracle.subtiles();
+                ASSERT_EQ(a.size(), b.size());
+                std::size_t differing = 0;
+                for (std::size_t i = 0; i < a.size(); ++i)
+                    differing += a[i].d0 != b[i].d0 || a[i].d1 != b[i].d1 || a[i].mask != b[i].mask || a[i].covered != b[i].covered;
+                EXPECT_EQ(differing, 0u) << where;
+                std::vector<float> depth_a, depth_b;
+                skipping.read_sample_depth(depth_a);
+                oracle.read_sample_depth(depth_b);
+                EXPECT_TRUE(depth_a == depth_b) << where;
+                EXPECT_EQ(depth_a.empty(), !sample_depth);
+                // Why the skip leaves the per-sample depth alone: every sample's depth is at or in
+                // front of its subtile's d0 (each sample of a promoted layer is covered by one of
+                // its triangles, whose depth at the sample is at least its depth at the corner
+                // the layer took, by the same monotone roundings as nearest_conservative_depth).
+                std::size_t below_d0 = 0;
+                const int sw = skipping.sample_width();
+                for (std::size_t k = 0; k < depth_a.size(); ++k) {
+                    const int x = int(k % std::size_t(sw)), y = int(k / std::size_t(sw));
+                    below_d0 += depth_a[k] < skipping.subtile(x / OcclusionBuffer::kSubtileWidth, y / OcclusionBuffer::kSubtileHeight).d0;
+                }
+                EXPECT_EQ(below_d0, 0u) << where;
+                EXPECT_TRUE(skipping.stats() == oracle.stats()) << where;
+            }
     }
     select_isa("best");
 }

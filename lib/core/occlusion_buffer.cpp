@@ -144,7 +144,7 @@ detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) 
                                        stride_,
                                        sample_depth_.empty() ? nullptr : sample_depth_.data(),
                                        sample_depth_stride_};
-    return {planes, sample_width_, sample_height_, row_begin, row_end, detail::selected_rows_kernel()};
+    return {planes, sample_width_, sample_height_, row_begin, row_end, detail::selected_rows_kernel(), detail::hidden_skip_enabled()};
 }
 
 bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache) {
@@ -299,6 +299,16 @@ void OcclusionBuffer::read_depth(std::vector<float>& w) const {
             if (!sample_depth_.empty()) d = std::max(d, sample_depth_[std::size_t(y) * sample_depth_stride_ + std::size_t(x)]);
             w[at] = d > 0.0f ? 1.0f / d : INFINITY;
         }
+}
+
+void OcclusionBuffer::read_sample_depth(std::vector<float>& d) const {
+    d.clear();
+    if (sample_depth_.empty()) return;
+    d.reserve(std::size_t(sample_width_) * std::size_t(sample_height_));
+    for (int y = 0; y < sample_height_; ++y) {
+        const auto row = sample_depth_.begin() + std::ptrdiff_t(std::size_t(y) * sample_depth_stride_);
+        d.insert(d.end(), row, row + sample_width_);
+    }
 }
 
 std::array<float, 16> clip_from_world(const Camera& camera, double aspect) {

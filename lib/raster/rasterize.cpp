@@ -213,7 +213,7 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriang
     std::uint64_t updated = 0;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
-        if (!t.planes.sample_depth &&
+        if (t.skip_hidden &&
             hidden_behind_reference_layer(t.planes, i0 / kW, i1 / kW, ty0, ty1,
                                           nearest_conservative_depth(prepared, i0, i1, std::max(j0, ty0 * kH), std::min(j1, ty1 * kH + kH - 1))))
             continue;

@@ -52,6 +52,7 @@ struct RasterTarget {
     int sample_width, sample_height;
     int row_begin, row_end;  // the subtile rows [row_begin, row_end) this call may write
     TriangleRowsKernel kernel;
+    bool skip_hidden;  // hidden_skip_enabled() when the target was made
 };
 
 // The three edge functions of a triangle oriented positive inside: for edge k,
@@ -122,9 +123,13 @@ inline float nearest_conservative_depth(const PreparedTriangle& tri, int i0, int
 // Then rasterizing the triangle there changes nothing, bit for bit: a subtile takes a triangle
 // only when its conservative depth is > d0, and `covered` already holds every sample of a
 // subtile with d0 > 0 (d0 is only set by promoting a full working layer, and every mask merged
-// into the layer was first added to `covered`). Per-sample depth is not covered by this
-// argument: callers skip nothing when planes.sample_depth is kept. The SIMD kernels make the
-// same test with vectors of subtiles (pure comparisons: the same answer).
+// into the layer was first added to `covered`). Nor does it change the per-sample depth
+// (planes.sample_depth): every sample's depth is at or in front of its subtile's d0, since each
+// sample of a promoted layer is covered by one of its triangles, whose conservative_depth at
+// the sample is at least its value at the corner of its covered samples that the layer took
+// (the roundings are monotone), and that is at least d0; so nearest, which bounds the
+// triangle's depth at every sample of the box, is at or behind what each sample holds. The
+// SIMD kernels make the same test with vectors of subtiles (pure comparisons: the same answer).
 bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
 
 // The row rule in float, for triangles whose three edges are silhouette edges (no shared
@@ -321,6 +326,11 @@ constexpr int kChunkSubtileRows = 16;
 
 // The reference row loop: scalar intervals and update_subtile_row_reference.
 std::uint64_t rasterize_rows_reference(const RasterTarget& target, const RasterTriangle& triangle);
+
+// Whether the row loops skip chunks hidden behind the reference layer (default: yes). The
+// skip changes no bit; switching it off gives the tests an oracle for that.
+void set_hidden_skip(bool enabled);
+bool hidden_skip_enabled();
 
 // The kernel for the selected instruction set (see select_isa in occlusion_buffer.hpp).
 TriangleRowsKernel selected_rows_kernel();

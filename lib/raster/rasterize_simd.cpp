@@ -427,7 +427,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         const int row0 = ty0 * kH, rows = (ty1 - ty0 + 1) * kH;
-        if (!t.planes.sample_depth &&
+        if (t.skip_hidden &&
             HiddenBehindReferenceLayer(t.planes, i0 / kW, i1 / kW, ty0, ty1,
                                        nearest_conservative_depth(tri, i0, i1, std::max(triangle.j0, row0), std::min(j1, row0 + rows - 1))))
             continue;
@@ -478,6 +478,7 @@ namespace {
 
 // The selected kernel: the reference, or Highway's choice among the allowed targets.
 std::atomic<bool> use_reference{false};
+std::atomic<bool> skip_hidden{true};
 
 struct NamedTarget {
     const char* name;
@@ -490,6 +491,8 @@ const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4
 
 TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_rows_reference : HOMCULL_RESOLVED_KERNEL(RasterizeRows); }
 bool scalar_reference_selected() { return use_reference; }
+void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
+bool hidden_skip_enabled() { return skip_hidden; }
 
 }  // namespace detail
 

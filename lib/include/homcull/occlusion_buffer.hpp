@@ -238,6 +238,9 @@ public:
     // bound, or the per-sample depth where that is nearer (BufferConfig::sample_depth).
     void read_coverage(std::vector<std::uint8_t>& covered) const;
     void read_depth(std::vector<float>& w) const;
+    // The per-sample depth as kept (BufferConfig::sample_depth): 1/w per sample, row-major,
+    // 0 where no occluder covers it; empty when the buffer does not keep it.
+    void read_sample_depth(std::vector<float>& d) const;
     // The farthest-depth pyramid the rectangle tests use, every level one after the other:
     // level 0 the subtiles' d0, level l the minimum over cells of 2^l x 2^l subtiles, each
     // ceil(subtiles_x / 2^l) x ceil(subtiles_y / 2^l) cells, row-major, down to 1 x 1.
