@@ -137,6 +137,7 @@ inline bool gather_direct_ready(const TriangleInput& in, std::size_t first, std:
            reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0 && end - first >= std::size_t(TriangleBatch::kSize) &&
            3 * (first + std::size_t(TriangleBatch::kSize)) <= in.vertex_count;
 }
+
 FrontEndKernels selected_front_end_kernels();
 
 // Sets up triangles [begin, end) of the input in batches and hands every triangle of their
