@@ -214,8 +214,7 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriang
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         if (t.skip_hidden &&
-            hidden_behind_reference_layer(t.planes, i0 / kW, i1 / kW, ty0, ty1,
-                                          nearest_conservative_depth(prepared, i0, i1, std::max(j0, ty0 * kH), std::min(j1, ty1 * kH + kH - 1))))
+            hidden_behind_reference_layer(t.planes, i0 / kW, i1 / kW, ty0, ty1, chunk_nearest_depth(prepared, i0, i1, j0, j1, ty0, ty1)))
             continue;
         for (int ty = ty0; ty <= ty1; ++ty) {
             // The covered interval [first, last] of each of the subtile row's sample rows.

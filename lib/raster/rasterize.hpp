@@ -132,6 +132,13 @@ inline float nearest_conservative_depth(const PreparedTriangle& tri, int i0, int
 // SIMD kernels make the same test with vectors of subtiles (pure comparisons: the same answer).
 bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
 
+// nearest_conservative_depth of a triangle over its samples in subtile rows [ty0, ty1] (its
+// columns [i0, i1], its rows [j0, j1] within those): what the row loops test a chunk with.
+inline float chunk_nearest_depth(const PreparedTriangle& tri, int i0, int i1, int j0, int j1, int ty0, int ty1) {
+    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    return nearest_conservative_depth(tri, i0, i1, std::max(j0, ty0 * kH), std::min(j1, ty1 * kH + kH - 1));
+}
+
 // The row rule in float, for triangles whose three edges are silhouette edges (no shared
 // edge needs its bits matched by a neighbour) and near enough to the screen: 16 rows per
 // AVX-512 vector instead of 8 in double. Each edge k is taken relative to the whole sample

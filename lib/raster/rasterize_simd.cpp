@@ -428,8 +428,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         const int row0 = ty0 * kH, rows = (ty1 - ty0 + 1) * kH;
         if (t.skip_hidden &&
-            HiddenBehindReferenceLayer(t.planes, i0 / kW, i1 / kW, ty0, ty1,
-                                       nearest_conservative_depth(tri, i0, i1, std::max(triangle.j0, row0), std::min(j1, row0 + rows - 1))))
+            HiddenBehindReferenceLayer(t.planes, i0 / kW, i1 / kW, ty0, ty1, chunk_nearest_depth(tri, i0, i1, triangle.j0, j1, ty0, ty1)))
             continue;
         if (triangle.plane.float_rows) FloatRowIntervals(triangle, row0, rows, first, last);
         else DoubleRowIntervals(triangle, row0, rows, first, last);

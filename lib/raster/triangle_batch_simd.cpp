@@ -125,7 +125,6 @@ void GatherDirectBatch(const TriangleInput& in, std::size_t first, TriangleBatch
             store(hn::ConcatUpperUpper(d4, zw23, zw01), batch.pw[k] + t);
         }
 #endif
-    batch.count = kSize;
     batch.indices_valid = (1u << kSize) - 1u;
     for (int t = 0; t < kSize; ++t) batch.triangle[t] = first + std::size_t(t);
 }
