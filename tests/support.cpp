@@ -1,8 +1,10 @@
 #include "support.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <random>
 
 namespace homcull::test {
@@ -104,6 +106,32 @@ std::string shared_scene(const std::string& file) {
 
 void write_text(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;
+}
+
+void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data) {
+    std::vector<std::size_t> order(count);
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::shuffle(order.begin(), order.end(), *static_cast<std::mt19937_64*>(user));
+    for (std::size_t i : order) task(data, i);
+}
+
+bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
+    const auto x = a.subtiles();
+    const auto y = b.subtiles();
+    if (x.size() != y.size()) return false;
+    for (std::size_t i = 0; i < x.size(); ++i)
+        if (x[i].d0 != y[i].d0 || x[i].d1 != y[i].d1 || x[i].mask != y[i].mask || x[i].covered != y[i].covered) return false;
+    std::vector<float> depth_a, depth_b;
+    a.read_depth(depth_a);
+    b.read_depth(depth_b);
+    return depth_a == depth_b;
+}
+
+bool same_pyramid(const OcclusionBuffer& a, const OcclusionBuffer& b) {
+    std::vector<float> x, y;
+    a.read_pyramid(x);
+    b.read_pyramid(y);
+    return x == y;
 }
 
 }  // namespace homcull::test

@@ -25,6 +25,15 @@ BufferConfig buffer_config(int width, int height, int samples, float near_w, boo
 // An identity-matrix TriangleInput over clip-space xyzw triangles, no backface culling.
 TriangleInput clip_space_input(const std::vector<float>& xyzw);
 
+// A "job system" (ParallelFor::run, user = a std::mt19937_64) that runs the tasks in a
+// shuffled order on the calling thread.
+void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data);
+// The same subtiles, and the same read-back depth (which includes the per-sample depth when
+// the buffers keep one).
+bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b);
+// The same pyramids of the rectangle tests (built band by band with a job system).
+bool same_pyramid(const OcclusionBuffer& a, const OcclusionBuffer& b);
+
 // A fresh, empty folder for one test's files.
 std::string temp_dir(const std::string& test_name);
 // The shared scenes folder: $HOMCULL_SHARED_SCENES_DIR, else the one CMake was given.

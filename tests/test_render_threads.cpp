@@ -19,36 +19,6 @@
 namespace homcull {
 namespace {
 
-// A "job system" that runs the tasks in a shuffled order on the calling thread.
-void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data) {
-    std::vector<std::size_t> order(count);
-    std::iota(order.begin(), order.end(), std::size_t(0));
-    std::shuffle(order.begin(), order.end(), *static_cast<std::mt19937_64*>(user));
-    for (std::size_t i : order) task(data, i);
-}
-
-// The same subtiles, and the same read-back depth (which includes the per-sample depth when
-// the buffers keep one).
-bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
-    const auto x = a.subtiles();
-    const auto y = b.subtiles();
-    if (x.size() != y.size()) return false;
-    for (std::size_t i = 0; i < x.size(); ++i)
-        if (x[i].d0 != y[i].d0 || x[i].d1 != y[i].d1 || x[i].mask != y[i].mask || x[i].covered != y[i].covered) return false;
-    std::vector<float> depth_a, depth_b;
-    a.read_depth(depth_a);
-    b.read_depth(depth_b);
-    return depth_a == depth_b;
-}
-
-// The pyramids of the rectangle tests (built band by band with a job system).
-bool same_pyramid(const OcclusionBuffer& a, const OcclusionBuffer& b) {
-    std::vector<float> x, y;
-    a.read_pyramid(x);
-    b.read_pyramid(y);
-    return x == y;
-}
-
 // Renders the buffers again with every available instruction set and expects the scalar
 // reference's statistics and subtiles, buffer by buffer; leaves the best one selected.
 template <typename RenderAll>
@@ -60,7 +30,7 @@ void expect_every_isa_gives(const std::vector<OcclusionBuffer>& reference, Rende
         ASSERT_EQ(buffers.size(), reference.size());
         for (std::size_t k = 0; k < buffers.size(); ++k) {
             EXPECT_TRUE(reference[k].stats() == buffers[k].stats()) << isa << ", buffer " << k;
-            EXPECT_TRUE(same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
+            EXPECT_TRUE(test::same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
         }
     }
     select_isa("best");
@@ -81,11 +51,11 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     serial.render(in);
     threaded.render(in, tbb_parallel_for());
     std::mt19937_64 order_rng(9);
-    shuffled.render(in, ParallelFor{run_shuffled, &order_rng});
-    EXPECT_TRUE(same_subtiles(serial, threaded));
-    EXPECT_TRUE(same_subtiles(serial, shuffled));
-    EXPECT_TRUE(same_pyramid(serial, threaded));
-    EXPECT_TRUE(same_pyramid(serial, shuffled));
+    shuffled.render(in, ParallelFor{test::run_shuffled, &order_rng});
+    EXPECT_TRUE(test::same_subtiles(serial, threaded));
+    EXPECT_TRUE(test::same_subtiles(serial, shuffled));
+    EXPECT_TRUE(test::same_pyramid(serial, threaded));
+    EXPECT_TRUE(test::same_pyramid(serial, shuffled));
     EXPECT_EQ(serial.stats().subtiles_updated, threaded.stats().subtiles_updated);
     EXPECT_EQ(serial.stats().rasterized, shuffled.stats().rasterized);
     // A second frame into the same buffers reuses the scratch and still agrees.
@@ -93,7 +63,7 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     threaded.clear();
     serial.render(in);
     threaded.render(in, tbb_parallel_for());
-    EXPECT_TRUE(same_subtiles(serial, threaded));
+    EXPECT_TRUE(test::same_subtiles(serial, threaded));
 }
 
 // render_frame is clear() then render(): the same bits with and without a job system, over a
@@ -107,15 +77,15 @@ TEST(RenderThreads, RenderFrameIsClearThenRender) {
     config.near_w = 1.0f;
     config.sample_depth = true;
     std::mt19937_64 order_rng(5);
-    for (const ParallelFor& parallel : {ParallelFor{}, tbb_parallel_for(), ParallelFor{run_shuffled, &order_rng}}) {
+    for (const ParallelFor& parallel : {ParallelFor{}, tbb_parallel_for(), ParallelFor{test::run_shuffled, &order_rng}}) {
         OcclusionBuffer reference(config), framed(config);
         reference.render(test::clip_space_input(first));
         framed.render(test::clip_space_input(first), parallel);
         reference.clear();
         reference.render(test::clip_space_input(second));
         framed.render_frame(test::clip_space_input(second), parallel);
-        EXPECT_TRUE(same_subtiles(reference, framed));
-        EXPECT_TRUE(same_pyramid(reference, framed));
+        EXPECT_TRUE(test::same_subtiles(reference, framed));
+        EXPECT_TRUE(test::same_pyramid(reference, framed));
         EXPECT_EQ(reference.stats().rasterized, framed.stats().rasterized);
         EXPECT_EQ(reference.stats().triangles_in, framed.stats().triangles_in);
         EXPECT_EQ(reference.stats().subtiles_updated, framed.stats().subtiles_updated);
@@ -124,8 +94,8 @@ TEST(RenderThreads, RenderFrameIsClearThenRender) {
         none.triangle_count = 0;
         framed.render_frame(none, parallel);
         OcclusionBuffer empty(config);
-        EXPECT_TRUE(same_subtiles(empty, framed));
-        EXPECT_TRUE(same_pyramid(empty, framed));
+        EXPECT_TRUE(test::same_subtiles(empty, framed));
+        EXPECT_TRUE(test::same_pyramid(empty, framed));
         EXPECT_EQ(framed.stats().triangles_in, 0u);
     }
 }
@@ -143,8 +113,8 @@ TEST(RenderThreads, RenderFrameThrowsBeforeClearing) {
     TriangleInput bad = test::clip_space_input(xyzw);
     bad.position_components = 2;
     EXPECT_THROW(buffer.render_frame(bad, tbb_parallel_for()), Error);
-    EXPECT_TRUE(same_subtiles(reference, buffer));
-    EXPECT_TRUE(same_pyramid(reference, buffer));
+    EXPECT_TRUE(test::same_subtiles(reference, buffer));
+    EXPECT_TRUE(test::same_pyramid(reference, buffer));
 }
 
 TEST(RenderThreads, CityFromAboveSameBits) {
@@ -161,8 +131,8 @@ TEST(RenderThreads, CityFromAboveSameBits) {
     const auto clip = clip_from_world(c, 640.0 / 360.0);
     serial.render(occluders.input(clip));
     threaded.render(occluders.input(clip), tbb_parallel_for());
-    EXPECT_TRUE(same_subtiles(serial, threaded));
-    EXPECT_TRUE(same_pyramid(serial, threaded));
+    EXPECT_TRUE(test::same_subtiles(serial, threaded));
+    EXPECT_TRUE(test::same_pyramid(serial, threaded));
 }
 
 }  // namespace
@@ -255,7 +225,7 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
         std::vector<OcclusionBuffer> buffers;
         render_all(buffers);
         for (std::size_t k = 0; k < buffers.size(); ++k)
-            EXPECT_TRUE(same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
+            EXPECT_TRUE(test::same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
     }
     select_isa("best");
     EXPECT_THROW(select_isa("mmx"), Error);
@@ -342,7 +312,7 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
     EXPECT_GT(all.rasterized, 1000u);
     for (std::size_t k = 0; k < reference.size(); k += 2) {  // with and without the vertex cache
         EXPECT_TRUE(reference[k].stats() == reference[k + 1].stats()) << "buffer " << k;
-        EXPECT_TRUE(same_subtiles(reference[k], reference[k + 1])) << "buffer " << k;
+        EXPECT_TRUE(test::same_subtiles(reference[k], reference[k + 1])) << "buffer " << k;
     }
     expect_every_isa_gives(reference, render_all);
 }
@@ -397,7 +367,7 @@ TEST(Isa, TriangleSoupsGiveTheReferenceBits) {
     EXPECT_GT(stats.too_large, 0u);
     EXPECT_GT(stats.rasterized, 1000u);
     EXPECT_TRUE(reference[0].stats() == reference[1].stats());  // alignment changes nothing
-    EXPECT_TRUE(same_subtiles(reference[0], reference[1]));
+    EXPECT_TRUE(test::same_subtiles(reference[0], reference[1]));
     expect_every_isa_gives(reference, render_all);
 }
 
@@ -448,13 +418,13 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
     EXPECT_GT(reference.stats().outside + reference.stats().backface_culled, 10000u);
     const OcclusionBuffer without_cache = render(kVertices + kUnused, {});  // more vertices than triangles: no cache
     EXPECT_TRUE(reference.stats() == without_cache.stats());
-    EXPECT_TRUE(same_subtiles(reference, without_cache));
+    EXPECT_TRUE(test::same_subtiles(reference, without_cache));
     for (const std::string& isa : available_isas()) {
         select_isa(isa);
         for (const bool threads : {false, true}) {
             const OcclusionBuffer b = render(kVertices, threads ? tbb : ParallelFor{});
             EXPECT_TRUE(reference.stats() == b.stats()) << isa << (threads ? ", TBB" : ", serial");
-            EXPECT_TRUE(same_subtiles(reference, b)) << isa << (threads ? ", TBB" : ", serial");
+            EXPECT_TRUE(test::same_subtiles(reference, b)) << isa << (threads ? ", TBB" : ", serial");
         }
     }
     select_isa("best");

@@ -1,6 +1,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/render_bands.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 
@@ -13,18 +14,9 @@ namespace homcull {
 namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+using detail::kBandPyramidLevels;
+using detail::kBandSubtileRows;
 constexpr std::size_t kChunkTriangles = 2048;  // triangles set up per task
-// Subtile rows rasterized per task (128 sample rows): a triangle crossing into another band
-// is set up once but entered once per band (16 rows: S1 at 1080p, two threads, 13.5 ms and
-// castle C0 1.02 ms; 32 rows: 12.8 and 0.96 ms; 64 rows: 3 bands at 720p, castle 1.12 ms).
-constexpr int kBandSubtileRows = 32;
-// The pyramid levels a band builds from its own rows, right after rasterizing them: the cells
-// of level l span 2^l subtile rows, within one band while 2^l divides the band's rows. Built on
-// the calling thread instead, they had to read every band's d0 from the other core's cache
-// (castle C0, two threads: 0.15 ms of 1.0).
-constexpr int kBandPyramidLevels = 5;
-static_assert((1 << kBandPyramidLevels) == kBandSubtileRows, "a band's rows hold whole cells of its levels");
-
 // A band reads its bins' triangles in order, but they were written by whichever thread set up
 // their chunk, and a kernel call per triangle is too short for the hardware prefetcher to
 // follow: they are prefetched this many triangles ahead (S1 at 1080p, two threads: 14.0 ->
@@ -114,6 +106,10 @@ void OcclusionBuffer::build_pyramid_rows(int row_begin, int row_end, int last_le
         std::copy_n(d0_.begin() + std::ptrdiff_t(at(0, ty)), subtiles_x_, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_);
     for (int level = 1; level <= last_level; ++level)
         reduce_pyramid_rows(level, row_begin >> level, std::min(levels_[std::size_t(level)].height, (row_end + (1 << level) - 1) >> level));
+}
+
+void OcclusionBuffer::reduce_pyramid_above_bands() {
+    for (int level = kBandPyramidLevels + 1; level < int(levels_.size()); ++level) reduce_pyramid_rows(level, 0, levels_[std::size_t(level)].height);
 }
 
 void OcclusionBuffer::reduce_pyramid_rows(int level, int y_begin, int y_end) {
@@ -260,7 +256,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         b.band_updated_[band] = updated;
         b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
     }, &job);
-    for (int level = kBandPyramidLevels + 1; level < int(levels_.size()); ++level) reduce_pyramid_rows(level, 0, levels_[std::size_t(level)].height);
+    reduce_pyramid_above_bands();
 
     for (std::size_t c = 0; c < chunk_count; ++c) stats_ += chunks_[c].stats;
     for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;

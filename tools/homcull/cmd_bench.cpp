@@ -9,6 +9,7 @@
 #include <homcull/io/camera_path.hpp>
 #include <homcull/io/scene_io.hpp>
 #include <homcull/io/workload_s1.hpp>
+#include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/tbb_parallel_for.hpp>
 #include <homcull/world_triangles.hpp>
@@ -26,7 +27,7 @@ namespace {
 struct BenchOptions {
     std::string workload = "s1", resolution = "1920x1080", isa = "best";
     std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views = "data/views/castle.json";
-    int samples = 1, threads = 1, repeat = 0;
+    int samples = 1, threads = 1, repeat = 0, clusters = 0;
     bool json = false, sample_depth = false;
 };
 
@@ -109,16 +110,31 @@ void run_bench(const BenchOptions& o) {
         const CameraPath views = read_camera_path(o.views);
         const WorldTriangles occluders = gather_world_triangles(castle, objects_with_role(castle, "occluder"));
         const int repeat = o.repeat > 0 ? o.repeat : 21;
+        // --clusters N: the occluders split into clusters of at most N triangles first (timed
+        // apart: it is done once, when the scene is loaded), and rendered as such.
+        OccluderClusters clustered;
+        if (o.clusters > 0) {
+            const long long start = now_ns();
+            ClusterLimits limits;
+            limits.max_triangles = std::size_t(o.clusters);
+            limits.max_vertices = std::min<std::size_t>(255, std::size_t(o.clusters));
+            clustered = build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3,
+                                                occluders.indices.data(), occluders.triangle_count(), occluders.shared_edges.data(), limits);
+            out["cluster_build_ms"] = elapsed_ms(start);
+            out["clusters"] = clustered.clusters.size();
+        }
         nlohmann::json per_view = nlohmann::json::array();
         std::vector<double> medians;
         for (const Camera& view : views.frames) {
             config.near_w = float(view.near_plane);
             OcclusionBuffer buffer(config);
             const TriangleInput in = occluders.input(clip_from_world(view, res.aspect()), Backface::cw);
+            const ClusteredInput clustered_in{&clustered, in.model_to_clip, in.backface};
             std::vector<double> ms;
             for (int r = 0; r < repeat; ++r) {
                 const long long start = now_ns();
-                buffer.render_frame(in, parallel);
+                if (o.clusters > 0) buffer.render_frame(clustered_in, parallel);
+                else buffer.render_frame(in, parallel);
                 ms.push_back(elapsed_ms(start));
             }
             medians.push_back(median(ms));
@@ -160,6 +176,10 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--repeat", o->repeat, "Runs to take the median of (0 = 5 for s1, 21 for castle)");
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
     cmd->add_option("--scene", o->scene, "Castle scene for --workload castle")->capture_default_str();
+    cmd->add_option("--clusters", o->clusters,
+                    "castle: split the occluders into clusters of at most N triangles (a multiple of 4, <= 512) and render those "
+                    "(OccluderClusters); 0 = the triangles as one input")
+        ->capture_default_str();
     cmd->add_option("--views", o->views, "Camera path with the views for --workload castle")->capture_default_str();
     cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");
     cmd->add_flag("--json", o->json, "Print JSON on stdout");

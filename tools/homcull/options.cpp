@@ -86,7 +86,9 @@ nlohmann::json camera_json(const Camera& c) {
 nlohmann::json stats_json(const RasterStats& s) {
     return {{"triangles_in", s.triangles_in}, {"invalid", s.invalid},   {"outside", s.outside},
             {"near_clipped", s.near_clipped}, {"too_large", s.too_large}, {"backface_culled", s.backface_culled},
-            {"degenerate", s.degenerate},     {"rasterized", s.rasterized}, {"subtiles_updated", s.subtiles_updated}};
+            {"degenerate", s.degenerate},     {"rasterized", s.rasterized}, {"subtiles_updated", s.subtiles_updated},
+            {"clusters_outside", s.clusters_outside}, {"cluster_bands_hidden", s.cluster_bands_hidden},
+            {"cluster_bands_drawn", s.cluster_bands_drawn}};
 }
 
 Resolution parse_resolution(const std::string& text) {

@@ -24,6 +24,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace homcull {
@@ -83,17 +84,26 @@ struct RasterStats {
     // the subtiles they update keeps the figure the same with or without that skip, and
     // with any number of threads.
     std::uint64_t subtiles_updated = 0;
+    // Clustered input (ClusteredInput) only. Clusters whose box is outside the view or covers
+    // no sample centre; then, per band of subtile rows a cluster's box reaches, the clusters
+    // skipped there (their box behind the band's reference layer) and those drawn. The
+    // triangle counts above count a cluster's triangles once per band that draws it.
+    std::uint64_t clusters_outside = 0;
+    std::uint64_t cluster_bands_hidden = 0;
+    std::uint64_t cluster_bands_drawn = 0;
 
     RasterStats& operator+=(const RasterStats& o) {
         triangles_in += o.triangles_in, invalid += o.invalid, outside += o.outside, near_clipped += o.near_clipped;
         too_large += o.too_large, backface_culled += o.backface_culled, degenerate += o.degenerate, rasterized += o.rasterized;
         subtiles_updated += o.subtiles_updated;
+        clusters_outside += o.clusters_outside, cluster_bands_hidden += o.cluster_bands_hidden, cluster_bands_drawn += o.cluster_bands_drawn;
         return *this;
     }
     bool operator==(const RasterStats& o) const {
         return triangles_in == o.triangles_in && invalid == o.invalid && outside == o.outside && near_clipped == o.near_clipped &&
                too_large == o.too_large && backface_culled == o.backface_culled && degenerate == o.degenerate &&
-               rasterized == o.rasterized && subtiles_updated == o.subtiles_updated;
+               rasterized == o.rasterized && subtiles_updated == o.subtiles_updated && clusters_outside == o.clusters_outside &&
+               cluster_bands_hidden == o.cluster_bands_hidden && cluster_bands_drawn == o.cluster_bands_drawn;
     }
 };
 
@@ -132,6 +142,16 @@ struct TriangleInput {
 // missing or the stride is below one position (12 bytes).
 void compute_shared_edges(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                           const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
+
+struct OccluderClusters;
+// An occluder mesh split into clusters at load time (occluder_clusters.hpp), under a
+// model-to-clip matrix (column-major), for OcclusionBuffer::render. Its positions have 3
+// components; its shared-edge flags are the mesh's.
+struct ClusteredInput {
+    const OccluderClusters* clusters = nullptr;
+    std::array<float, 16> model_to_clip{};
+    Backface backface = Backface::cw;
+};
 
 // The caller's job system, for render(): run(user, count, task, task_data) must call
 // task(task_data, i) once for every i in [0, count), in any order, on any threads, and return
@@ -178,6 +198,22 @@ public:
     // threads: about 10 % faster than clear() and render()). Throws, as render() does, before
     // anything is cleared.
     void render_frame(const TriangleInput& input, const ParallelFor& parallel = {});
+    // Rasterizes a clustered mesh, deciding clusters by their boxes before any of their
+    // triangles is set up: clusters outside the view are dropped; the others are taken nearest
+    // first (by their boxes' nearest w, then their number), and each band of subtile rows
+    // (128 sample rows, whatever the threads) skips a cluster whose box lies behind the band's
+    // reference layer over every subtile the box covers there (test_rect's rule, on the
+    // layer as it is when the cluster's turn comes). A skipped cluster only leaves out
+    // occlusion, so the buffer stays conservative; but a triangle of it could have entered a
+    // subtile (its conservative depth is a bound, evaluated where the box is not), so the bits
+    // are those of this order and these skips, not of render(TriangleInput) over the same
+    // triangles. They are the same on every instruction set and with any threads: with a job
+    // system the bands run in parallel, each setting up the clusters it draws (a cluster
+    // reaching two bands is set up twice; no bins, nothing copied). Scratch for the clusters'
+    // order and each band's transformed vertices is reused and only grows. Throws
+    // homcull::Error when input.clusters is null.
+    void render(const ClusteredInput& input, const ParallelFor& parallel = {});
+    void render_frame(const ClusteredInput& input, const ParallelFor& parallel = {});
 
     // Occludee tests. Thread-safe with each other (no render in flight).
     // Screen rectangle in NDC (y up) with the nearest clip w of the occludee. Occluded when
@@ -297,12 +333,23 @@ private:
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
     bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
 
+    // Clustered input (clustered_render.cpp).
+    void render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first);
+    struct PlacedCluster;
+    // After the bands: the pyramid levels above those each band built (kBandPyramidLevels).
+    void reduce_pyramid_above_bands();
+
     // Render scratch, reused across frames (grown, never shrunk).
     struct Chunk;
     std::vector<Chunk> chunks_;
     std::vector<std::uint64_t> band_updated_;
     std::vector<double> vertex_clip_;           // four planes of vertex_count + padding
     std::vector<std::uint8_t> vertex_outcode_;
+    std::vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
+    std::vector<RasterStats> band_stats_;
+    std::vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
+    std::vector<double> band_vertex_clip_;         // per band: four planes of a cluster's vertices + padding
+    std::vector<std::uint8_t> band_vertex_outcode_;
 
 public:
     ~OcclusionBuffer();

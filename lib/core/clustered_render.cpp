@@ -1,0 +1,179 @@
+// OcclusionBuffer::render(ClusteredInput): clusters decided by their boxes, nearest first,
+// band by band (see occlusion_buffer.hpp and occluder_clusters.hpp).
+#include <homcull/error.hpp>
+#include <homcull/occluder_clusters.hpp>
+#include <homcull/occlusion_buffer.hpp>
+
+#include "core/rect_tests.hpp"
+#include "core/render_bands.hpp"
+#include "raster/rasterize.hpp"
+#include "raster/triangle_batch.hpp"
+
+#include <algorithm>
+
+namespace homcull {
+namespace {
+
+constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+using detail::kBandPyramidLevels;
+using detail::kBandSubtileRows;
+
+// A cluster as the triangle pipeline takes it: its own vertices, its local 16-bit indices.
+TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderCluster& c, const ClusteredInput& in) {
+    TriangleInput t;
+    t.positions = clusters.positions.data() + 3 * std::size_t(c.first_vertex);
+    t.position_components = 3;
+    t.position_stride = 3 * sizeof(float);
+    t.vertex_count = c.vertex_count;
+    t.indices = clusters.indices.data() + 3 * std::size_t(c.first_triangle);
+    t.indices_16bit = true;
+    t.triangle_count = c.triangle_count;
+    t.model_to_clip = in.model_to_clip;
+    t.backface = in.backface;
+    t.shared_edges = clusters.shared_edges.data() + c.first_triangle;
+    return t;
+}
+
+}  // namespace
+
+void OcclusionBuffer::render(const ClusteredInput& input, const ParallelFor& parallel) { render_clusters(input, parallel, false); }
+
+void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFor& parallel) { render_clusters(input, parallel, true); }
+
+void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
+    if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
+    const OccluderClusters& clusters = *in.clusters;
+    if (clear_first) stats_ = RasterStats{};
+
+    // The clusters must lie within their arrays, and the scratch below holds the largest.
+    for (const OccluderCluster& c : clusters.clusters)
+        if (std::size_t(c.first_vertex) + c.vertex_count > clusters.positions.size() / 3 ||
+            std::size_t(c.first_triangle) + c.triangle_count > clusters.shared_edges.size() ||
+            3 * (std::size_t(c.first_triangle) + c.triangle_count) > clusters.indices.size() || c.vertex_count > clusters.max_cluster_vertices)
+            throw Error("render: a cluster reaches past the OccluderClusters' positions, indices or flags, or past max_cluster_vertices");
+
+    // The clusters in view, with their boxes' samples and nearest depth (the rectangle tests'
+    // preparation, so that "hidden" means what test_aabb means by it), nearest first.
+    placed_clusters_.clear();
+    RasterStats frame;
+    for (std::size_t k = 0; k < clusters.clusters.size(); ++k) {
+        const OccluderCluster& c = clusters.clusters[k];
+        if (c.triangle_count == 0) continue;
+        PlacedCluster p{0.0f, std::uint32_t(k), 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};
+        ScreenRect rect;
+        Visibility decided = Visibility::visible;
+        detail::RectQuery q;
+        if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, in.model_to_clip, config_.near_w, rect, decided) &&
+            prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided)) {
+            p = {rect.w_min, std::uint32_t(k), q.i0, q.i1, q.j0, q.j1, q.d_near, true};
+        } else if (decided != Visibility::visible) {  // outside the view, or between sample centres
+            ++frame.clusters_outside;
+            continue;
+        }
+        placed_clusters_.push_back(p);
+    }
+    std::sort(placed_clusters_.begin(), placed_clusters_.end(), [](const PlacedCluster& a, const PlacedCluster& b) {
+        return a.nearest_w < b.nearest_w || (a.nearest_w == b.nearest_w && a.cluster < b.cluster);
+    });
+
+    // Scratch for one cluster's transformed vertices (triangle_batch.hpp's cache), one per band.
+    const std::size_t bands = band_updated_.size();
+    const std::size_t plane = std::size_t(clusters.max_cluster_vertices) + detail::kVertexClipPadding;
+    if (band_vertex_clip_.size() < bands * 4 * plane) band_vertex_clip_.resize(bands * 4 * plane);
+    if (band_vertex_outcode_.size() < bands * plane) band_vertex_outcode_.resize(bands * plane);
+    band_stats_.assign(bands, RasterStats{});
+    const auto cache_of = [&](std::size_t band) {
+        double* clip = band_vertex_clip_.data() + band * 4 * plane;
+        return detail::VertexClip{clip, clip + plane, clip + 2 * plane, clip + 3 * plane, band_vertex_outcode_.data() + band * plane};
+    };
+    const auto band_rows = [&](std::size_t band, int& row_begin, int& row_end) {
+        row_begin = int(band) * kBandSubtileRows;
+        row_end = std::min(row_begin + kBandSubtileRows, subtiles_y_);
+    };
+    // Whether a band draws a cluster (its box reaches the band and is not hidden there),
+    // counting the answer in the band's statistics.
+    const auto band_draws = [&](const PlacedCluster& p, std::size_t band, const detail::SubtilePlanes& planes) {
+        int row_begin, row_end;
+        band_rows(band, row_begin, row_end);
+        const int ty0 = std::max(p.j0 / kH, row_begin), ty1 = std::min(p.j1 / kH, row_end - 1);
+        if (ty0 > ty1) return false;
+        if (p.testable && detail::hidden_behind_reference_layer(planes, p.i0 / kW, p.i1 / kW, ty0, ty1, p.d_near)) {
+            ++band_stats_[band].cluster_bands_hidden;
+            return false;
+        }
+        ++band_stats_[band].cluster_bands_drawn;
+        return true;
+    };
+    const detail::FrontEndKernels kernels = detail::selected_front_end_kernels();
+    const auto set_up = [&](const PlacedCluster& p, const detail::VertexClip& cache, RasterStats& stats, auto&& emit) {
+        const TriangleInput t = cluster_input(clusters, clusters.clusters[p.cluster], in);
+        kernels.transform_vertices(t, double(config_.near_w), 0, t.vertex_count, cache);
+        detail::setup_triangle_range(t, &cache, 0, t.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
+                                     stats, emit);
+    };
+
+    if (parallel.run) {
+        // Each band walks the clusters in order and sets up those it draws: the bands need no
+        // bins, and each decides on its own rows as the serial loop below does.
+        struct Job {
+            decltype(band_rows)* rows;
+            decltype(band_draws)* draws;
+            decltype(set_up)* set_up_cluster;
+            decltype(cache_of)* band_cache;
+            OcclusionBuffer* self;
+            bool clear_first;
+        } job{&band_rows, &band_draws, &set_up, &cache_of, this, clear_first};
+        parallel.run(parallel.user, bands, [](void* data, std::size_t band) {
+            const Job& j = *static_cast<Job*>(data);
+            OcclusionBuffer& b = *j.self;
+            int row_begin, row_end;
+            (*j.rows)(band, row_begin, row_end);
+            if (j.clear_first) b.clear_rows(row_begin, row_end);
+            const detail::RasterTarget target = b.raster_target(row_begin, row_end);
+            const detail::VertexClip cache = (*j.band_cache)(band);
+            RasterStats& stats = b.band_stats_[band];
+            for (const PlacedCluster& p : b.placed_clusters_)
+                if ((*j.draws)(p, band, target.planes))
+                    (*j.set_up_cluster)(p, cache, stats, [&](const detail::RasterTriangle& tri) { stats.subtiles_updated += target.kernel(target, tri); });
+            b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
+        }, &job);
+        reduce_pyramid_above_bands();
+    } else {
+        // One thread: each cluster is set up once and rasterized in the runs of bands that draw
+        // it. The statistics are the bands': its triangles' counts once per band drawing it.
+        if (clear_first) clear_rows(0, subtiles_y_);
+        const detail::RasterTarget whole = raster_target(0, subtiles_y_);
+        const detail::VertexClip cache = cache_of(0);
+        std::vector<std::pair<int, int>>& runs = cluster_row_runs_;  // subtile rows [first, second)
+        RasterStats serial;
+        for (const PlacedCluster& p : placed_clusters_) {
+            runs.clear();
+            std::uint64_t drawn = 0;
+            for (std::size_t band = std::size_t(p.j0 / kH / kBandSubtileRows); band <= std::size_t(p.j1 / kH / kBandSubtileRows); ++band) {
+                if (!band_draws(p, band, whole.planes)) continue;
+                ++drawn;
+                int row_begin, row_end;
+                band_rows(band, row_begin, row_end);
+                if (!runs.empty() && runs.back().second == row_begin) runs.back().second = row_end;
+                else runs.emplace_back(row_begin, row_end);
+            }
+            if (runs.empty()) continue;
+            RasterStats stats;
+            set_up(p, cache, stats, [&](const detail::RasterTriangle& tri) {
+                detail::RasterTarget target = whole;
+                for (const auto& [row_begin, row_end] : runs) {
+                    target.row_begin = row_begin, target.row_end = row_end;
+                    serial.subtiles_updated += target.kernel(target, tri);
+                }
+            });
+            for (std::uint64_t k = 0; k < drawn; ++k) serial += stats;
+        }
+        band_stats_[0] += serial;
+        build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+    }
+
+    stats_ += frame;
+    for (const RasterStats& s : band_stats_) stats_ += s;
+}
+
+}  // namespace homcull

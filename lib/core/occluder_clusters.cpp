@@ -1,0 +1,135 @@
+#include <homcull/error.hpp>
+#include <homcull/occluder_clusters.hpp>
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <unordered_map>
+
+namespace homcull {
+namespace {
+
+// A triangle's three vertex numbers, to find which input triangle a meshlet triangle is:
+// meshopt_buildMeshlets keeps each triangle's vertices in order but not its number.
+struct TriangleKey {
+    std::uint32_t v[3];
+    bool operator==(const TriangleKey& o) const { return v[0] == o.v[0] && v[1] == o.v[1] && v[2] == o.v[2]; }
+};
+struct TriangleKeyHash {
+    std::size_t operator()(const TriangleKey& k) const {
+        return std::size_t(k.v[0]) * 0x9E3779B97F4A7C15ull ^ std::size_t(k.v[1]) * 0xC2B2AE3D27D4EB4Full ^ std::size_t(k.v[2]);
+    }
+};
+
+}  // namespace
+
+OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
+                                         const std::uint32_t* indices, std::size_t triangle_count, const std::uint8_t* shared_edges,
+                                         const ClusterLimits& limits) {
+    const auto fail = [](const std::string& why) { throw Error("build_occluder_clusters: " + why); };
+    if (limits.max_vertices < 3 || limits.max_vertices > 255) fail("max_vertices must be in [3, 255]");
+    if (limits.max_triangles < 4 || limits.max_triangles > 512 || limits.max_triangles % 4 != 0)
+        fail("max_triangles must be a multiple of 4 in [4, 512]");
+    OccluderClusters out;
+    if (triangle_count == 0) return out;
+    if (!positions || !indices) fail("positions or indices missing");
+    if (position_stride < 3 * sizeof(float)) fail("position stride smaller than one position (12 bytes)");
+    for (std::size_t i = 0; i < 3 * triangle_count; ++i)
+        if (indices[i] >= vertex_count)
+            fail("index " + std::to_string(indices[i]) + " of triangle " + std::to_string(i / 3) + " is not below vertex_count " +
+                 std::to_string(vertex_count));
+
+    // meshopt_buildMeshlets reads packed x, y, z (it takes a stride, but this keeps the
+    // positions it sees and the ones copied below the same by construction).
+    std::vector<float> packed(3 * vertex_count);
+    for (std::size_t v = 0; v < vertex_count; ++v)
+        std::memcpy(&packed[3 * v], reinterpret_cast<const unsigned char*>(positions) + v * position_stride, 3 * sizeof(float));
+
+    // meshoptimizer sorts positions spatially: it sees non-finite ones as the origin (the
+    // clusters keep them as they are, and their boxes say so).
+    std::vector<float> finite(packed);
+    for (float& x : finite)
+        if (!std::isfinite(x)) x = 0.0f;
+
+    const std::size_t index_count = 3 * triangle_count;
+    std::vector<meshopt_Meshlet> meshlets(meshopt_buildMeshletsBound(index_count, limits.max_vertices, limits.max_triangles));
+    std::vector<unsigned int> meshlet_vertices(meshlets.size() * limits.max_vertices);
+    std::vector<unsigned char> meshlet_triangles(meshlets.size() * limits.max_triangles * 3);
+    // cone_weight 0: clusters as compact in space as it can make them (their boxes are what the
+    // render tests), not grouped by facing.
+    meshlets.resize(meshopt_buildMeshlets(meshlets.data(), meshlet_vertices.data(), meshlet_triangles.data(), indices, index_count,
+                                          finite.data(), vertex_count, 3 * sizeof(float), limits.max_vertices, limits.max_triangles, 0.0f));
+
+    // The input triangles by their vertices, several per key when a mesh repeats a triangle.
+    std::unordered_map<TriangleKey, std::vector<std::uint32_t>, TriangleKeyHash> triangle_of;
+    triangle_of.reserve(triangle_count);
+    for (std::size_t t = triangle_count; t-- > 0;)  // reversed: each list hands out its first triangle first
+        triangle_of[{{indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]}}].push_back(std::uint32_t(t));
+
+    out.indices.reserve(index_count);
+    out.shared_edges.reserve(triangle_count);
+    out.clusters.reserve(meshlets.size());
+    std::vector<bool> placed(triangle_count, false);
+    // Appends a cluster of the given input vertices and triangles (vertex numbers local to it).
+    const auto append = [&](const std::vector<std::uint32_t>& vertices, const std::vector<std::uint8_t>& local,
+                            const std::vector<std::uint32_t>& originals) {
+        OccluderCluster c;
+        c.first_vertex = std::uint32_t(out.positions.size() / 3);
+        c.vertex_count = std::uint32_t(vertices.size());
+        c.first_triangle = std::uint32_t(out.shared_edges.size());
+        c.triangle_count = std::uint32_t(originals.size());
+        c.bounded = true;
+        for (const std::uint32_t v : vertices) {
+            const float* p = &packed[3 * std::size_t(v)];
+            out.positions.insert(out.positions.end(), p, p + 3);
+            c.bounded = c.bounded && std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+            c.bounds.extend(glm::vec3(p[0], p[1], p[2]));
+        }
+        out.indices.insert(out.indices.end(), local.begin(), local.end());
+        for (const std::uint32_t t : originals) {
+            out.shared_edges.push_back(shared_edges ? shared_edges[t] : 0);
+            placed[t] = true;
+        }
+        out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
+        out.clusters.push_back(c);
+    };
+    std::vector<std::uint32_t> vertices, originals;
+    std::vector<std::uint8_t> local;
+    for (const meshopt_Meshlet& m : meshlets) {
+        vertices.assign(meshlet_vertices.begin() + m.vertex_offset, meshlet_vertices.begin() + m.vertex_offset + m.vertex_count);
+        local.assign(meshlet_triangles.begin() + m.triangle_offset, meshlet_triangles.begin() + m.triangle_offset + 3 * m.triangle_count);
+        originals.clear();
+        for (unsigned t = 0; t < m.triangle_count; ++t) {
+            const TriangleKey key{{vertices[local[3 * t]], vertices[local[3 * t + 1]], vertices[local[3 * t + 2]]}};
+            std::vector<std::uint32_t>& same = triangle_of.at(key);
+            originals.push_back(same.back());
+            same.pop_back();
+        }
+        append(vertices, local, originals);
+    }
+    // Triangles meshoptimizer left out (it skips those with a repeated vertex), in clusters of
+    // consecutive ones: every triangle is drawn, and the pipeline counts them as it would.
+    vertices.clear(), local.clear(), originals.clear();
+    for (std::size_t t = 0; t <= triangle_count; ++t) {
+        const bool end = t == triangle_count;
+        if (!end && placed[t]) continue;
+        if (end || originals.size() == limits.max_triangles || vertices.size() + 3 > limits.max_vertices) {
+            if (!originals.empty()) append(vertices, local, originals);
+            vertices.clear(), local.clear(), originals.clear();
+            if (end) break;
+        }
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = indices[3 * t + std::size_t(k)];
+            const auto at = std::find(vertices.begin(), vertices.end(), v);
+            local.push_back(std::uint8_t(at - vertices.begin()));
+            if (at == vertices.end()) vertices.push_back(v);
+        }
+        originals.push_back(std::uint32_t(t));
+    }
+    return out;
+}
+
+}  // namespace homcull

@@ -1,0 +1,305 @@
+// Occluder clusters: the build keeps every triangle, and the clustered render skips what it
+// should, gives the same bits on every instruction set and with any threads, and never claims
+// an occluder nearer than Embree finds one.
+#include "support.hpp"
+
+#include <homcull/camera.hpp>
+#include <homcull/error.hpp>
+#include <homcull/io/camera_path.hpp>
+#include <homcull/io/scene_io.hpp>
+#include <homcull/occluder_clusters.hpp>
+#include <homcull/occlusion_buffer.hpp>
+#include <homcull/tbb_parallel_for.hpp>
+#include <homcull/truth/ray_scene.hpp>
+#include <homcull/world_triangles.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <tuple>
+
+namespace homcull {
+namespace {
+
+OccluderClusters cluster_world(const WorldTriangles& w, const ClusterLimits& limits = {}) {
+    return build_occluder_clusters(w.positions.data(), 3 * sizeof(float), w.positions.size() / 3, w.indices.data(), w.triangle_count(),
+                                   w.shared_edges.data(), limits);
+}
+
+// Appends a cluster made by hand: the given vertices and triangles (local indices, with their
+// shared-edge flags).
+void append_cluster(OccluderClusters& clusters, const std::vector<glm::vec3>& vertices, const std::vector<std::uint16_t>& indices,
+                    const std::vector<std::uint8_t>& flags) {
+    OccluderCluster c;
+    c.first_vertex = std::uint32_t(clusters.positions.size() / 3);
+    c.vertex_count = std::uint32_t(vertices.size());
+    c.first_triangle = std::uint32_t(clusters.shared_edges.size());
+    c.triangle_count = std::uint32_t(flags.size());
+    c.bounded = true;
+    for (const glm::vec3& v : vertices) {
+        clusters.positions.insert(clusters.positions.end(), {v.x, v.y, v.z});
+        c.bounds.extend(v);
+    }
+    clusters.indices.insert(clusters.indices.end(), indices.begin(), indices.end());
+    clusters.shared_edges.insert(clusters.shared_edges.end(), flags.begin(), flags.end());
+    clusters.max_cluster_vertices = std::max(clusters.max_cluster_vertices, c.vertex_count);
+    clusters.clusters.push_back(c);
+}
+
+// A quad a, b, c, d (counter-clockwise from the side it faces) as a cluster of two triangles
+// sharing the diagonal a-c.
+void append_quad(OccluderClusters& clusters, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+    append_cluster(clusters, {a, b, c, d}, {0, 1, 2, 0, 2, 3}, {0b100, 0b001});
+}
+
+// A triangle as its three positions and flags, to compare meshes whatever their order.
+using TriangleRecord = std::array<float, 10>;
+TriangleRecord record(const float* p0, const float* p1, const float* p2, std::uint8_t flags) {
+    return {p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], p2[0], p2[1], p2[2], float(flags)};
+}
+
+TEST(OccluderClusters, KeepEveryTriangleWithItsVerticesAndFlags) {
+    Scene scene;
+    for (int k = 0; k < 40; ++k)
+        test::add_box(scene, "box", glm::vec3(float(k % 8) * 3.0f, 0.0f, float(k / 8) * -3.0f),
+                      glm::vec3(float(k % 8) * 3.0f + 2.0f, 1.0f + float(k % 3), float(k / 8) * -3.0f + 2.0f));
+    scene.finalize();
+    const WorldTriangles world = gather_world_triangles(scene, objects_with_role(scene, ""));
+    ASSERT_EQ(world.triangle_count(), 480u);
+    for (const std::size_t max_triangles : {std::size_t(4), std::size_t(64), std::size_t(512)}) {
+        ClusterLimits limits;
+        limits.max_triangles = max_triangles;
+        limits.max_vertices = std::min<std::size_t>(255, max_triangles);
+        const OccluderClusters clusters = cluster_world(world, limits);
+        std::vector<TriangleRecord> before, after;
+        for (std::size_t t = 0; t < world.triangle_count(); ++t) {
+            const std::uint32_t* v = &world.indices[3 * t];
+            before.push_back(record(&world.positions[3 * v[0]], &world.positions[3 * v[1]], &world.positions[3 * v[2]], world.shared_edges[t]));
+        }
+        std::uint32_t largest = 0;
+        for (const OccluderCluster& c : clusters.clusters) {
+            EXPECT_LE(c.triangle_count, max_triangles);
+            EXPECT_LE(c.vertex_count, limits.max_vertices);
+            EXPECT_TRUE(c.bounded);
+            largest = std::max(largest, c.vertex_count);
+            for (std::uint32_t t = c.first_triangle; t < c.first_triangle + c.triangle_count; ++t) {
+                const float* p[3];
+                for (int k = 0; k < 3; ++k) {
+                    const std::uint16_t local = clusters.indices[3 * t + std::size_t(k)];
+                    ASSERT_LT(local, c.vertex_count);
+                    p[k] = &clusters.positions[3 * (std::size_t(c.first_vertex) + local)];
+                    for (int axis = 0; axis < 3; ++axis) {  // inside the cluster's box
+                        EXPECT_GE(p[k][axis], c.bounds.min[axis]);
+                        EXPECT_LE(p[k][axis], c.bounds.max[axis]);
+                    }
+                }
+                after.push_back(record(p[0], p[1], p[2], clusters.shared_edges[t]));
+            }
+        }
+        EXPECT_EQ(largest, clusters.max_cluster_vertices);
+        std::sort(before.begin(), before.end());
+        std::sort(after.begin(), after.end());
+        EXPECT_EQ(before, after) << "clusters of at most " << max_triangles << " triangles";
+        if (max_triangles == 4) {
+            EXPECT_GE(clusters.clusters.size(), 120u);
+        }
+    }
+}
+
+TEST(OccluderClusters, BadInputIsAnErrorOrADefinedResult) {
+    const std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    const std::vector<std::uint32_t> indices = {0, 1, 2, 2, 1, 3};
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 3, indices.data(), 2, nullptr), Error);  // index 3 of 3 vertices
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 8, 4, indices.data(), 2, nullptr), Error);
+    EXPECT_THROW(build_occluder_clusters(nullptr, 12, 4, indices.data(), 2, nullptr), Error);
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, {64, 6}), Error);    // not a multiple of 4
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, {300, 64}), Error);  // over 255 vertices
+    EXPECT_TRUE(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 0, nullptr).clusters.empty());
+    // A triangle with a repeated vertex (which meshoptimizer leaves out) is kept, and counted
+    // degenerate when drawn.
+    const std::vector<std::uint32_t> with_repeat = {0, 1, 2, 1, 1, 3, 2, 1, 3};
+    const OccluderClusters kept = build_occluder_clusters(positions.data(), 12, 4, with_repeat.data(), 3, nullptr);
+    EXPECT_EQ(kept.triangle_count(), 3u);
+
+    // A vertex that is not a number: its cluster has no box, is always drawn, and the
+    // triangle pipeline counts its triangle invalid.
+    std::vector<float> bad = positions;
+    bad[4] = std::numeric_limits<float>::quiet_NaN();
+    const OccluderClusters clusters = build_occluder_clusters(bad.data(), 12, 4, indices.data(), 2, nullptr);
+    ASSERT_EQ(clusters.clusters.size(), 1u);
+    EXPECT_FALSE(clusters.clusters[0].bounded);
+    OcclusionBuffer buffer(test::buffer_config(64, 48, 1, 0.1f));
+    Camera camera = test::camera_down_minus_z();
+    camera.eye = {0.5, 0.5, 2};
+    buffer.render_frame(ClusteredInput{&clusters, clip_from_world(camera, 64.0 / 48.0), Backface::none});
+    EXPECT_EQ(buffer.stats().invalid, 2u);  // both triangles use vertex 1
+    EXPECT_EQ(buffer.stats().cluster_bands_drawn, 1u);
+
+    // Clusters that do not fit their arrays are refused before anything is read.
+    OccluderClusters broken = clusters;
+    broken.clusters[0].vertex_count = 9;
+    EXPECT_THROW(buffer.render(ClusteredInput{&broken, clip_from_world(camera, 64.0 / 48.0), Backface::none}), Error);
+    broken = clusters;
+    broken.clusters[0].triangle_count = 3;
+    EXPECT_THROW(buffer.render(ClusteredInput{&broken, clip_from_world(camera, 64.0 / 48.0), Backface::none}), Error);
+    EXPECT_THROW(buffer.render(ClusteredInput{}), Error);
+    buffer.render_frame(ClusteredInput{&kept, clip_from_world(camera, 64.0 / 48.0), Backface::none});
+    EXPECT_EQ(buffer.stats().triangles_in, 3u);
+    EXPECT_EQ(buffer.stats().degenerate, 1u);
+}
+
+// Two clusters made by hand, the far one first: a wall filling the view at z = -5 and a small
+// quad behind it at z = -50. Drawn nearest first, the far one is hidden in every band it
+// reaches and skipped there: the buffer is the wall's alone.
+TEST(ClusteredRender, SkipsAClusterHiddenBehindANearerOne) {
+    OccluderClusters clusters;
+    append_quad(clusters, {-3, -3, -50}, {3, -3, -50}, {3, 3, -50}, {-3, 3, -50});      // far, small on screen
+    append_quad(clusters, {-20, -20, -5}, {20, -20, -5}, {20, 20, -5}, {-20, 20, -5});  // near, covers the view
+    const Camera camera = test::camera_down_minus_z(90.0, 0.5);
+    const std::array<float, 16> m = clip_from_world(camera, 300.0 / 260.0);
+    OcclusionBuffer both(test::buffer_config(300, 260, 1, 0.5f)), wall_only(test::buffer_config(300, 260, 1, 0.5f));
+    both.render_frame(ClusteredInput{&clusters, m, Backface::cw});
+    OccluderClusters wall = clusters;
+    wall.clusters.erase(wall.clusters.begin());
+    wall_only.render_frame(ClusteredInput{&wall, m, Backface::cw});
+    EXPECT_TRUE(test::same_subtiles(both, wall_only));
+    EXPECT_TRUE(test::same_pyramid(both, wall_only));
+    // 260 rows: 65 subtile rows, 3 bands; the far quad's rows (122 to 138) reach the first two.
+    EXPECT_EQ(both.stats().cluster_bands_drawn, 3u);
+    EXPECT_EQ(both.stats().cluster_bands_hidden, 2u);
+    EXPECT_EQ(both.stats().triangles_in, 6u);  // the wall's two triangles, in each of 3 bands
+
+    // With the wall drawn last (the far quad nearer than it), both are drawn.
+    for (float& p : clusters.positions)
+        if (p == -50.0f) p = -4.0f;
+    clusters.clusters[0].bounds.min.z = clusters.clusters[0].bounds.max.z = -4.0f;
+    both.render_frame(ClusteredInput{&clusters, m, Backface::cw});
+    EXPECT_EQ(both.stats().cluster_bands_hidden, 0u);
+    EXPECT_EQ(both.stats().cluster_bands_drawn, 5u);
+}
+
+// A cluster whose box crosses the near plane is drawn in every band, untested; one wholly
+// behind the eye or beside the view is counted outside and never set up.
+TEST(ClusteredRender, ClustersAcrossTheNearPlaneAreDrawnAndThoseOutsideAreNot) {
+    OccluderClusters clusters;
+    append_quad(clusters, {-50, -1, 20}, {50, -1, 20}, {50, -1, -100}, {-50, -1, -100});  // the floor, under the eye, facing up
+    append_quad(clusters, {-1, -1, 10}, {1, -1, 10}, {1, 1, 10}, {-1, 1, 10});           // behind the eye
+    append_quad(clusters, {100, -1, -10}, {102, -1, -10}, {102, 1, -10}, {100, 1, -10});  // beside the view
+    OcclusionBuffer buffer(test::buffer_config(320, 200, 1, 0.1f));
+    buffer.render_frame(ClusteredInput{&clusters, clip_from_world(test::camera_down_minus_z(60.0), 1.6), Backface::none});
+    EXPECT_GT(buffer.stats().near_clipped, 0u);
+    EXPECT_EQ(buffer.stats().cluster_bands_drawn, 2u);  // the floor's cluster, in both bands
+    EXPECT_EQ(buffer.stats().clusters_outside, 2u);
+    EXPECT_EQ(buffer.stats().triangles_in, 4u);  // the floor's two, in each band
+    std::vector<std::uint8_t> covered;
+    buffer.read_coverage(covered);
+    EXPECT_EQ(covered.back(), 1u);  // the floor reaches the bottom row
+}
+
+struct CastleOccluders {
+    Scene scene;
+    WorldTriangles world;
+    CameraPath views;
+};
+const CastleOccluders* castle() {
+    static const CastleOccluders* loaded = [] {
+        const std::string path = test::shared_scene("intel_castle.glb");
+        if (path.empty()) return static_cast<CastleOccluders*>(nullptr);
+        auto* c = new CastleOccluders;
+        c->scene = load_scene(path);
+        c->world = gather_world_triangles(c->scene, objects_with_role(c->scene, "occluder"));
+        c->views = read_camera_path(std::string(HOMCULL_SOURCE_DIR) + "/data/views/castle.json");
+        return c;
+    }();
+    return loaded;
+}
+
+// The castle's occluders in clusters, from two of its views, with and without per-sample
+// depth: every instruction set and every job system gives the scalar reference's bits,
+// statistics and pyramid.
+TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
+    const CastleOccluders* c = castle();
+    if (!c) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const OccluderClusters clusters = cluster_world(c->world);
+    std::mt19937_64 order_rng(5);
+    const ParallelFor tbb = tbb_parallel_for(), shuffled{test::run_shuffled, &order_rng};
+    for (const std::size_t view : {std::size_t(0), c->views.frames.size() - 1}) {
+        const Camera& camera = c->views.frames[view];
+        const ClusteredInput in{&clusters, clip_from_world(camera, 1280.0 / 720.0), Backface::cw};
+        for (const bool sample_depth : {false, true}) {
+            const BufferConfig config = test::buffer_config(sample_depth ? 320 : 1280, sample_depth ? 180 : 720, sample_depth ? 4 : 1,
+                                                            float(camera.near_plane), sample_depth);
+            select_isa("scalar");
+            OcclusionBuffer reference(config);
+            reference.render_frame(in);
+            EXPECT_GT(reference.stats().cluster_bands_hidden, 10u);
+            EXPECT_GT(reference.stats().clusters_outside, 50u);
+            for (const std::string& isa : available_isas())
+                for (const ParallelFor& parallel : {ParallelFor{}, tbb, shuffled}) {
+                    select_isa(isa);
+                    OcclusionBuffer buffer(config);
+                    buffer.render(in, parallel);  // into an empty buffer: what render_frame gives
+                    const std::string what = isa + (parallel.run ? (parallel.user ? ", shuffled" : ", TBB") : ", serial") +
+                                             ", view " + std::to_string(view) + (sample_depth ? ", sample depth" : "");
+                    EXPECT_TRUE(reference.stats() == buffer.stats()) << what;
+                    EXPECT_TRUE(test::same_subtiles(reference, buffer)) << what;
+                    EXPECT_TRUE(test::same_pyramid(reference, buffer)) << what;
+                }
+            select_isa("best");
+        }
+    }
+}
+
+// Wherever the clustered buffer claims an occluder, a ray through the sample's centre hits
+// something at or before the buffer's depth (as FloatRowRule's test of the triangle path):
+// castle views and fzk_haus, a full-size buffer and a 4 x 4-sample one.
+TEST(ClusteredRender, ClaimedSamplesAreBehindEmbreeHits) {
+    struct Case {
+        std::string scene, role;
+        std::vector<Camera> cameras;
+    };
+    std::vector<Case> cases;
+    if (const CastleOccluders* c = castle()) cases.push_back({"intel_castle.glb", "occluder", {c->views.frames[0], c->views.frames[2]}});
+    Camera house;
+    house.eye = {-12, 3, 10};
+    house.target = {6, 2, -5};
+    cases.push_back({"fzk_haus.glb", "", {house}});
+    long claimed = 0;
+    for (const Case& k : cases) {
+        const std::string path = test::shared_scene(k.scene);
+        if (path.empty()) GTEST_SKIP() << k.scene << " is missing from " << test::shared_scenes_dir();
+        const Scene scene = load_scene(path);
+        const RayScene rays(scene);
+        const OccluderClusters clusters = cluster_world(gather_world_triangles(scene, objects_with_role(scene, k.role)));
+        for (const Camera& camera : k.cameras) {
+            const CameraBasis basis = camera_basis(camera);
+            for (const auto& [width, height, samples] : {std::tuple{640, 360, 1}, {160, 90, 4}}) {
+                OcclusionBuffer buffer(test::buffer_config(width, height, samples, float(camera.near_plane)));
+                const double aspect = double(width) / double(height);
+                buffer.render_frame(ClusteredInput{&clusters, clip_from_world(camera, aspect), Backface::cw});
+                EXPECT_GT(buffer.stats().cluster_bands_drawn, 0u);
+                std::vector<float> bound_w;
+                buffer.read_depth(bound_w);
+                const int sw = buffer.sample_width(), sh = buffer.sample_height();
+                for (int j = 0; j < sh; ++j)
+                    for (int i = 0; i < sw; ++i) {
+                        const float w = bound_w[std::size_t(j) * std::size_t(sw) + std::size_t(i)];
+                        if (!std::isfinite(w)) continue;
+                        ++claimed;
+                        const glm::vec3 direction(ray_direction(camera, basis, aspect, pixel_to_ndc({sw, sh}, i + 0.5, j + 0.5)));
+                        const RayHit hit = rays.intersect(glm::vec3(camera.eye), direction, float(camera.near_plane), float(camera.far_plane));
+                        ASSERT_TRUE(hit.hit()) << k.scene << ": sample " << i << "," << j << " claimed with nothing behind it";
+                        ASSERT_LE(double(hit.t), double(w) * (1.0 + 1e-5)) << k.scene << ": sample " << i << "," << j << " claimed nearer";
+                    }
+            }
+        }
+    }
+    EXPECT_GT(claimed, 100000);
+}
+
+}  // namespace
+}  // namespace homcull
