@@ -10,6 +10,7 @@
 #include "raster/triangle_batch.hpp"
 
 #include <algorithm>
+#include <thread>
 
 namespace homcull {
 namespace {
@@ -113,8 +114,19 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     };
 
     if (parallel.run) {
-        // Each band walks the clusters in order and sets up those it draws: the bands need no
-        // bins, and each decides on its own rows as the serial loop below does.
+        // Each band walks the clusters in order and decides on its own rows, as the serial loop
+        // below does. A cluster is set up by the first band that draws it and its triangles
+        // kept for the others (which wait for them: a band setting one up depends on no other
+        // task, so the wait is short and cannot deadlock): no bins, and no cluster set up twice.
+        const std::size_t placed = placed_clusters_.size();
+        if (cluster_setup_capacity_ < placed) {
+            cluster_setups_ = std::make_unique<ClusterSetup[]>(placed);
+            cluster_setup_capacity_ = placed;
+        }
+        for (std::size_t k = 0; k < placed; ++k) {
+            cluster_setups_[k].state.store(ClusterSetup::kNotSetUp, std::memory_order_relaxed);
+            cluster_setups_[k].drawn_bands.store(0, std::memory_order_relaxed);
+        }
         struct Job {
             decltype(band_rows)* rows;
             decltype(band_draws)* draws;
@@ -131,13 +143,30 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
             if (j.clear_first) b.clear_rows(row_begin, row_end);
             const detail::RasterTarget target = b.raster_target(row_begin, row_end);
             const detail::VertexClip cache = (*j.band_cache)(band);
-            RasterStats& stats = b.band_stats_[band];
-            for (const PlacedCluster& p : b.placed_clusters_)
-                if ((*j.draws)(p, band, target.planes))
-                    (*j.set_up_cluster)(p, cache, stats, [&](const detail::RasterTriangle& tri) { stats.subtiles_updated += target.kernel(target, tri); });
+            std::uint64_t updated = 0;
+            for (std::size_t k = 0; k < b.placed_clusters_.size(); ++k) {
+                if (!(*j.draws)(b.placed_clusters_[k], band, target.planes)) continue;
+                ClusterSetup& s = b.cluster_setups_[k];
+                s.drawn_bands.fetch_add(1, std::memory_order_relaxed);
+                int expected = ClusterSetup::kNotSetUp;
+                if (s.state.compare_exchange_strong(expected, ClusterSetup::kSettingUp, std::memory_order_acquire)) {
+                    s.triangles.clear();
+                    s.stats = RasterStats{};
+                    (*j.set_up_cluster)(b.placed_clusters_[k], cache, s.stats,
+                                        [&](const detail::RasterTriangle& tri) { s.triangles.push_back(tri); });
+                    s.state.store(ClusterSetup::kReady, std::memory_order_release);
+                } else {
+                    while (s.state.load(std::memory_order_acquire) != ClusterSetup::kReady) std::this_thread::yield();
+                }
+                for (const detail::RasterTriangle& tri : s.triangles) updated += target.kernel(target, tri);
+            }
+            b.band_stats_[band].subtiles_updated += updated;
             b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
         }, &job);
         reduce_pyramid_above_bands();
+        // Each setup's counts once per band that drew the cluster, as on one thread.
+        for (std::size_t k = 0; k < placed; ++k)
+            for (std::uint32_t n = cluster_setups_[k].drawn_bands.load(std::memory_order_relaxed); n > 0; --n) frame += cluster_setups_[k].stats;
     } else {
         // One thread: each cluster is set up once and rasterized in the runs of bands that draw
         // it. The statistics are the bands': its triangles' counts once per band drawing it.

@@ -3,7 +3,11 @@
 // clustered_render.cpp), and the clustered render's per-frame record of a cluster.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "raster/rasterize.hpp"
+
+#include <atomic>
 #include <cstdint>
+#include <vector>
 
 namespace homcull {
 namespace detail {
@@ -31,6 +35,16 @@ struct OcclusionBuffer::PlacedCluster {
     int i0, i1, j0, j1;
     float d_near;
     bool testable;
+};
+
+// With a job system, a cluster in view is set up once, by the first band that draws it, and
+// its triangles kept here for the other bands that draw it (each waits until they are ready).
+struct OcclusionBuffer::ClusterSetup {
+    std::vector<detail::RasterTriangle> triangles;
+    RasterStats stats;                           // the setup's counts
+    std::atomic<int> state{0};                   // kNotSetUp, kSettingUp, kReady
+    std::atomic<std::uint32_t> drawn_bands{0};  // bands that drew it
+    static constexpr int kNotSetUp = 0, kSettingUp = 1, kReady = 2;
 };
 
 }  // namespace homcull

@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -336,6 +337,7 @@ private:
     // Clustered input (clustered_render.cpp).
     void render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first);
     struct PlacedCluster;
+    struct ClusterSetup;
     // After the bands: the pyramid levels above those each band built (kBandPyramidLevels).
     void reduce_pyramid_above_bands();
 
@@ -348,6 +350,8 @@ private:
     std::vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
     std::vector<RasterStats> band_stats_;
     std::vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
+    std::unique_ptr<ClusterSetup[]> cluster_setups_;      // job system: one per cluster in view
+    std::size_t cluster_setup_capacity_ = 0;
     std::vector<double> band_vertex_clip_;         // per band: four planes of a cluster's vertices + padding
     std::vector<std::uint8_t> band_vertex_outcode_;
 
