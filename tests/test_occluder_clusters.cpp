@@ -119,8 +119,7 @@ TEST(OccluderClusters, BadInputIsAnErrorOrADefinedResult) {
     EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, {64, 6}), Error);    // not a multiple of 4
     EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, {300, 64}), Error);  // over 255 vertices
     EXPECT_TRUE(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 0, nullptr).clusters.empty());
-    // A triangle with a repeated vertex (which meshoptimizer leaves out) is kept, and counted
-    // degenerate when drawn.
+    // A triangle with a repeated vertex is kept, and counted degenerate when drawn.
     const std::vector<std::uint32_t> with_repeat = {0, 1, 2, 1, 1, 3, 2, 1, 3};
     const OccluderClusters kept = build_occluder_clusters(positions.data(), 12, 4, with_repeat.data(), 3, nullptr);
     EXPECT_EQ(kept.triangle_count(), 3u);

@@ -72,8 +72,8 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
     out.indices.reserve(index_count);
     out.shared_edges.reserve(triangle_count);
     out.clusters.reserve(meshlets.size());
-    std::vector<bool> placed(triangle_count, false);
-    // Appends a cluster of the given input vertices and triangles (vertex numbers local to it).
+    // Appends a cluster of the given input vertices and triangles (vertex numbers local to it;
+    // `originals` the input triangles, for their flags).
     const auto append = [&](const std::vector<std::uint32_t>& vertices, const std::vector<std::uint8_t>& local,
                             const std::vector<std::uint32_t>& originals) {
         OccluderCluster c;
@@ -89,10 +89,7 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
             c.bounds.extend(glm::vec3(p[0], p[1], p[2]));
         }
         out.indices.insert(out.indices.end(), local.begin(), local.end());
-        for (const std::uint32_t t : originals) {
-            out.shared_edges.push_back(shared_edges ? shared_edges[t] : 0);
-            placed[t] = true;
-        }
+        for (const std::uint32_t t : originals) out.shared_edges.push_back(shared_edges ? shared_edges[t] : 0);
         out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
         out.clusters.push_back(c);
     };
@@ -104,31 +101,15 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         originals.clear();
         for (unsigned t = 0; t < m.triangle_count; ++t) {
             const TriangleKey key{{vertices[local[3 * t]], vertices[local[3 * t + 1]], vertices[local[3 * t + 2]]}};
-            std::vector<std::uint32_t>& same = triangle_of.at(key);
-            originals.push_back(same.back());
-            same.pop_back();
+            const auto same = triangle_of.find(key);
+            if (same == triangle_of.end() || same->second.empty()) fail("meshoptimizer changed a triangle (internal error)");
+            originals.push_back(same->second.back());
+            same->second.pop_back();
         }
         append(vertices, local, originals);
     }
-    // Triangles meshoptimizer left out (it skips those with a repeated vertex), in clusters of
-    // consecutive ones: every triangle is drawn, and the pipeline counts them as it would.
-    vertices.clear(), local.clear(), originals.clear();
-    for (std::size_t t = 0; t <= triangle_count; ++t) {
-        const bool end = t == triangle_count;
-        if (!end && placed[t]) continue;
-        if (end || originals.size() == limits.max_triangles || vertices.size() + 3 > limits.max_vertices) {
-            if (!originals.empty()) append(vertices, local, originals);
-            vertices.clear(), local.clear(), originals.clear();
-            if (end) break;
-        }
-        for (int k = 0; k < 3; ++k) {
-            const std::uint32_t v = indices[3 * t + std::size_t(k)];
-            const auto at = std::find(vertices.begin(), vertices.end(), v);
-            local.push_back(std::uint8_t(at - vertices.begin()));
-            if (at == vertices.end()) vertices.push_back(v);
-        }
-        originals.push_back(std::uint32_t(t));
-    }
+    if (out.shared_edges.size() != triangle_count)
+        fail("meshoptimizer left out " + std::to_string(triangle_count - out.shared_edges.size()) + " triangles (internal error)");
     return out;
 }
 
