@@ -133,6 +133,7 @@ struct StrategyCase {
     OccluderBudget budget;
     bool hierarchy;
     bool lod = false;
+    bool clusters = false;  // SceneCullerConfig::occluder_clusters
 };
 const StrategyCase kStrategies[] = {
     {"one-pass", CullStrategy::one_pass, {}, true},
@@ -146,6 +147,9 @@ const StrategyCase kStrategies[] = {
     {"one-pass, LOD", CullStrategy::one_pass, {}, true, true},
     {"progressive, LOD", CullStrategy::progressive, {}, true, true},
     {"temporal, distance budget, LOD", CullStrategy::temporal, {OccluderRanking::distance, 3000}, true, true},
+    {"one-pass, clusters", CullStrategy::one_pass, {}, true, false, true},
+    {"progressive, clusters", CullStrategy::progressive, {}, true, false, true},
+    {"temporal, distance budget, LOD, clusters", CullStrategy::temporal, {OccluderRanking::distance, 3000}, true, true, true},
 };
 constexpr std::size_t kOnePassLod = 8;
 
@@ -172,6 +176,7 @@ std::vector<WalkTotals> walk_every_strategy(const Scene& scene, const std::vecto
         config.occluder_budget = s.budget;
         config.hierarchy = s.hierarchy;
         config.lods = s.lod ? &lods : nullptr;
+        config.occluder_clusters = s.clusters;
         cullers.emplace_back(scene, candidates, config);
     }
     std::vector<WalkTotals> totals(cullers.size());

@@ -10,6 +10,7 @@
 #include "raster/triangle_batch.hpp"
 
 #include <algorithm>
+#include <string>
 #include <thread>
 
 namespace homcull {
@@ -31,7 +32,7 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
     t.triangle_count = c.triangle_count;
     t.model_to_clip = in.model_to_clip;
     t.backface = in.backface;
-    t.shared_edges = clusters.shared_edges.data() + c.first_triangle;
+    t.shared_edges = (in.shared_edges ? in.shared_edges : clusters.shared_edges.data()) + c.first_triangle;
     return t;
 }
 
@@ -44,7 +45,6 @@ void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFo
 void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
     const OccluderClusters& clusters = *in.clusters;
-    if (clear_first) stats_ = RasterStats{};
 
     // The clusters must lie within their arrays, and the scratch below holds the largest.
     for (const OccluderCluster& c : clusters.clusters)
@@ -57,7 +57,12 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     // preparation, so that "hidden" means what test_aabb means by it), nearest first.
     placed_clusters_.clear();
     RasterStats frame;
-    for (std::size_t k = 0; k < clusters.clusters.size(); ++k) {
+    const std::size_t count = in.cluster_ids ? in.cluster_count : clusters.clusters.size();
+    for (std::size_t n = 0; n < count; ++n) {
+        const std::size_t k = in.cluster_ids ? in.cluster_ids[n] : n;
+        if (k >= clusters.clusters.size())
+            throw Error("render: cluster number " + std::to_string(k) + " is not below the cluster count " +
+                        std::to_string(clusters.clusters.size()));
         const OccluderCluster& c = clusters.clusters[k];
         if (c.triangle_count == 0) continue;
         PlacedCluster p{0.0f, std::uint32_t(k), 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};
@@ -73,6 +78,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
         }
         placed_clusters_.push_back(p);
     }
+    if (clear_first) stats_ = RasterStats{};  // after every check: a render that throws changes nothing
     std::sort(placed_clusters_.begin(), placed_clusters_.end(), [](const PlacedCluster& a, const PlacedCluster& b) {
         return a.nearest_w < b.nearest_w || (a.nearest_w == b.nearest_w && a.cluster < b.cluster);
     });

@@ -71,6 +71,7 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
 
     out.indices.reserve(index_count);
     out.shared_edges.reserve(triangle_count);
+    out.source_triangles.reserve(triangle_count);
     out.clusters.reserve(meshlets.size());
     // Appends a cluster of the given input vertices and triangles (vertex numbers local to it;
     // `originals` the input triangles, for their flags).
@@ -90,6 +91,7 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         }
         out.indices.insert(out.indices.end(), local.begin(), local.end());
         for (const std::uint32_t t : originals) out.shared_edges.push_back(shared_edges ? shared_edges[t] : 0);
+        out.source_triangles.insert(out.source_triangles.end(), originals.begin(), originals.end());
         out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
         out.clusters.push_back(c);
     };

@@ -84,6 +84,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
                              occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first);
     }
     gather_lods();
+    build_clusters();
     drawn_.assign(occluders.size(), 0);
     frame_occluders_.reserve(occluders.size());
     frame_indices_.reserve(occluders_.indices.size());
@@ -118,6 +119,11 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
     frame_indices_.clear();
     frame_shared_.clear();
     frame_rendered_ = 0;  // the buffer is cleared by the frame's first render (render_frame), or by build_maps
+    frame_clusters_.clear();
+    frame_clusters_rendered_ = 0;
+    frame_cluster_triangles_waiting_ = 0;
+    frame_clusters_own_flags_ = false;
+    frame_started_ = false;
 
     // one_pass (and temporal's first frame): the candidates in the frustum. temporal: those not
     // found occluded last frame. progressive draws as it traverses.
@@ -196,6 +202,35 @@ void SceneCuller::gather_lods() {
     }
 }
 
+// config_.occluder_clusters: each candidate's triangles split into clusters of their own (so
+// that a frame draws the clusters of the candidates it picks), one after the other in clusters_.
+void SceneCuller::build_clusters() {
+    if (!config_.occluder_clusters) return;
+    cluster_first_.assign(1, 0);
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+        const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
+        const OccluderClusters part =
+            build_occluder_clusters(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
+                                    occluders_.indices.data() + 3 * first, count, occluders_.shared_edges.data() + first);
+        const auto vertex_base = std::uint32_t(clusters_.positions.size() / 3), triangle_base = std::uint32_t(clusters_.shared_edges.size());
+        for (OccluderCluster c : part.clusters) {
+            c.first_vertex += vertex_base;
+            c.first_triangle += triangle_base;
+            clusters_.clusters.push_back(c);
+        }
+        clusters_.positions.insert(clusters_.positions.end(), part.positions.begin(), part.positions.end());
+        clusters_.indices.insert(clusters_.indices.end(), part.indices.begin(), part.indices.end());
+        clusters_.shared_edges.insert(clusters_.shared_edges.end(), part.shared_edges.begin(), part.shared_edges.end());
+        for (const std::uint32_t t : part.source_triangles) {
+            clusters_.source_triangles.push_back(std::uint32_t(first) + t);
+            own_cluster_shared_edges_.push_back(own_shared_edges_[first + t]);
+        }
+        clusters_.max_cluster_vertices = std::max(clusters_.max_cluster_vertices, part.max_cluster_vertices);
+        cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
+    }
+    frame_clusters_.reserve(clusters_.clusters.size());
+}
+
 bool SceneCuller::draws_lod(std::uint32_t id, const Camera& camera) const {
     const std::uint32_t k = candidate_of_[id];
     return lod_first_[k] < lod_first_[k + 1] && lod_usable(scene_->objects[id].world_bounds, camera);
@@ -209,11 +244,19 @@ void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, const 
     const std::uint32_t first = lod ? lod_first_[k] : first_triangle_[k], last = lod ? lod_first_[k + 1] : first_triangle_[k + 1];
     frame_occluders_.push_back(id);
     drawn_[k] = 1;
-    frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::size_t(first), indices.begin() + 3 * std::size_t(last));
-    frame_shared_.insert(frame_shared_.end(), flags.begin() + first, flags.begin() + last);
     ++work_.occluder_objects;
     work_.occluder_triangles += last - first;
     work_.occluder_lods += lod;
+    if (config_.occluder_clusters && !lod) {
+        for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) frame_clusters_.push_back(c);
+        frame_cluster_triangles_waiting_ += last - first;
+        // Flags across objects only when every waiting cluster may have them (else each object's own).
+        const bool own = &shared_edges == &own_shared_edges_;
+        frame_clusters_own_flags_ = frame_clusters_own_flags_ || own;
+        return;
+    }
+    frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::size_t(first), indices.begin() + 3 * std::size_t(last));
+    frame_shared_.insert(frame_shared_.end(), flags.begin() + first, flags.begin() + last);
 }
 
 // temporal's second pass. Last frame's answers leave out the candidates that were hidden; one
@@ -255,18 +298,34 @@ void SceneCuller::draw_newly_visible(const Frame& frame, std::vector<OccludeeAns
     timings_.test_ms += ms_since(start);
 }
 
-// The triangles of frame_indices_ not rendered yet.
+// The clusters of frame_clusters_ and the triangles of frame_indices_ not rendered yet; the
+// frame's first render clears the buffer (render_frame clears each band where it rasterizes).
 void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel) {
-    const std::size_t count = frame_shared_.size() - frame_rendered_;
-    if (count == 0) return;
+    const std::size_t clusters = frame_clusters_.size() - frame_clusters_rendered_, count = frame_shared_.size() - frame_rendered_;
+    if (clusters == 0 && count == 0) return;
     const auto start = Clock::now();
-    TriangleInput in = occluders_.input(frame.clip, config_.backface);
-    in.indices = frame_indices_.data() + 3 * frame_rendered_;
-    in.triangle_count = count;
-    in.shared_edges = frame_shared_.data() + frame_rendered_;
-    if (frame_rendered_ == 0) buffer_.render_frame(in, parallel);  // clears each band where it is rasterized
-    else buffer_.render(in, parallel);
-    frame_rendered_ += count;
+    if (clusters > 0) {
+        ClusteredInput in{&clusters_, frame.clip, config_.backface};
+        in.cluster_ids = frame_clusters_.data() + frame_clusters_rendered_;
+        in.cluster_count = clusters;
+        if (frame_clusters_own_flags_) in.shared_edges = own_cluster_shared_edges_.data();
+        if (!frame_started_) buffer_.render_frame(in, parallel);
+        else buffer_.render(in, parallel);
+        frame_started_ = true;
+        frame_clusters_rendered_ += clusters;
+        frame_cluster_triangles_waiting_ = 0;
+        frame_clusters_own_flags_ = false;
+    }
+    if (count > 0) {
+        TriangleInput in = occluders_.input(frame.clip, config_.backface);
+        in.indices = frame_indices_.data() + 3 * frame_rendered_;
+        in.triangle_count = count;
+        in.shared_edges = frame_shared_.data() + frame_rendered_;
+        if (!frame_started_) buffer_.render_frame(in, parallel);
+        else buffer_.render(in, parallel);
+        frame_started_ = true;
+        frame_rendered_ += count;
+    }
     ++work_.renders;
     timings_.render_ms += ms_since(start);
 }
@@ -275,7 +334,7 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
 // occluders' boxes.
 void SceneCuller::build_maps(const Frame& frame) {
     const auto start = Clock::now();
-    if (frame_rendered_ == 0) buffer_.clear();  // nothing drawn yet this frame: it still holds the last one
+    if (!frame_started_) buffer_.clear();  // nothing drawn yet this frame: it still holds the last one
     maps_.clear();
     if (config_.maps.depth == DepthTest::deb)
         for (std::uint32_t id : frame_occluders_) maps_.add_occluder_box(scene_->objects[id].world_bounds, frame.clip);

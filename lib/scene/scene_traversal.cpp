@@ -52,7 +52,7 @@ void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answ
         const ObjectHierarchy::Node& node = hierarchy_.nodes[node_heap_.back().second];
         const float node_key = node_heap_.back().first;
         node_heap_.pop_back();
-        const std::size_t waiting = frame_shared_.size() - frame_rendered_;
+        const std::size_t waiting = triangles_waiting();
         if (progressive && (waiting >= batch || (waiting >= early_batch && node_key > waiting_nearest_far))) {
             render_pending(frame, parallel);
             build_maps(frame);

@@ -38,6 +38,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "on: with samples occludees, keep the occluders' depth per sample (precise at silhouettes); off: the "
                    "subtile layers alone (faster render)")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
+    app.add_option("--clusters", o.clusters,
+                   "on: split each occluder into clusters when the scene is loaded, and draw the frame's clusters nearest first, "
+                   "skipping those outside the view or hidden (faster render); off: every drawn triangle is set up")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--occluders", o.occluders, "Occluder candidates: role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
     app.add_option("--complexity", o.complexity,
@@ -83,6 +87,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.occludees = o.occludees == "box" ? OccludeeShape::box : o.occludees == "rects" ? OccludeeShape::rectangles
                 : o.occludees == "samples" ? OccludeeShape::samples : OccludeeShape::automatic;
     c.sample_depth = o.sample_depth == "on";
+    c.occluder_clusters = o.clusters == "on";
     c.strategy = o.strategy == "progressive" ? CullStrategy::progressive : o.strategy == "temporal" ? CullStrategy::temporal
                                                                                                  : CullStrategy::one_pass;
     c.occluder_budget.ranking = o.rank == "distance" ? OccluderRanking::distance : o.rank == "area" ? OccluderRanking::area

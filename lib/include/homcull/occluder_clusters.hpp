@@ -29,6 +29,7 @@ struct OccluderClusters {
     std::vector<float> positions;            // x, y, z per vertex; each cluster's vertices together
     std::vector<std::uint16_t> indices;      // 3 per triangle, relative to its cluster's first vertex
     std::vector<std::uint8_t> shared_edges;  // one per triangle, as TriangleInput::shared_edges
+    std::vector<std::uint32_t> source_triangles;  // one per triangle: its number in the input mesh
     std::vector<OccluderCluster> clusters;
     std::uint32_t max_cluster_vertices = 0;  // the largest vertex_count
 

@@ -152,6 +152,13 @@ struct ClusteredInput {
     const OccluderClusters* clusters = nullptr;
     std::array<float, 16> model_to_clip{};
     Backface backface = Backface::cw;
+    // Optional: only these clusters (numbers into clusters->clusters, cluster_count of them);
+    // null: all of them.
+    const std::uint32_t* cluster_ids = nullptr;
+    std::size_t cluster_count = 0;
+    // Optional: shared-edge flags to use instead of clusters->shared_edges, one per clustered
+    // triangle in the same order (for example flags computed within each object only).
+    const std::uint8_t* shared_edges = nullptr;
 };
 
 // The caller's job system, for render(): run(user, count, task, task_data) must call

@@ -6,6 +6,7 @@
 // candidate occluders' triangles are set up once, and a frame allocates nothing once its
 // scratch has grown (the first frames).
 #include <homcull/object_hierarchy.hpp>
+#include <homcull/occluder_clusters.hpp>
 #include <homcull/occluder_lod.hpp>
 #include <homcull/occluder_selection.hpp>
 #include <homcull/occlusion_maps.hpp>
@@ -74,6 +75,11 @@ struct SceneCullerConfig {
     // for this scene's candidates): an occluder is drawn with its LOD whenever lod_usable()
     // allows it, which keeps every answer conservative (see occluder_lod.hpp). Null: never.
     const OccluderLods* lods = nullptr;
+    // Draw the occluders as clusters (occluder_clusters.hpp), built per candidate when the
+    // culler is made: each frame the drawn candidates' clusters go nearest first, and those
+    // outside the view or hidden are skipped before their triangles are set up. Occluders
+    // drawn with their LOD still go triangle by triangle. Off: every drawn triangle is set up.
+    bool occluder_clusters = false;
 };
 
 // The shape `automatic` stands for with this configuration.
@@ -146,6 +152,12 @@ private:
     // with shared-edge flags within the LOD; an empty range when it has none.
     std::vector<std::uint32_t> lod_first_, lod_indices_;
     std::vector<std::uint8_t> lod_shared_edges_;
+    // config_.occluder_clusters: candidate k's clusters are [cluster_first_[k], cluster_first_[k + 1])
+    // of clusters_, whose flags are occluders_.shared_edges'; own_cluster_shared_edges_ the
+    // own_shared_edges_ of the same triangles.
+    OccluderClusters clusters_;
+    std::vector<std::uint32_t> cluster_first_;
+    std::vector<std::uint8_t> own_cluster_shared_edges_;
     ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
@@ -158,6 +170,11 @@ private:
     std::vector<std::uint32_t> frame_indices_;    // their triangles' indices into occluders_
     std::vector<std::uint8_t> frame_shared_;      // and their own_shared_edges_
     std::size_t frame_rendered_ = 0;              // triangles of frame_indices_ already rendered
+    std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
+    std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
+    std::size_t frame_cluster_triangles_waiting_ = 0;
+    bool frame_clusters_own_flags_ = false;       // the waiting clusters need own_cluster_shared_edges_
+    bool frame_started_ = false;                  // something was rendered this frame (the buffer is cleared)
     std::vector<std::uint32_t> temporal_pool_;    // temporal: the candidates not occluded last frame
     std::vector<std::uint32_t> ranked_;           // rank_occluders' choice
     std::vector<std::pair<float, std::uint32_t>> rank_scratch_, node_heap_;
@@ -172,6 +189,9 @@ private:
     void append_occluder(std::uint32_t id, const Camera& camera, const std::vector<std::uint8_t>& shared_edges);
     bool draws_lod(std::uint32_t id, const Camera& camera) const;
     void gather_lods();
+    void build_clusters();
+    // Triangles appended and not rendered yet (progressive draws every batch of them).
+    std::size_t triangles_waiting() const { return frame_shared_.size() - frame_rendered_ + frame_cluster_triangles_waiting_; }
     void render_pending(const Frame& frame, const ParallelFor& parallel);
     void build_maps(const Frame& frame);
     void draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
