@@ -181,6 +181,55 @@ TEST(ClusteredRender, SkipsAClusterHiddenBehindANearerOne) {
     EXPECT_EQ(both.stats().cluster_bands_drawn, 5u);
 }
 
+// ClusteredInput's subset and flags: drawing clusters {2, 0} of three is drawing a mesh of those
+// two alone, and other flags are used instead of the clusters' own.
+TEST(ClusteredRender, ASubsetAndOtherFlagsAreThatMesh) {
+    OccluderClusters three, two;
+    const auto quads = [](OccluderClusters& c, std::initializer_list<int> which) {
+        for (const int k : which) {
+            const float z = -6.0f - 3.0f * float(k), x = float(k) - 1.5f;
+            append_quad(c, {x - 1, -1, z}, {x + 1, -1, z}, {x + 1, 1, z}, {x - 1, 1, z});
+        }
+    };
+    quads(three, {0, 1, 2});
+    quads(two, {2, 0});
+    const std::array<float, 16> m = clip_from_world(test::camera_down_minus_z(70.0, 0.5), 200.0 / 150.0);
+    const std::uint32_t ids[] = {2, 0};
+    OcclusionBuffer subset(test::buffer_config(200, 150, 2, 0.5f)), alone(test::buffer_config(200, 150, 2, 0.5f));
+    ClusteredInput in{&three, m, Backface::cw};
+    in.cluster_ids = ids;
+    in.cluster_count = 2;
+    subset.render_frame(in);
+    alone.render_frame(ClusteredInput{&two, m, Backface::cw});
+    EXPECT_TRUE(test::same_subtiles(subset, alone));
+    EXPECT_TRUE(subset.stats() == alone.stats());
+
+    // Other flags: a quad in clip space (identity matrix, w = 1) whose diagonal runs through
+    // sample centres. Shared, the diagonal needs no margin and its samples are covered; with
+    // the flags replaced by none, it keeps the margin and they are not.
+    OccluderClusters square;
+    append_quad(square, {-1, -1, 0.5f}, {1, -1, 0.5f}, {1, 1, 0.5f}, {-1, 1, 0.5f});
+    std::array<float, 16> identity{};
+    for (int k = 0; k < 4; ++k) identity[std::size_t(5 * k)] = 1.0f;
+    const std::vector<std::uint8_t> none(square.shared_edges.size(), 0);
+    OcclusionBuffer shared(test::buffer_config(8, 8, 1, 0.5f)), margin(test::buffer_config(8, 8, 1, 0.5f));
+    shared.render_frame(ClusteredInput{&square, identity, Backface::none});
+    ClusteredInput without{&square, identity, Backface::none};
+    without.shared_edges = none.data();
+    margin.render_frame(without);
+    std::vector<std::uint8_t> covered_shared, covered_margin;
+    shared.read_coverage(covered_shared);
+    margin.read_coverage(covered_margin);
+    EXPECT_EQ(std::count(covered_shared.begin(), covered_shared.end(), 1), 64);
+    EXPECT_EQ(std::count(covered_margin.begin(), covered_margin.end(), 1), 64 - 8);  // the diagonal's 8 samples
+
+    const std::uint32_t bad[] = {3};
+    in = ClusteredInput{&three, m, Backface::cw};
+    in.cluster_ids = bad;
+    in.cluster_count = 1;
+    EXPECT_THROW(subset.render(in), Error);
+}
+
 // A cluster whose box crosses the near plane is drawn in every band, untested; one wholly
 // behind the eye or beside the view is counted outside and never set up.
 TEST(ClusteredRender, ClustersAcrossTheNearPlaneAreDrawnAndThoseOutsideAreNot) {
