@@ -8,6 +8,7 @@
 #include <homcull/io/scene_io.hpp>
 #include <homcull/object_hierarchy.hpp>
 #include <homcull/occluder_selection.hpp>
+#include <homcull/tbb_parallel_for.hpp>
 #include <homcull/truth/occluder_lod_build.hpp>
 #include <homcull/truth/walk_path.hpp>
 #include <homcull/truth/walkthrough.hpp>
@@ -245,6 +246,38 @@ TEST(SceneCulling, EveryStrategyOnSharedScenesHasNoFalseCulls) {
         }
     }
     if (found == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
+}
+
+// Occluders as clusters with a job system: the same answers and statistics as on one thread,
+// frame after frame (progressive renders several batches a frame into the same buffer).
+TEST(SceneCulling, ClustersGiveTheSameAnswersWithAJobSystem) {
+    const std::string path = test::shared_scene("intel_castle.glb");
+    if (path.empty()) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const Scene castle = load_scene(path);
+    const std::vector<std::uint32_t> candidates = occluder_candidates(castle, OccluderFilter::role);
+    const RayScene rays(castle);
+    WalkOptions walk;
+    walk.frames = 12;
+    const CameraPath frames = walk_path(rays, castle, walk);
+    for (const CullStrategy strategy : {CullStrategy::one_pass, CullStrategy::progressive}) {
+        SceneCullerConfig config;
+        config.display = {480, 270};
+        config.strategy = strategy;
+        config.occluder_clusters = true;
+        SceneCuller serial(castle, candidates, config), threaded(castle, candidates, config);
+        std::vector<OccludeeAnswer> a, b;
+        for (std::size_t f = 0; f < frames.frames.size(); f += 3) {
+            serial.cull(frames.frames[f], a);
+            threaded.cull(frames.frames[f], b, tbb_parallel_for());
+            ASSERT_EQ(a.size(), b.size());
+            for (std::size_t id = 0; id < a.size(); ++id) {
+                EXPECT_EQ(a[id].visibility, b[id].visibility) << "frame " << f << ", object " << id;
+                EXPECT_EQ(a[id].level_of_visibility, b[id].level_of_visibility) << "frame " << f << ", object " << id;
+            }
+            EXPECT_TRUE(serial.buffer().stats() == threaded.buffer().stats()) << "frame " << f;
+            EXPECT_GT(serial.buffer().stats().cluster_bands_drawn, 0u);
+        }
+    }
 }
 
 // Temporal's second pass: an occluder hidden last frame that comes into view is drawn in the

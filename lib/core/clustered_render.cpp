@@ -46,17 +46,11 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
     const OccluderClusters& clusters = *in.clusters;
 
-    // The clusters must lie within their arrays, and the scratch below holds the largest.
-    for (const OccluderCluster& c : clusters.clusters)
-        if (std::size_t(c.first_vertex) + c.vertex_count > clusters.positions.size() / 3 ||
-            std::size_t(c.first_triangle) + c.triangle_count > clusters.shared_edges.size() ||
-            3 * (std::size_t(c.first_triangle) + c.triangle_count) > clusters.indices.size() || c.vertex_count > clusters.max_cluster_vertices)
-            throw Error("render: a cluster reaches past the OccluderClusters' positions, indices or flags, or past max_cluster_vertices");
-
     // The clusters in view, with their boxes' samples and nearest depth (the rectangle tests'
     // preparation, so that "hidden" means what test_aabb means by it), nearest first.
     placed_clusters_.clear();
     RasterStats frame;
+    std::size_t most_vertices = 0, most_triangles = 0;  // of the clusters in view: the scratch below holds them
     const std::size_t count = in.cluster_ids ? in.cluster_count : clusters.clusters.size();
     for (std::size_t n = 0; n < count; ++n) {
         const std::size_t k = in.cluster_ids ? in.cluster_ids[n] : n;
@@ -64,6 +58,10 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
             throw Error("render: cluster number " + std::to_string(k) + " is not below the cluster count " +
                         std::to_string(clusters.clusters.size()));
         const OccluderCluster& c = clusters.clusters[k];
+        if (std::size_t(c.first_vertex) + c.vertex_count > clusters.positions.size() / 3 ||
+            std::size_t(c.first_triangle) + c.triangle_count > clusters.shared_edges.size() ||
+            3 * (std::size_t(c.first_triangle) + c.triangle_count) > clusters.indices.size())
+            throw Error("render: cluster " + std::to_string(k) + " reaches past the OccluderClusters' positions, indices or flags");
         if (c.triangle_count == 0) continue;
         PlacedCluster p{0.0f, std::uint32_t(k), 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};
         ScreenRect rect;
@@ -77,18 +75,29 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
             continue;
         }
         placed_clusters_.push_back(p);
+        most_vertices = std::max(most_vertices, std::size_t(c.vertex_count));
+        most_triangles = std::max(most_triangles, std::size_t(c.triangle_count));
     }
-    if (clear_first) stats_ = RasterStats{};  // after every check: a render that throws changes nothing
     std::sort(placed_clusters_.begin(), placed_clusters_.end(), [](const PlacedCluster& a, const PlacedCluster& b) {
         return a.nearest_w < b.nearest_w || (a.nearest_w == b.nearest_w && a.cluster < b.cluster);
     });
 
     // Scratch for one cluster's transformed vertices (triangle_batch.hpp's cache), one per band.
     const std::size_t bands = band_updated_.size();
-    const std::size_t plane = std::size_t(clusters.max_cluster_vertices) + detail::kVertexClipPadding;
+    const std::size_t plane = most_vertices + detail::kVertexClipPadding;
     if (band_vertex_clip_.size() < bands * 4 * plane) band_vertex_clip_.resize(bands * 4 * plane);
     if (band_vertex_outcode_.size() < bands * plane) band_vertex_outcode_.resize(bands * plane);
     band_stats_.assign(bands, RasterStats{});
+    if (parallel.run) {  // each cluster in view: a slot for its set-up triangles
+        while (cluster_setups_.size() < placed_clusters_.size()) cluster_setups_.push_back(std::make_unique<ClusterSetup>());
+        for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
+            cluster_setups_[k]->state.store(ClusterSetup::kNotSetUp, std::memory_order_relaxed);
+            // Room for a cluster's triangles (clipped fans may still add some): after the first
+            // frames, the band tasks allocate nothing.
+            cluster_setups_[k]->triangles.reserve(most_triangles);
+        }
+    }
+    if (clear_first) stats_ = RasterStats{};  // after every check and allocation: a render that throws changes nothing
     const auto cache_of = [&](std::size_t band) {
         double* clip = band_vertex_clip_.data() + band * 4 * plane;
         return detail::VertexClip{clip, clip + plane, clip + 2 * plane, clip + 3 * plane, band_vertex_outcode_.data() + band * plane};
@@ -124,15 +133,6 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
         // below does. A cluster is set up by the first band that draws it and its triangles
         // kept for the others (which wait for them: a band setting one up depends on no other
         // task, so the wait is short and cannot deadlock): no bins, and no cluster set up twice.
-        const std::size_t placed = placed_clusters_.size();
-        if (cluster_setup_capacity_ < placed) {
-            cluster_setups_ = std::make_unique<ClusterSetup[]>(placed);
-            cluster_setup_capacity_ = placed;
-        }
-        for (std::size_t k = 0; k < placed; ++k) {
-            cluster_setups_[k].state.store(ClusterSetup::kNotSetUp, std::memory_order_relaxed);
-            cluster_setups_[k].drawn_bands.store(0, std::memory_order_relaxed);
-        }
         struct Job {
             decltype(band_rows)* rows;
             decltype(band_draws)* draws;
@@ -149,30 +149,32 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
             if (j.clear_first) b.clear_rows(row_begin, row_end);
             const detail::RasterTarget target = b.raster_target(row_begin, row_end);
             const detail::VertexClip cache = (*j.band_cache)(band);
-            std::uint64_t updated = 0;
+            RasterStats& stats = b.band_stats_[band];
             for (std::size_t k = 0; k < b.placed_clusters_.size(); ++k) {
                 if (!(*j.draws)(b.placed_clusters_[k], band, target.planes)) continue;
-                ClusterSetup& s = b.cluster_setups_[k];
-                s.drawn_bands.fetch_add(1, std::memory_order_relaxed);
+                ClusterSetup& s = *b.cluster_setups_[k];
                 int expected = ClusterSetup::kNotSetUp;
                 if (s.state.compare_exchange_strong(expected, ClusterSetup::kSettingUp, std::memory_order_acquire)) {
-                    s.triangles.clear();
-                    s.stats = RasterStats{};
-                    (*j.set_up_cluster)(b.placed_clusters_[k], cache, s.stats,
-                                        [&](const detail::RasterTriangle& tri) { s.triangles.push_back(tri); });
+                    try {
+                        s.triangles.clear();
+                        s.stats = RasterStats{};
+                        (*j.set_up_cluster)(b.placed_clusters_[k], cache, s.stats,
+                                            [&](const detail::RasterTriangle& tri) { s.triangles.push_back(tri); });
+                    } catch (...) {  // the bands waiting for it must not wait for ever
+                        s.state.store(ClusterSetup::kFailed, std::memory_order_release);
+                        throw;
+                    }
                     s.state.store(ClusterSetup::kReady, std::memory_order_release);
                 } else {
-                    while (s.state.load(std::memory_order_acquire) != ClusterSetup::kReady) std::this_thread::yield();
+                    while ((expected = s.state.load(std::memory_order_acquire)) == ClusterSetup::kSettingUp) std::this_thread::yield();
+                    if (expected == ClusterSetup::kFailed) return;  // another band throws: the render fails
                 }
-                for (const detail::RasterTriangle& tri : s.triangles) updated += target.kernel(target, tri);
+                stats += s.stats;  // the setup's counts once per band that draws the cluster, as on one thread
+                for (const detail::RasterTriangle& tri : s.triangles) stats.subtiles_updated += target.kernel(target, tri);
             }
-            b.band_stats_[band].subtiles_updated += updated;
             b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
         }, &job);
         reduce_pyramid_above_bands();
-        // Each setup's counts once per band that drew the cluster, as on one thread.
-        for (std::size_t k = 0; k < placed; ++k)
-            for (std::uint32_t n = cluster_setups_[k].drawn_bands.load(std::memory_order_relaxed); n > 0; --n) frame += cluster_setups_[k].stats;
     } else {
         // One thread: each cluster is set up once and rasterized in the runs of bands that draw
         // it. The statistics are the bands': its triangles' counts once per band drawing it.

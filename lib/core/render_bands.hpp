@@ -41,10 +41,9 @@ struct OcclusionBuffer::PlacedCluster {
 // its triangles kept here for the other bands that draw it (each waits until they are ready).
 struct OcclusionBuffer::ClusterSetup {
     std::vector<detail::RasterTriangle> triangles;
-    RasterStats stats;                           // the setup's counts
-    std::atomic<int> state{0};                   // kNotSetUp, kSettingUp, kReady
-    std::atomic<std::uint32_t> drawn_bands{0};  // bands that drew it
-    static constexpr int kNotSetUp = 0, kSettingUp = 1, kReady = 2;
+    RasterStats stats;          // the setup's counts
+    std::atomic<int> state{0};  // kNotSetUp, kSettingUp, kReady, or kFailed (the setup threw)
+    static constexpr int kNotSetUp = 0, kSettingUp = 1, kReady = 2, kFailed = 3;
 };
 
 }  // namespace homcull

@@ -207,11 +207,18 @@ void SceneCuller::gather_lods() {
 void SceneCuller::build_clusters() {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
+    std::vector<std::uint32_t> local;  // the candidate's indices, relative to its first vertex
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
-        const OccluderClusters part =
-            build_occluder_clusters(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
-                                    occluders_.indices.data() + 3 * first, count, occluders_.shared_edges.data() + first);
+        // Each object's vertices are together in occluders_.positions: the build sees only
+        // those (meshoptimizer's work grows with the vertices it is given).
+        const auto begin = occluders_.indices.begin() + std::ptrdiff_t(3 * first), end = begin + std::ptrdiff_t(3 * count);
+        const std::uint32_t base = count ? *std::min_element(begin, end) : 0, top = count ? *std::max_element(begin, end) : 0;
+        local.assign(begin, end);
+        for (std::uint32_t& v : local) v -= base;
+        const OccluderClusters part = build_occluder_clusters(occluders_.positions.data() + 3 * std::size_t(base), 3 * sizeof(float),
+                                                              count ? std::size_t(top - base) + 1 : 0, local.data(), count,
+                                                              occluders_.shared_edges.data() + first);
         const auto vertex_base = std::uint32_t(clusters_.positions.size() / 3), triangle_base = std::uint32_t(clusters_.shared_edges.size());
         for (OccluderCluster c : part.clusters) {
             c.first_vertex += vertex_base;
@@ -315,6 +322,7 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
         frame_clusters_rendered_ += clusters;
         frame_cluster_triangles_waiting_ = 0;
         frame_clusters_own_flags_ = false;
+        ++work_.renders;
     }
     if (count > 0) {
         TriangleInput in = occluders_.input(frame.clip, config_.backface);
@@ -325,8 +333,8 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
         else buffer_.render(in, parallel);
         frame_started_ = true;
         frame_rendered_ += count;
+        ++work_.renders;
     }
-    ++work_.renders;
     timings_.render_ms += ms_since(start);
 }
 

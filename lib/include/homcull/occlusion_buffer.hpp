@@ -210,16 +210,17 @@ public:
     // triangles is set up: clusters outside the view are dropped; the others are taken nearest
     // first (by their boxes' nearest w, then their number), and each band of subtile rows
     // (128 sample rows, whatever the threads) skips a cluster whose box lies behind the band's
-    // reference layer over every subtile the box covers there (test_rect's rule, on the
-    // layer as it is when the cluster's turn comes). A skipped cluster only leaves out
-    // occlusion, so the buffer stays conservative; but a triangle of it could have entered a
-    // subtile (its conservative depth is a bound, evaluated where the box is not), so the bits
-    // are those of this order and these skips, not of render(TriangleInput) over the same
-    // triangles. They are the same on every instruction set and with any threads: with a job
-    // system the bands run in parallel, each setting up the clusters it draws (a cluster
-    // reaching two bands is set up twice; no bins, nothing copied). Scratch for the clusters'
-    // order and each band's transformed vertices is reused and only grows. Throws
-    // homcull::Error when input.clusters is null.
+    // reference layer d0 over every subtile the box covers there (test_rect's first rule, on
+    // d0 alone, on the layer as it is when the cluster's turn comes). A skipped cluster only
+    // leaves out occlusion, so the buffer stays conservative; but a triangle of it could have
+    // entered a subtile (its conservative depth is a bound, evaluated where the box is not), so
+    // the bits are those of this order and these skips, not of render(TriangleInput) over the
+    // same triangles. They are the same on every instruction set and with any threads: with a
+    // job system the bands run in parallel, and a cluster is set up once, by the first band
+    // that draws it, its triangles kept for the other bands (no bins). Scratch (the clusters'
+    // order, each band's transformed vertices, the kept triangles) is reused and only grows.
+    // Throws homcull::Error, before anything is drawn, when input.clusters is null, a cluster
+    // number is out of range or a cluster reaches past its arrays.
     void render(const ClusteredInput& input, const ParallelFor& parallel = {});
     void render_frame(const ClusteredInput& input, const ParallelFor& parallel = {});
 
@@ -357,8 +358,7 @@ private:
     std::vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
     std::vector<RasterStats> band_stats_;
     std::vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
-    std::unique_ptr<ClusterSetup[]> cluster_setups_;      // job system: one per cluster in view
-    std::size_t cluster_setup_capacity_ = 0;
+    std::vector<std::unique_ptr<ClusterSetup>> cluster_setups_;  // job system: one per cluster in view (never moved)
     std::vector<double> band_vertex_clip_;         // per band: four planes of a cluster's vertices + padding
     std::vector<std::uint8_t> band_vertex_outcode_;
 
