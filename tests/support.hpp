@@ -7,6 +7,10 @@
 #include <string>
 #include <vector>
 
+namespace homcull {
+class RayScene;
+}
+
 namespace homcull::test {
 
 // Appends an object holding a quad (two CCW triangles a, b, c, d) with its own mesh.
@@ -33,6 +37,12 @@ void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t
 bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b);
 // The same pyramids of the rectangle tests (built band by band with a job system).
 bool same_pyramid(const OcclusionBuffer& a, const OcclusionBuffer& b);
+
+// Wherever the buffer claims an occluder (read_depth finite), a ray through the sample's
+// centre must hit something at or before the claimed depth (the ray parameter is the view
+// depth; 10^-5 absorbs Embree's float rounding). Adds a failure naming `what` and the sample at
+// the first that does not; returns the number of claimed samples.
+long expect_claims_behind_embree_hits(const RayScene& rays, const Camera& camera, const OcclusionBuffer& buffer, const std::string& what);
 
 // A fresh, empty folder for one test's files.
 std::string temp_dir(const std::string& test_name);
