@@ -41,6 +41,7 @@ struct GoldenCase {
     Resolution display;
     int samples;
     DepthTest depth;
+    bool clusters = false;  // SceneCullerConfig::occluder_clusters
 };
 
 Camera look(glm::dvec3 eye, glm::dvec3 target, double fov_y = 60.0, double near_plane = 0.1) {
@@ -60,6 +61,8 @@ std::vector<GoldenCase> golden_cases() {
         {"fzk_haus", "fzk_haus.glb", look({-9, 4, 8}, {6, 2, -5}), {320, 180}, 1, DepthTest::masked},
         {"castle_c0", "intel_castle.glb", look({27, 2, -47}, {28.4258, 2.6111, -37.1211}, 36.0, 1.0), {320, 180}, 1,
          DepthTest::masked},
+        {"castle_c0_clusters", "intel_castle.glb", look({27, 2, -47}, {28.4258, 2.6111, -37.1211}, 36.0, 1.0), {320, 180}, 1,
+         DepthTest::masked, true},
     };
 }
 
@@ -86,6 +89,7 @@ std::vector<DumpPart> render_case(const GoldenCase& c, const Scene& scene) {
     config.display = c.display;
     config.samples = c.samples;
     config.maps.depth = c.depth;
+    config.occluder_clusters = c.clusters;
     SceneCuller culler(scene, occluder_candidates(scene, OccluderFilter::size), config);
     std::vector<OccludeeAnswer> answers;
     culler.cull(c.camera, answers);
