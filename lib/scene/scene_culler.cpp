@@ -167,7 +167,7 @@ void SceneCuller::select_occluders(const Frame& frame) {
     bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0;
     for (std::size_t i = 0; i < ranked_.size() && every_candidate_in_frustum; ++i)
         every_candidate_in_frustum = !draws_lod(ranked_[i], *frame.camera);
-    const std::vector<std::uint8_t>& flags = every_candidate_in_frustum ? occluders_.shared_edges : own_shared_edges_;
+    const EdgeFlags flags = every_candidate_in_frustum ? EdgeFlags::across_objects : EdgeFlags::own_object;
     for (std::uint32_t id : ranked_) append_occluder(id, *frame.camera, flags);
     timings_.select_ms += ms_since(start);
 }
@@ -243,11 +243,12 @@ bool SceneCuller::draws_lod(std::uint32_t id, const Camera& camera) const {
     return lod_first_[k] < lod_first_[k + 1] && lod_usable(scene_->objects[id].world_bounds, camera);
 }
 
-void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, const std::vector<std::uint8_t>& shared_edges) {
+void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, EdgeFlags edge_flags) {
     const std::uint32_t k = candidate_of_[id];
     const bool lod = draws_lod(id, camera);
+    const bool own = edge_flags == EdgeFlags::own_object;
     const std::vector<std::uint32_t>& indices = lod ? lod_indices_ : occluders_.indices;
-    const std::vector<std::uint8_t>& flags = lod ? lod_shared_edges_ : shared_edges;
+    const std::vector<std::uint8_t>& flags = lod ? lod_shared_edges_ : own ? own_shared_edges_ : occluders_.shared_edges;
     const std::uint32_t first = lod ? lod_first_[k] : first_triangle_[k], last = lod ? lod_first_[k + 1] : first_triangle_[k + 1];
     frame_occluders_.push_back(id);
     drawn_[k] = 1;
@@ -258,7 +259,6 @@ void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, const 
         for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) frame_clusters_.push_back(c);
         frame_cluster_triangles_waiting_ += last - first;
         // Flags across objects only when every waiting cluster may have them (else each object's own).
-        const bool own = &shared_edges == &own_shared_edges_;
         frame_clusters_own_flags_ = frame_clusters_own_flags_ || own;
         return;
     }
@@ -292,7 +292,7 @@ void SceneCuller::draw_newly_visible(const Frame& frame, std::vector<OccludeeAns
         (void)distance;
         const std::size_t n = occluder_triangles_drawn(*scene_, id, *frame.camera, config_.lods);
         if (n > left) continue;
-        append_occluder(id, *frame.camera, own_shared_edges_);
+        append_occluder(id, *frame.camera, EdgeFlags::own_object);
         left -= n;
     }
     timings_.select_ms += ms_since(start);

@@ -185,8 +185,11 @@ private:
     static constexpr std::uint32_t kNone = ~std::uint32_t(0);
     struct Frame;
     void select_occluders(const Frame& frame);
-    // Appends an occluder's triangles, its LOD's when it has one usable from this camera.
-    void append_occluder(std::uint32_t id, const Camera& camera, const std::vector<std::uint8_t>& shared_edges);
+    // Which shared-edge flags an occluder is drawn with (docs/scene-culling.md, "Shared edges").
+    enum class EdgeFlags : std::uint8_t { own_object, across_objects };
+    // Appends an occluder's triangles (or clusters), its LOD's when it has one usable from this
+    // camera, with those flags (an LOD always has its own).
+    void append_occluder(std::uint32_t id, const Camera& camera, EdgeFlags edge_flags);
     bool draws_lod(std::uint32_t id, const Camera& camera) const;
     void gather_lods();
     void build_clusters();
