@@ -341,6 +341,10 @@ bool hidden_skip_enabled();
 
 // The kernel for the selected instruction set (see select_isa in occlusion_buffer.hpp).
 TriangleRowsKernel selected_rows_kernel();
+// hidden_behind_reference_layer for the selected instruction set: the SIMD row loop's test
+// (a vector of subtiles per step, the same comparisons, so the same answer), or the scalar one.
+using HiddenTestKernel = bool (*)(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
+HiddenTestKernel selected_hidden_test();
 // Whether select_isa chose the plain scalar reference paths.
 bool scalar_reference_selected();
 

@@ -396,6 +396,11 @@ HWY_INLINE bool HiddenBehindReferenceLayer(const SubtilePlanes& planes, int tx0,
     return true;
 }
 
+// HiddenBehindReferenceLayer as a kernel of its own, for the clustered render's box tests.
+bool HiddenBehindReferenceLayerKernel(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest) {
+    return HiddenBehindReferenceLayer(planes, tx0, tx1, ty0, ty1, nearest);
+}
+
 // The reference's row loop, over chunks of up to kChunkSubtileRows subtile rows. A chunk where
 // the triangle is hidden behind the reference layer is skipped (HiddenBehindReferenceLayer; on
 // S1 that is most of them). Otherwise two passes: first the
@@ -472,6 +477,7 @@ namespace homcull {
 namespace detail {
 
 HWY_EXPORT(RasterizeRows);
+HWY_EXPORT(HiddenBehindReferenceLayerKernel);
 
 namespace {
 
@@ -489,6 +495,9 @@ const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4
 }  // namespace
 
 TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_rows_reference : HOMCULL_RESOLVED_KERNEL(RasterizeRows); }
+HiddenTestKernel selected_hidden_test() {
+    return use_reference ? &hidden_behind_reference_layer : HOMCULL_RESOLVED_KERNEL(HiddenBehindReferenceLayerKernel);
+}
 bool scalar_reference_selected() { return use_reference; }
 void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
 bool hidden_skip_enabled() { return skip_hidden; }
