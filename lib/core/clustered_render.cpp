@@ -17,6 +17,7 @@ namespace homcull {
 namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+constexpr std::size_t kClustersPerPlacementTask = 64;
 using detail::kBandPyramidLevels;
 using detail::kBandSubtileRows;
 
@@ -38,6 +39,24 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
 
 }  // namespace
 
+void OcclusionBuffer::place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
+                                    ClusterPlace& out) const {
+    out.fate = ClusterPlace::kInView;
+    if (c.triangle_count == 0) {
+        out.fate = ClusterPlace::kEmpty;
+        return;
+    }
+    out.placed = {0.0f, number, 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};  // untestable: every sample, no test
+    ScreenRect rect;
+    Visibility decided = Visibility::visible;
+    detail::RectQuery q;
+    if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, model_to_clip, config_.near_w, rect, decided) &&
+        prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
+        out.placed = {rect.w_min, number, q.i0, q.i1, q.j0, q.j1, q.d_near, true};
+    else if (decided != Visibility::visible)  // outside the view, or between sample centres
+        out.fate = ClusterPlace::kOutside;
+}
+
 void OcclusionBuffer::render(const ClusteredInput& input, const ParallelFor& parallel) { render_clusters(input, parallel, false); }
 
 void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFor& parallel) { render_clusters(input, parallel, true); }
@@ -46,11 +65,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
     const OccluderClusters& clusters = *in.clusters;
 
-    // The clusters in view, with their boxes' samples and nearest depth (the rectangle tests'
-    // preparation, so that "hidden" means what test_aabb means by it), nearest first.
-    placed_clusters_.clear();
-    RasterStats frame;
-    std::size_t most_vertices = 0, most_triangles = 0;  // of the clusters in view: the scratch below holds them
+    // Every cluster is checked before anything is drawn (a render that throws changes nothing).
     const std::size_t count = in.cluster_ids ? in.cluster_count : clusters.clusters.size();
     for (std::size_t n = 0; n < count; ++n) {
         const std::size_t k = in.cluster_ids ? in.cluster_ids[n] : n;
@@ -62,19 +77,43 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
             std::size_t(c.first_triangle) + c.triangle_count > clusters.shared_edges.size() ||
             3 * (std::size_t(c.first_triangle) + c.triangle_count) > clusters.indices.size())
             throw Error("render: cluster " + std::to_string(k) + " reaches past the OccluderClusters' positions, indices or flags");
-        if (c.triangle_count == 0) continue;
-        PlacedCluster p{0.0f, std::uint32_t(k), 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};
-        ScreenRect rect;
-        Visibility decided = Visibility::visible;
-        detail::RectQuery q;
-        if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, in.model_to_clip, config_.near_w, rect, decided) &&
-            prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided)) {
-            p = {rect.w_min, std::uint32_t(k), q.i0, q.i1, q.j0, q.j1, q.d_near, true};
-        } else if (decided != Visibility::visible) {  // outside the view, or between sample centres
+    }
+
+    // Each cluster's box on the screen: its samples and nearest depth (the rectangle tests'
+    // preparation, so that "hidden" means what test_aabb means by it), or outside the view. With
+    // a job system, in tasks: the castle's 393 boxes took 0.04 ms of a 0.46 ms two-thread render.
+    if (cluster_places_.size() < count) cluster_places_.resize(count);
+    struct PlaceJob {
+        OcclusionBuffer* self;
+        const ClusteredInput* in;
+        std::size_t count;
+    } place_job{this, &in, count};
+    const auto place_task = [](void* data, std::size_t task) {
+        const PlaceJob& j = *static_cast<PlaceJob*>(data);
+        const OccluderClusters& set = *j.in->clusters;
+        for (std::size_t n = task * kClustersPerPlacementTask; n < std::min(j.count, (task + 1) * kClustersPerPlacementTask); ++n) {
+            const std::size_t k = j.in->cluster_ids ? j.in->cluster_ids[n] : n;
+            j.self->place_cluster(set.clusters[k], std::uint32_t(k), j.in->model_to_clip, j.self->cluster_places_[n]);
+        }
+    };
+    const std::size_t place_tasks = (count + kClustersPerPlacementTask - 1) / kClustersPerPlacementTask;
+    if (parallel.run && place_tasks > 1) parallel.run(parallel.user, place_tasks, place_task, &place_job);
+    else
+        for (std::size_t task = 0; task < place_tasks; ++task) place_task(&place_job, task);
+
+    // The clusters in view, in input order, then nearest first.
+    placed_clusters_.clear();
+    RasterStats frame;
+    std::size_t most_vertices = 0, most_triangles = 0;  // of the clusters in view: the scratch below holds them
+    for (std::size_t n = 0; n < count; ++n) {
+        const ClusterPlace& place = cluster_places_[n];
+        if (place.fate == ClusterPlace::kEmpty) continue;
+        if (place.fate == ClusterPlace::kOutside) {
             ++frame.clusters_outside;
             continue;
         }
-        placed_clusters_.push_back(p);
+        placed_clusters_.push_back(place.placed);
+        const OccluderCluster& c = clusters.clusters[place.placed.cluster];
         most_vertices = std::max(most_vertices, std::size_t(c.vertex_count));
         most_triangles = std::max(most_triangles, std::size_t(c.triangle_count));
     }

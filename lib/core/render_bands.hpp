@@ -37,6 +37,14 @@ struct OcclusionBuffer::PlacedCluster {
     bool testable;
 };
 
+// Where a cluster's box lands this frame (OcclusionBuffer::place_cluster), one per cluster of
+// the input, in its order.
+struct OcclusionBuffer::ClusterPlace {
+    PlacedCluster placed;  // when in view
+    std::uint8_t fate;
+    static constexpr std::uint8_t kInView = 0, kOutside = 1, kEmpty = 2;  // kEmpty: no triangles
+};
+
 // With a job system, a cluster in view is set up once, by the first band that draws it, and
 // its triangles kept here for the other bands that draw it (each waits until they are ready).
 struct OcclusionBuffer::ClusterSetup {

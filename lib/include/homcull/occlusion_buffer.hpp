@@ -145,6 +145,7 @@ void compute_shared_edges(const float* positions, std::size_t position_stride, s
                           const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
 
 struct OccluderClusters;
+struct OccluderCluster;
 // An occluder mesh split into clusters at load time (occluder_clusters.hpp), under a
 // model-to-clip matrix (column-major), for OcclusionBuffer::render. Its positions have 3
 // components; its shared-edge flags are the mesh's.
@@ -345,7 +346,9 @@ private:
     // Clustered input (clustered_render.cpp).
     void render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first);
     struct PlacedCluster;
+    struct ClusterPlace;
     struct ClusterSetup;
+    void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip, ClusterPlace& out) const;
     // After the bands: the pyramid levels above those each band built (kBandPyramidLevels).
     void reduce_pyramid_above_bands();
 
@@ -355,6 +358,7 @@ private:
     std::vector<std::uint64_t> band_updated_;
     std::vector<double> vertex_clip_;           // four planes of vertex_count + padding
     std::vector<std::uint8_t> vertex_outcode_;
+    std::vector<ClusterPlace> cluster_places_;    // each input cluster's box this frame
     std::vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
     std::vector<RasterStats> band_stats_;
     std::vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
