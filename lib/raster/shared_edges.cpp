@@ -3,25 +3,58 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
-#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <vector>
 
 namespace homcull {
+namespace {
 
+// An edge's two positions, lower first (lexicographically), as the bits of their floats with
+// -0 made +0: equal keys are equal positions under float ==, which is what "the same
+// position" has always meant here.
+struct EdgeKey {
+    std::array<std::uint32_t, 6> bits;
+    bool operator==(const EdgeKey& o) const { return bits == o.bits; }
+};
+
+std::uint32_t float_key(float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, sizeof u);
+    return u == 0x80000000u ? 0u : u;
+}
+
+std::uint64_t hash(const EdgeKey& key) {
+    std::uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (std::uint32_t b : key.bits) {  // a multiply-xorshift step per word
+        h = (h ^ b) * 0xBF58476D1CE4E5B9ull;
+        h ^= h >> 31;
+    }
+    return h;
+}
+
+}  // namespace
+
+// Edges are matched through a hash table of their keys rather than by sorting them: the scene
+// culler runs this over every occluder of a scene at load time, and sorting sponza's 786,000
+// edges was most of its setup.
 void compute_shared_edges(const float* positions, std::size_t stride, std::size_t vertex_count,
                           const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges) {
     if (triangle_count == 0) return;
     if (!positions || !shared_edges || stride < 3 * sizeof(float))
         throw Error("compute_shared_edges: positions or output missing, or stride smaller than one position");
     struct Edge {
-        std::array<float, 6> key;  // from, to (from < to lexicographically)
-        bool reversed;             // the triangle runs to -> from
-        std::size_t triangle;
+        EdgeKey key;
+        std::uint32_t triangle;
         std::uint8_t bit;
+        bool reversed;   // the triangle runs from its higher position to its lower one
+        std::uint8_t directions = 0;  // on the first edge of each key: 1 forward seen, 2 reversed seen
+        std::uint32_t first = 0;      // the first edge with this key
     };
+    if (triangle_count > 0xFFFFFFFFull / 3)
+        throw Error("compute_shared_edges: more than 2^32 / 3 triangles");
     auto position = [&](std::size_t v) {
         std::array<float, 3> p;
         std::memcpy(p.data(), reinterpret_cast<const unsigned char*>(positions) + std::size_t(v) * stride, sizeof p);
@@ -34,7 +67,7 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
         std::size_t v[3];
         for (int k = 0; k < 3; ++k) v[k] = indices ? indices[3 * t + std::size_t(k)] : 3 * t + std::size_t(k);
         if (v[0] >= vertex_count || v[1] >= vertex_count || v[2] >= vertex_count) continue;
-        bool finite = true;  // NaN would break the sort's ordering; such triangles are not drawn anyway
+        bool finite = true;  // such triangles are not drawn anyway
         for (int k = 0; k < 3; ++k)
             for (float c : position(v[k])) finite = finite && std::isfinite(c);
         if (!finite) continue;
@@ -44,22 +77,34 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
             const bool reversed = b < a;
             const auto& lo = reversed ? b : a;
             const auto& hi = reversed ? a : b;
-            edges.push_back({{lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]}, reversed, t, std::uint8_t(1u << k)});
+            Edge e{{{float_key(lo[0]), float_key(lo[1]), float_key(lo[2]), float_key(hi[0]), float_key(hi[1]), float_key(hi[2])}},
+                   std::uint32_t(t), std::uint8_t(1u << k), reversed};
+            edges.push_back(e);
         }
     }
-    std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.key < y.key; });
-    // Within a run of equal edges, each edge is shared if the run holds the opposite direction.
-    for (std::size_t i = 0; i < edges.size();) {
-        std::size_t j = i;
-        bool forward = false, backward = false;
-        while (j < edges.size() && edges[j].key == edges[i].key) {
-            (edges[j].reversed ? backward : forward) = true;
-            ++j;
+
+    // Open addressing, at most half full: slot = 1 + the first edge with that key, 0 = empty.
+    std::size_t capacity = 16;
+    while (capacity < 2 * edges.size()) capacity *= 2;
+    std::vector<std::uint32_t> table(capacity, 0);
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+        Edge& e = edges[i];
+        for (std::size_t slot = hash(e.key) & (capacity - 1);; slot = (slot + 1) & (capacity - 1)) {
+            if (table[slot] == 0) {
+                table[slot] = std::uint32_t(i + 1);
+                e.first = std::uint32_t(i);
+                break;
+            }
+            if (edges[table[slot] - 1].key == e.key) {
+                e.first = table[slot] - 1;
+                break;
+            }
         }
-        if (forward && backward)
-            for (std::size_t k = i; k < j; ++k) shared_edges[edges[k].triangle] |= edges[k].bit;
-        i = j;
+        edges[e.first].directions |= e.reversed ? 2u : 1u;
     }
+    // An edge is shared when its key was seen in the opposite direction too.
+    for (const Edge& e : edges)
+        if (edges[e.first].directions == 3u) shared_edges[e.triangle] |= e.bit;
 }
 
 }  // namespace homcull
