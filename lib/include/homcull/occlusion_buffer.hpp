@@ -139,7 +139,7 @@ struct TriangleInput {
 // Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
 // in opposite order as consistently wound neighbours have them) and writes the
 // TriangleInput::shared_edges bits. `indices` may be null (vertices 3k, 3k+1, 3k+2). Meant
-// for load time: it allocates and sorts. Throws homcull::Error when positions or the output are
+// for load time: it allocates (the edges and a hash table of them, about 100 bytes per triangle). Throws homcull::Error when positions or the output are
 // missing or the stride is below one position (12 bytes).
 void compute_shared_edges(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                           const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
