@@ -317,6 +317,47 @@ TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
     }
 }
 
+// More clusters than one placement task takes (64), drawn as a subset in another order, with
+// empty clusters and clusters outside the view among them, frame after frame on the same
+// buffers: every job system gives the serial bits and statistics (no shared scene needed).
+TEST(ClusteredRender, ManyClustersGiveTheSameBitsWithAnyJobSystem) {
+    OccluderClusters clusters;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> across(-12.0f, 12.0f), depth(-40.0f, -3.0f), half(0.3f, 3.0f);
+    for (int k = 0; k < 230; ++k) {
+        if (k % 29 == 0) {
+            append_cluster(clusters, {}, {}, {});  // no triangles
+            continue;
+        }
+        // Every 17th beside the view, every 23rd behind the eye.
+        const float x = k % 17 == 0 ? 500.0f : across(rng), y = 0.6f * across(rng), z = k % 23 == 0 ? 20.0f : depth(rng), s = half(rng);
+        append_quad(clusters, {x - s, y - s, z}, {x + s, y - s, z}, {x + s, y + s, z}, {x - s, y + s, z});
+    }
+    std::vector<std::uint32_t> ids(clusters.clusters.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) ids[k] = std::uint32_t(k);
+    std::shuffle(ids.begin(), ids.end(), rng);
+    const std::array<float, 16> m = clip_from_world(test::camera_down_minus_z(80.0, 0.5), 320.0 / 200.0);
+    std::mt19937_64 order_rng(3);
+    const ParallelFor tbb = tbb_parallel_for(), shuffled{test::run_shuffled, &order_rng};
+    const BufferConfig config = test::buffer_config(320, 200, 2, 0.5f);
+    OcclusionBuffer serial(config), threaded(config), shuffled_order(config);
+    for (const std::size_t count : {std::size_t(197), std::size_t(70), ids.size()}) {
+        ClusteredInput in{&clusters, m, Backface::cw};
+        in.cluster_ids = ids.data();
+        in.cluster_count = count;
+        serial.render_frame(in);
+        threaded.render_frame(in, tbb);
+        shuffled_order.render_frame(in, shuffled);
+        EXPECT_GT(serial.stats().clusters_outside, 0u) << count;
+        EXPECT_GT(serial.stats().cluster_bands_hidden, 0u) << count;
+        for (const OcclusionBuffer* b : {&threaded, &shuffled_order}) {
+            EXPECT_TRUE(serial.stats() == b->stats()) << count;
+            EXPECT_TRUE(test::same_subtiles(serial, *b)) << count;
+            EXPECT_TRUE(test::same_pyramid(serial, *b)) << count;
+        }
+    }
+}
+
 // Wherever the clustered buffer claims an occluder, a ray through the sample's centre hits
 // something at or before the buffer's depth (as FloatRowRule's test of the triangle path):
 // castle views and fzk_haus, a full-size buffer and a 4 x 4-sample one.

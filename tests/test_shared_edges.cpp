@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <bitset>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -82,12 +84,64 @@ TEST(SharedEdges, MatchTheirDefinitionOnRandomMeshes) {
         homcull::compute_shared_edges(positions[0].data(), sizeof(Position), positions.size(), indices.data(), triangles, shared.data());
         const std::vector<std::uint8_t> expected = shared_edges_by_pairs(positions, indices);
         ASSERT_EQ(shared, expected) << "trial " << trial;
-        for (std::uint8_t bits : expected) shared_bits += std::size_t(__builtin_popcount(bits));
+        for (std::uint8_t bits : expected) shared_bits += std::bitset<8>(bits).count();
         checked += triangles;
     }
     // The meshes reach every case: most edges are shared, but far from all.
     EXPECT_GT(shared_bits, checked / 2);
     EXPECT_LT(shared_bits, checked * 3 * 9 / 10);
+}
+
+// A large mesh (a height field of 20,000 triangles over repeated heights, with some triangles
+// wound the other way and some duplicated), so that the hash table grows far past the small
+// meshes': against the definition computed by sorting the edges.
+TEST(SharedEdges, MatchTheirDefinitionOnALargeMesh) {
+    constexpr int kSide = 101;
+    std::mt19937 rng(3);
+    std::vector<Position> positions;
+    for (int j = 0; j < kSide; ++j)
+        for (int i = 0; i < kSide; ++i) positions.push_back({float(i), float(rng() % 3), float(j)});
+    std::vector<std::uint32_t> indices;
+    for (int j = 0; j + 1 < kSide; ++j)
+        for (int i = 0; i + 1 < kSide; ++i) {
+            const std::uint32_t a = std::uint32_t(j * kSide + i), b = a + 1, c = a + kSide + 1, d = a + kSide;
+            indices.insert(indices.end(), {a, c, b, a, d, c});
+            if (rng() % 10 == 0) std::swap(indices[indices.size() - 1], indices[indices.size() - 2]);  // wound the other way
+            if (rng() % 20 == 0) indices.insert(indices.end(), {a, c, b});                             // a duplicate
+        }
+    const std::size_t triangles = indices.size() / 3;
+    std::vector<std::uint8_t> shared(triangles, 0xFF);
+    homcull::compute_shared_edges(positions[0].data(), sizeof(Position), positions.size(), indices.data(), triangles, shared.data());
+
+    struct Edge {
+        std::array<float, 6> key;  // lower position first
+        bool reversed;
+        std::size_t triangle;
+        std::uint8_t bit;
+    };
+    std::vector<Edge> edges;
+    for (std::size_t t = 0; t < triangles; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const Position& a = positions[indices[3 * t + std::size_t(k)]];
+            const Position& b = positions[indices[3 * t + std::size_t((k + 1) % 3)]];
+            const bool reversed = b < a;
+            const Position& lo = reversed ? b : a;
+            const Position& hi = reversed ? a : b;
+            edges.push_back({{lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]}, reversed, t, std::uint8_t(1u << k)});
+        }
+    std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.key < y.key; });
+    std::vector<std::uint8_t> expected(triangles, 0);
+    for (std::size_t i = 0, j = 0; i < edges.size(); i = j) {
+        bool forward = false, backward = false;
+        for (j = i; j < edges.size() && edges[j].key == edges[i].key; ++j) (edges[j].reversed ? backward : forward) = true;
+        if (forward && backward)
+            for (std::size_t k = i; k < j; ++k) expected[edges[k].triangle] |= edges[k].bit;
+    }
+    EXPECT_EQ(shared, expected);
+    std::size_t shared_bits = 0;
+    for (std::uint8_t bits : expected) shared_bits += std::bitset<8>(bits).count();
+    EXPECT_GT(shared_bits, 2 * triangles);      // most interior edges
+    EXPECT_LT(shared_bits, 3 * triangles - 100);  // not the border, nor the flipped triangles' edges
 }
 
 // A closed mesh has every edge shared; an open one keeps its border; without indices the

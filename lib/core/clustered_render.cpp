@@ -39,8 +39,10 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
 
 }  // namespace
 
+// Runs in job-system tasks, which must not throw: every check that can fail stays in
+// render_clusters' serial loop, before the tasks.
 void OcclusionBuffer::place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
-                                    ClusterPlace& out) const {
+                                    ClusterPlace& out) const noexcept {
     out.fate = ClusterPlace::kInView;
     if (c.triangle_count == 0) {
         out.fate = ClusterPlace::kEmpty;

@@ -139,8 +139,9 @@ struct TriangleInput {
 // Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
 // in opposite order as consistently wound neighbours have them) and writes the
 // TriangleInput::shared_edges bits. `indices` may be null (vertices 3k, 3k+1, 3k+2). Meant
-// for load time: it allocates (the edges and a hash table of them, about 100 bytes per triangle). Throws homcull::Error when positions or the output are
-// missing or the stride is below one position (12 bytes).
+// for load time: it allocates the edges and a hash table of them (about 150 bytes per
+// triangle). Throws homcull::Error when positions or the output are missing, the stride is
+// below one position (12 bytes), or there are 2^32 / 3 triangles or more.
 void compute_shared_edges(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                           const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
 
@@ -217,9 +218,11 @@ public:
     // entered a subtile (its conservative depth is a bound, evaluated where the box is not), so
     // the bits are those of this order and these skips, not of render(TriangleInput) over the
     // same triangles. They are the same on every instruction set and with any threads: with a
-    // job system the bands run in parallel, and a cluster is set up once, by the first band
-    // that draws it, its triangles kept for the other bands (no bins). Scratch (the clusters'
-    // order, each band's transformed vertices, the kept triangles) is reused and only grows.
+    // job system (two parallel runs a frame) the clusters' boxes are placed in tasks of 64,
+    // then the bands run in parallel, and a cluster is set up once, by the first band that
+    // draws it, its triangles kept for the other bands (no bins). Scratch (each cluster's place
+    // and the clusters' order, each band's transformed vertices, the kept triangles) is reused
+    // and only grows.
     // Throws homcull::Error, before anything is drawn, when input.clusters is null, a cluster
     // number is out of range or a cluster reaches past its arrays.
     void render(const ClusteredInput& input, const ParallelFor& parallel = {});
@@ -348,7 +351,9 @@ private:
     struct PlacedCluster;
     struct ClusterPlace;
     struct ClusterSetup;
-    void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip, ClusterPlace& out) const;
+    // Where a cluster's box lands (in view, outside, or no triangles). In job-system tasks: noexcept.
+    void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
+                       ClusterPlace& out) const noexcept;
     // After the bands: the pyramid levels above those each band built (kBandPyramidLevels).
     void reduce_pyramid_above_bands();
 
