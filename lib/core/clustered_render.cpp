@@ -149,13 +149,13 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     };
     // Whether a band draws a cluster (its box reaches the band and is not hidden there),
     // counting the answer in the band's statistics.
-    const detail::HiddenTestKernel hidden_behind_reference_layer = detail::selected_hidden_test();
+    const detail::HiddenTestKernel hidden_test = detail::selected_hidden_test();
     const auto band_draws = [&](const PlacedCluster& p, std::size_t band, const detail::SubtilePlanes& planes) {
         int row_begin, row_end;
         band_rows(band, row_begin, row_end);
         const int ty0 = std::max(p.j0 / kH, row_begin), ty1 = std::min(p.j1 / kH, row_end - 1);
         if (ty0 > ty1) return false;
-        if (p.testable && hidden_behind_reference_layer(planes, p.i0 / kW, p.i1 / kW, ty0, ty1, p.d_near)) {
+        if (p.testable && hidden_test(planes, p.i0 / kW, p.i1 / kW, ty0, ty1, p.d_near)) {
             ++band_stats_[band].cluster_bands_hidden;
             return false;
         }
