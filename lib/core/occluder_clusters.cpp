@@ -7,20 +7,21 @@
 #include <cmath>
 #include <cstring>
 #include <string>
-#include <unordered_map>
+#include <tuple>
+#include <vector>
 
 namespace homcull {
 namespace {
 
-// A triangle's three vertex numbers, to find which input triangle a meshlet triangle is:
-// meshopt_buildMeshlets keeps each triangle's vertices in order but not its number.
-struct TriangleKey {
+// A triangle's three vertex numbers and its input number: sorted by vertices (then number),
+// they find which input triangle a meshlet triangle is (meshopt_buildMeshlets keeps each
+// triangle's vertices in order but not its number).
+struct NumberedTriangle {
     std::uint32_t v[3];
-    bool operator==(const TriangleKey& o) const { return v[0] == o.v[0] && v[1] == o.v[1] && v[2] == o.v[2]; }
-};
-struct TriangleKeyHash {
-    std::size_t operator()(const TriangleKey& k) const {
-        return std::size_t(k.v[0]) * 0x9E3779B97F4A7C15ull ^ std::size_t(k.v[1]) * 0xC2B2AE3D27D4EB4Full ^ std::size_t(k.v[2]);
+    std::uint32_t number;
+    bool same_vertices(const NumberedTriangle& o) const { return v[0] == o.v[0] && v[1] == o.v[1] && v[2] == o.v[2]; }
+    bool operator<(const NumberedTriangle& o) const {
+        return std::tie(v[0], v[1], v[2], number) < std::tie(o.v[0], o.v[1], o.v[2], o.number);
     }
 };
 
@@ -63,11 +64,14 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
     meshlets.resize(meshopt_buildMeshlets(meshlets.data(), meshlet_vertices.data(), meshlet_triangles.data(), indices, index_count,
                                           finite.data(), vertex_count, 3 * sizeof(float), limits.max_vertices, limits.max_triangles, 0.0f));
 
-    // The input triangles by their vertices, several per key when a mesh repeats a triangle.
-    std::unordered_map<TriangleKey, std::vector<std::uint32_t>, TriangleKeyHash> triangle_of;
-    triangle_of.reserve(triangle_count);
-    for (std::size_t t = triangle_count; t-- > 0;)  // reversed: each list hands out its first triangle first
-        triangle_of[{{indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]}}].push_back(std::uint32_t(t));
+    // The input triangles sorted by their vertices (a repeated triangle: its copies in input
+    // order), each handed out once. One sorted array rather than a list per triangle: the
+    // scene culler builds the clusters of every occluder at load time.
+    std::vector<NumberedTriangle> by_vertices(triangle_count);
+    for (std::size_t t = 0; t < triangle_count; ++t)
+        by_vertices[t] = {{indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]}, std::uint32_t(t)};
+    std::sort(by_vertices.begin(), by_vertices.end());
+    std::vector<std::uint32_t> handed_out(triangle_count, 0);  // at a run's first entry: how many of the run are taken
 
     out.indices.reserve(index_count);
     out.shared_edges.reserve(triangle_count);
@@ -102,11 +106,13 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         local.assign(meshlet_triangles.begin() + m.triangle_offset, meshlet_triangles.begin() + m.triangle_offset + 3 * m.triangle_count);
         originals.clear();
         for (unsigned t = 0; t < m.triangle_count; ++t) {
-            const TriangleKey key{{vertices[local[3 * t]], vertices[local[3 * t + 1]], vertices[local[3 * t + 2]]}};
-            const auto same = triangle_of.find(key);
-            if (same == triangle_of.end() || same->second.empty()) fail("meshoptimizer changed a triangle (internal error)");
-            originals.push_back(same->second.back());
-            same->second.pop_back();
+            const NumberedTriangle key{{vertices[local[3 * t]], vertices[local[3 * t + 1]], vertices[local[3 * t + 2]]}, 0};
+            const std::size_t run = std::size_t(std::lower_bound(by_vertices.begin(), by_vertices.end(), key) - by_vertices.begin());
+            const std::size_t next = run + handed_out[run < triangle_count ? run : 0];
+            if (run == triangle_count || next == triangle_count || !by_vertices[next].same_vertices(key))
+                fail("meshoptimizer changed a triangle (internal error)");
+            ++handed_out[run];
+            originals.push_back(by_vertices[next].number);
         }
         append(vertices, local, originals);
     }
