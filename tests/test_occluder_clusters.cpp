@@ -110,6 +110,20 @@ TEST(OccluderClusters, KeepEveryTriangleWithItsVerticesAndFlags) {
     }
 }
 
+// A mesh that repeats a triangle (three copies with different flags, among others): every
+// input triangle is in the clusters exactly once, with its own flags (source_triangles names it).
+TEST(OccluderClusters, RepeatedTrianglesAreEachKeptOnce) {
+    const std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0};
+    const std::vector<std::uint32_t> indices = {0, 1, 2, 1, 3, 2, 0, 1, 2, 1, 4, 3, 0, 1, 2};
+    const std::vector<std::uint8_t> flags = {1, 2, 3, 4, 5};
+    const OccluderClusters clusters = build_occluder_clusters(positions.data(), 3 * sizeof(float), 5, indices.data(), 5, flags.data());
+    std::vector<std::uint32_t> sources = clusters.source_triangles;
+    std::sort(sources.begin(), sources.end());
+    EXPECT_EQ(sources, (std::vector<std::uint32_t>{0, 1, 2, 3, 4}));
+    for (std::size_t t = 0; t < clusters.source_triangles.size(); ++t)
+        EXPECT_EQ(clusters.shared_edges[t], flags[clusters.source_triangles[t]]);
+}
+
 TEST(OccluderClusters, BadInputIsAnErrorOrADefinedResult) {
     const std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
     const std::vector<std::uint32_t> indices = {0, 1, 2, 2, 1, 3};
