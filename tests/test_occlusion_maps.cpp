@@ -43,9 +43,11 @@ ScreenRect pixel_rect(int width, int height, double x0, double y0, double x1, do
             float(1.0 - y0 / height * 2.0), w};
 }
 
-OcclusionBuffer buffer_of(int width, int height, int samples, const Occluders& occluders) {
+OcclusionBuffer buffer_of(int width, int height, int samples, const Occluders& occluders, DrawOrder order = DrawOrder::nearest_first) {
     OcclusionBuffer buffer(test::buffer_config(width, height, samples, 0.5f));
-    if (!occluders.xyzw.empty()) buffer.render(occluders.input());
+    TriangleInput in = occluders.input();
+    in.order = order;
+    if (!occluders.xyzw.empty()) buffer.render(in);
     return buffer;
 }
 
@@ -295,12 +297,14 @@ TEST(OcclusionMaps, RectanglesOfOneOccludeeShareTheHoleBudget) {
 // of it, at w = 2, a panel over the left half of the column's samples. An occludee at w = 5
 // over that column is visible through the right halves. The no-background Z-buffer keeps each
 // pixel's nearest depth and hides it: it is not conservative. Every other depth test keeps it
-// visible.
+// visible. The wall is drawn first (DrawOrder::as_given), so that the buffer keeps the panel as
+// a working layer in front of it; drawn nearest first, the wall fills the panel's layer and it
+// becomes one layer at the wall's depth, which no depth test could misread.
 TEST(OcclusionMaps, NearestDepthZBufferIsNotConservativeWithPartialCoverage) {
     Occluders o{16, 16, {}, {}};
     o.add(0, 0, 16, 16, 10.0f);
     o.add(0, 0, 8.5, 16, 2.0f);
-    const OcclusionBuffer buffer = buffer_of(16, 16, 4, o);
+    const OcclusionBuffer buffer = buffer_of(16, 16, 4, o, DrawOrder::as_given);
     const ScreenRect column = pixel_rect(16, 16, 8, 0, 9, 16, 5.0f);
     for (DepthTest depth : {DepthTest::masked, DepthTest::hzb, DepthTest::nbz, DepthTest::plane, DepthTest::deb}) {
         OcclusionMaps maps(buffer, maps_config(buffer, depth));

@@ -1,6 +1,8 @@
 // Workload S1 (../shared/workloads/s1): no false culls against an exact double-precision
 // depth at the same sample centres, and no more missed culls than Intel MOC (DESIGN.md:
-// 3.6 % of hidden rectangles at 1080p, 17.6 % at 360p).
+// 3.6 % of hidden rectangles at 1080p, 17.6 % at 360p). Drawn nearest first (the default
+// DrawOrder), homcull misses 1.44 % and 3.51 %; the test allows 2 % and 5 %, so that losing the
+// draw order (3.48 % and 15.9 % in S1's own order) fails it.
 #include "support.hpp"
 
 #include <homcull/io/workload_s1.hpp>
@@ -34,10 +36,10 @@ TEST(S1Accuracy, NoFalseCullsAndFewerMissesThanMoc) {
     const WorkloadS1 s1 = load_workload_s1(folder);
     const RectAccuracy high = measure(s1, 480, 270, 4);  // the samples of a 1920x1080 display
     EXPECT_EQ(high.false_culls, 0u);
-    EXPECT_LE(double(high.missed_culls), 0.036 * double(high.truly_hidden));
+    EXPECT_LE(double(high.missed_culls), 0.02 * double(high.truly_hidden));
     const RectAccuracy low = measure(s1, 640, 360, 1);
     EXPECT_EQ(low.false_culls, 0u);
-    EXPECT_LE(double(low.missed_culls), 0.176 * double(low.truly_hidden));
+    EXPECT_LE(double(low.missed_culls), 0.05 * double(low.truly_hidden));
 }
 
 // The oracle itself on bad input: errors for a bad grid or vertex, defined answers for any

@@ -2,6 +2,7 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include "core/render_bands.hpp"
+#include "raster/draw_order.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 
@@ -190,8 +191,13 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     if (clear_first) stats_ = RasterStats{};
     detail::VertexClip storage;
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;
-    if (parallel.run) render_binned(in, parallel, cache, clear_first);
-    else render_serial(in, cache, clear_first);
+    // Nearest first (TriangleInput::order): the sorted copy has the same vertices, so the cache
+    // serves it too.
+    if (!draw_order_) draw_order_ = std::make_unique<detail::DrawOrderScratch>();
+    TriangleInput sorted;
+    const TriangleInput& drawn = detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted) ? sorted : in;
+    if (parallel.run) render_binned(drawn, parallel, cache, clear_first);
+    else render_serial(drawn, cache, clear_first);
 }
 
 // One thread: each triangle is rasterized over the whole buffer as soon as it is set up, in

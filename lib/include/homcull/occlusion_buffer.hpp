@@ -42,6 +42,7 @@ struct SubtileView;
 struct RasterTarget;
 struct VertexClip;
 struct RasterTriangle;
+struct DrawOrderScratch;
 }  // namespace detail
 
 enum class Backface : std::uint8_t {
@@ -108,6 +109,18 @@ struct RasterStats {
     }
 };
 
+// The order one render call draws its triangles in. The buffer keeps what is drawn first best:
+// a triangle behind what is already drawn is skipped before its rows are computed, and a
+// layer of near samples takes the farther triangles behind it rather than being dropped for
+// them. nearest_first (the default) therefore sorts each call's triangles by their nearest
+// vertex before drawing them (raster/draw_order.hpp): on workload S1, whose triangles come in
+// random depth order, that renders faster and culls more (docs/occlusion-buffer.md, "Draw
+// order"). It costs a pass over the vertices and a sorted copy of the indices (or, without
+// indices, of the positions), kept by the buffer. as_given draws the triangles as they come,
+// for inputs already sorted. The order, and so the bits, are the same on every instruction
+// set and with any job system.
+enum class DrawOrder : std::uint8_t { nearest_first, as_given };
+
 // Vertex input as engines have it: positions (x, y, z, or x, y, z, w as floats) every
 // `stride` bytes, and triangles as 16- or 32-bit index triples (or none: consecutive
 // vertices). Positions are multiplied by model_to_clip as (x, y, z, 1) or (x, y, z, w).
@@ -134,6 +147,7 @@ struct TriangleInput {
     // a sample within rounding of it may be covered. Deciding "shared" per view needs the
     // neighbour's orientation at render time (planned).
     const std::uint8_t* shared_edges = nullptr;
+    DrawOrder order = DrawOrder::nearest_first;
 };
 
 // Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
@@ -363,6 +377,7 @@ private:
     std::vector<std::uint64_t> band_updated_;
     std::vector<double> vertex_clip_;           // four planes of vertex_count + padding
     std::vector<std::uint8_t> vertex_outcode_;
+    std::unique_ptr<detail::DrawOrderScratch> draw_order_;  // raster/draw_order.hpp; made by the first render
     std::vector<ClusterPlace> cluster_places_;    // each input cluster's box this frame
     std::vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
     std::vector<RasterStats> band_stats_;

@@ -1,0 +1,225 @@
+#include "raster/draw_order.hpp"
+
+#include "raster/triangle_setup.hpp"
+
+#include <homcull/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+
+namespace homcull::detail {
+namespace {
+
+// A bucket per 2^kDrawOrderBucketShift float bits of w: 2^(23 - 17) = 64 buckets per doubling
+// of w, about 1.1 % of w each, from near_w up to 2^16 near_w (kDrawOrderBuckets - 1 buckets);
+// farther triangles share the bucket before the last, which holds those with an index out of
+// range or a w that is not a number. A fixed scale, not the input's range, so that a task can
+// bucket its triangles without waiting for the others.
+constexpr std::uint32_t kLastBucket = kDrawOrderBuckets - 1;
+static_assert(((kLastBucket - 1) >> (23 - kDrawOrderBucketShift)) == 15, "the scale reaches 2^16 near_w");
+
+std::uint32_t float_bits(float f) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    return bits;
+}
+
+// The bucket of a nearest clip w (not a NaN) in front of near_w > 0: from the bits of
+// float(max(w, near_w)), which increase with w for positive floats (+inf included).
+std::uint32_t depth_bucket(double w, std::uint32_t near_bits, double near_w) {
+    const std::uint32_t steps = (float_bits(float(std::max(w, near_w))) - near_bits) >> kDrawOrderBucketShift;
+    return std::min(steps, kLastBucket - 1);
+}
+
+// Clip w of a position (transform_to_clip's last row, the same operations), from 3 or 4
+// components.
+template <int kComponents>
+double clip_w(const std::array<float, 16>& m, const unsigned char* vertex) {
+    float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    std::memcpy(p, vertex, kComponents * sizeof(float));
+    return double(m[3]) * double(p[0]) + double(m[7]) * double(p[1]) + double(m[11]) * double(p[2]) + double(m[15]) * double(p[3]);
+}
+
+// Buckets triangles [begin, end) into bucket[t] and counts them per bucket into count[].
+// `w_of(v)` is vertex v's clip w.
+template <typename Index, typename W>
+void bucket_triangles(const Index* indices, std::size_t begin, std::size_t end, std::size_t vertex_count, double near_w, W&& w_of,
+                      std::uint16_t* bucket, std::uint32_t* count) {
+    const std::uint32_t near_bits = float_bits(float(near_w));
+    for (std::size_t t = begin; t < end; ++t) {
+        const std::uint32_t v0 = vertex_index(indices, t, 0), v1 = vertex_index(indices, t, 1), v2 = vertex_index(indices, t, 2);
+        std::uint32_t b = kLastBucket;
+        if (v0 < vertex_count && v1 < vertex_count && v2 < vertex_count) {
+            const double w0 = w_of(v0), w1 = w_of(v1), w2 = w_of(v2);
+            // (std::min would hide a NaN in its second argument.)
+            if (!std::isnan(w0) && !std::isnan(w1) && !std::isnan(w2)) b = depth_bucket(std::min(std::min(w0, w1), w2), near_bits, near_w);
+        }
+        bucket[t] = std::uint16_t(b);
+        ++count[b];
+    }
+}
+
+void bucket_range(const TriangleInput& in, const VertexClip* cache, double near_w, std::size_t begin, std::size_t end, std::uint16_t* bucket,
+                  std::uint32_t* count) {
+    // S1's kind of input (no indices, vertices packed): in float lanes, a triangle per lane.
+    const std::size_t packed = std::size_t(in.position_components) * sizeof(float);
+    if (!in.indices && in.position_stride == packed && reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0) {
+        const std::array<float, 16>& m = in.model_to_clip;
+        const float row[4] = {m[3], m[7], m[11], m[15]};
+        bucket_packed_soup(static_cast<const float*>(in.positions), in.position_components, begin, end, row, float(near_w), bucket, count);
+        return;
+    }
+    with_typed_indices(in, [&](const auto* indices) {
+        const unsigned char* positions = static_cast<const unsigned char*>(in.positions);
+        const std::size_t stride = in.position_stride;
+        const auto with = [&](auto&& w_of) { bucket_triangles(indices, begin, end, in.vertex_count, near_w, w_of, bucket, count); };
+        if (cache) with([&](std::uint32_t v) { return cache->w[v]; });
+        else if (in.position_components == 4) with([&](std::uint32_t v) { return clip_w<4>(in.model_to_clip, positions + v * stride); });
+        else with([&](std::uint32_t v) { return clip_w<3>(in.model_to_clip, positions + v * stride); });
+    });
+}
+
+// Copies each triangle t of [begin, end) to position start[c]++ of the sorted copy, c the depth
+// class of its bucket (sort_nearest_first): `copy(t, p)` copies one, with a size known at
+// compile time (a copy of run-time size went through a library call per triangle).
+template <typename Copy>
+void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bucket, const std::uint8_t* class_of, std::uint32_t* start,
+                     Copy&& copy) {
+    for (std::size_t t = begin; t < end; ++t) copy(t, std::size_t(start[class_of[bucket[t]]]++));
+}
+
+void place_range(const TriangleInput& in, std::size_t begin, std::size_t end, const std::uint16_t* bucket, const std::uint8_t* class_of,
+                 std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges) {
+    const auto place = [&](auto&& copy) {
+        if (shared_edges) {
+            place_triangles(begin, end, bucket, class_of, start, [&](std::size_t t, std::size_t p) {
+                copy(t, p);
+                shared_edges[p] = in.shared_edges[t];
+            });
+        } else {
+            place_triangles(begin, end, bucket, class_of, start, copy);
+        }
+    };
+    const unsigned char* positions = static_cast<const unsigned char*>(in.positions);
+    const std::size_t stride = in.position_stride;
+    // Without indices, each triangle's 3 vertices packed: 3 or 4 floats each.
+    const auto soup = [&](auto components) {
+        constexpr std::size_t kWords = decltype(components)::value;
+        if (stride == kWords * sizeof(float))
+            place([&](std::size_t t, std::size_t p) { std::memcpy(data + 3 * kWords * p, positions + 3 * t * stride, 3 * kWords * sizeof(float)); });
+        else
+            place([&](std::size_t t, std::size_t p) {
+                for (std::size_t k = 0; k < 3; ++k) std::memcpy(data + (3 * p + k) * kWords, positions + (3 * t + k) * stride, kWords * sizeof(float));
+            });
+    };
+    if (in.indices && in.indices_16bit) {
+        const auto* indices = static_cast<const std::uint16_t*>(in.indices);
+        auto* out = reinterpret_cast<std::uint16_t*>(data);
+        place([&](std::size_t t, std::size_t p) { std::memcpy(out + 3 * p, indices + 3 * t, 3 * sizeof(std::uint16_t)); });
+    } else if (in.indices) {
+        const auto* indices = static_cast<const std::uint32_t*>(in.indices);
+        place([&](std::size_t t, std::size_t p) { std::memcpy(data + 3 * p, indices + 3 * t, 3 * sizeof(std::uint32_t)); });
+    } else if (in.position_components == 4) {
+        soup(std::integral_constant<std::size_t, 4>{});
+    } else {
+        soup(std::integral_constant<std::size_t, 3>{});
+    }
+}
+
+}  // namespace
+
+bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
+                        DrawOrderScratch& scratch, TriangleInput& sorted) {
+    const std::size_t n = in.triangle_count;
+    if (in.order == DrawOrder::as_given || n == 0) return false;
+    if (n > std::size_t(std::numeric_limits<std::uint32_t>::max()))
+        throw Error("render: DrawOrder::nearest_first sorts at most 2^32 - 1 triangles per call; split the input or use DrawOrder::as_given");
+    // A counting sort in tasks of kDrawOrderTask triangles, in two passes:
+    // 1. each task buckets its triangles (fine buckets, about 1 % of w each) and counts them
+    //    per bucket;
+    // 2. the buckets, in order, are grouped into kDrawOrderClasses depth classes of about equal
+    //    counts, and every (class, task) gets its first position, classes in order and tasks in
+    //    order within a class; each task then copies its triangles there.
+    // Stable, so the order does not depend on the tasks. Few classes rather than every bucket:
+    // the copies then go to a few sequential streams instead of scattering over the whole copy
+    // (S1's render with 1,024 classes was slower than with none), and drawing S1 in 32 classes
+    // of depth is within 2 % of drawing it fully sorted (docs/occlusion-buffer.md, "Draw order").
+    const std::size_t tasks = (n + kDrawOrderTask - 1) / kDrawOrderTask;
+    const std::size_t words = in.indices ? (in.indices_16bit ? (3 * n + 1) / 2 : 3 * n) : 3 * n * std::size_t(in.position_components);
+    if (scratch.bucket.size() < n) scratch.bucket.resize(n);
+    if (scratch.data.size() < words) scratch.data.resize(words);
+    if (in.shared_edges && scratch.shared_edges.size() < n) scratch.shared_edges.resize(n);
+    if (scratch.count.size() < tasks * kDrawOrderBuckets) scratch.count.resize(tasks * kDrawOrderBuckets);
+    if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
+    std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
+
+    struct Job {
+        const TriangleInput* in;
+        const VertexClip* cache;
+        double near_w;
+        DrawOrderScratch* scratch;
+    } job{&in, cache, near_w, &scratch};
+    const auto run = [&](void (*task)(void*, std::size_t)) {
+        if (parallel.run && tasks > 1) parallel.run(parallel.user, tasks, task, &job);
+        else
+            for (std::size_t k = 0; k < tasks; ++k) task(&job, k);
+    };
+    run([](void* data, std::size_t k) {
+        const Job& j = *static_cast<Job*>(data);
+        bucket_range(*j.in, j.cache, j.near_w, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
+                     j.scratch->bucket.data(), j.scratch->count.data() + k * kDrawOrderBuckets);
+    });
+
+    // The classes: bad triangles (the last bucket) alone in the last class; the other buckets
+    // grouped into the classes before it, a new class starting after the bucket where the
+    // running count reaches its share, (c + 1) m / (kDrawOrderClasses - 1) for class c of m
+    // good triangles (a bucket is never split).
+    std::fill_n(scratch.start.begin(), tasks * kDrawOrderClasses, 0u);
+    std::uint64_t good = 0;
+    for (std::uint32_t b = 0; b < kLastBucket; ++b)
+        for (std::size_t k = 0; k < tasks; ++k) good += scratch.count[k * kDrawOrderBuckets + b];
+    constexpr std::uint32_t kGoodClasses = kDrawOrderClasses - 1;
+    std::uint64_t running = 0;
+    std::uint32_t c = 0;
+    for (std::uint32_t b = 0; b < kDrawOrderBuckets; ++b) {
+        if (b == kLastBucket) c = kGoodClasses;
+        scratch.class_of[b] = std::uint8_t(c);
+        for (std::size_t k = 0; k < tasks; ++k) {
+            const std::uint32_t count = scratch.count[k * kDrawOrderBuckets + b];
+            scratch.start[k * kDrawOrderClasses + c] += count;
+            running += count;
+        }
+        if (c + 1 < kGoodClasses && running * kGoodClasses >= std::uint64_t(c + 1) * good) ++c;
+    }
+    std::uint32_t sum = 0;
+    for (std::uint32_t cls = 0; cls < kDrawOrderClasses; ++cls)
+        for (std::size_t k = 0; k < tasks; ++k) {
+            std::uint32_t& s = scratch.start[k * kDrawOrderClasses + cls];
+            const std::uint32_t count = s;
+            s = sum;
+            sum += count;
+        }
+    run([](void* data, std::size_t k) {
+        const Job& j = *static_cast<Job*>(data);
+        DrawOrderScratch& s = *j.scratch;
+        place_range(*j.in, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(), s.class_of,
+                    s.start.data() + k * kDrawOrderClasses, s.data.data(), j.in->shared_edges ? s.shared_edges.data() : nullptr);
+    });
+
+    sorted = in;
+    sorted.order = DrawOrder::as_given;
+    sorted.shared_edges = in.shared_edges ? scratch.shared_edges.data() : nullptr;
+    if (in.indices) {
+        sorted.indices = scratch.data.data();
+    } else {
+        sorted.positions = scratch.data.data();
+        sorted.position_stride = std::size_t(in.position_components) * sizeof(float);
+        sorted.vertex_count = 3 * n;
+    }
+    return true;
+}
+
+}  // namespace homcull::detail
