@@ -6,6 +6,7 @@
 
 #include "core/rect_tests.hpp"
 #include "core/render_bands.hpp"
+#include "core/run_tasks.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 
@@ -59,9 +60,15 @@ void OcclusionBuffer::place_cluster(const OccluderCluster& c, std::uint32_t numb
         out.fate = ClusterPlace::kOutside;
 }
 
-void OcclusionBuffer::render(const ClusteredInput& input, const ParallelFor& parallel) { render_clusters(input, parallel, false); }
+void OcclusionBuffer::render(const ClusteredInput& input, const ParallelFor& parallel) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
+    render_clusters(input, parallel, false);
+}
 
-void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFor& parallel) { render_clusters(input, parallel, true); }
+void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFor& parallel) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
+    render_clusters(input, parallel, true);
+}
 
 void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
@@ -99,9 +106,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
         }
     };
     const std::size_t place_tasks = (count + kClustersPerPlacementTask - 1) / kClustersPerPlacementTask;
-    if (parallel.run && place_tasks > 1) parallel.run(parallel.user, place_tasks, place_task, &place_job);
-    else
-        for (std::size_t task = 0; task < place_tasks; ++task) place_task(&place_job, task);
+    detail::run_tasks(parallel, place_tasks, place_task, &place_job);
 
     // The clusters in view, in input order, then nearest first.
     placed_clusters_.clear();
@@ -183,7 +188,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
             OcclusionBuffer* self;
             bool clear_first;
         } job{&band_rows, &band_draws, &set_up, &cache_of, this, clear_first};
-        parallel.run(parallel.user, bands, [](void* data, std::size_t band) {
+        detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
             const Job& j = *static_cast<Job*>(data);
             OcclusionBuffer& b = *j.self;
             int row_begin, row_end;

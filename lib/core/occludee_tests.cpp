@@ -2,6 +2,7 @@
 // whose first, coarse stage runs in SIMD lanes: rect_tests_simd.cpp) and world boxes.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/float_mode.hpp"
 #include "core/min_pyramid.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
@@ -53,6 +54,7 @@ detail::SubtileView OcclusionBuffer::subtile_view() const {
 
 Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y,
                                                  float w_min) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     detail::RectQuery q;
     Visibility decided;
     if (!prepare(ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min, q, decided)) return decided;
@@ -64,6 +66,7 @@ Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_
 }
 
 Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     detail::RectQuery q;
     Visibility decided;
     if (!prepare(ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min, q, decided)) return decided;
@@ -153,6 +156,7 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
 }  // namespace detail
 
 Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
     if (!detail::box_rectangle(box_min, box_max, m, config_.near_w, r, decided)) return decided;
@@ -160,6 +164,7 @@ Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_ma
 }
 
 void OcclusionBuffer::test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     const detail::RectBlockKernel block = detail::selected_rect_block_kernel();
     if (!block) {  // the scalar reference
         for (std::size_t k = 0; k < count; ++k)
@@ -174,6 +179,7 @@ void OcclusionBuffer::test_rects(const ScreenRect* rects, std::size_t count, Vis
 }
 
 void OcclusionBuffer::test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& m, Visibility* results) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     constexpr std::size_t kBlock = 64;
     ScreenRect rects[kBlock];
     std::size_t index[kBlock];

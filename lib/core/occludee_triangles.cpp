@@ -14,6 +14,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/float_mode.hpp"
 #include "core/raised_vertex_plane.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
@@ -216,6 +217,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
 
 OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInput& in, std::uint64_t tolerated_samples,
                                                               std::size_t first_triangle) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     TriangleTest result;
     if (in.triangle_count == 0) return result;
     detail::check_triangle_input(in, "test_triangles");

@@ -2,6 +2,7 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include "core/render_bands.hpp"
+#include "core/run_tasks.hpp"
 #include "raster/draw_order.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
@@ -167,14 +168,13 @@ bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const Parallel
         const Job& j = *static_cast<Job*>(data);
         j.transform(*j.in, j.near_w, k * kVerticesPerTask, std::min(j.in->vertex_count, (k + 1) * kVerticesPerTask), *j.cache);
     };
-    if (parallel.run && tasks > 1) parallel.run(parallel.user, tasks, task, &job);
-    else
-        for (std::size_t k = 0; k < tasks; ++k) task(&job, k);
+    detail::run_tasks(parallel, tasks, task, &job);
     return true;
 }
 
 void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& parallel) {
     if (in.triangle_count == 0) return;
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     render_rows(in, parallel, false);
 }
 
@@ -183,6 +183,7 @@ void OcclusionBuffer::render_frame(const TriangleInput& in, const ParallelFor& p
         clear();
         return;
     }
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     render_rows(in, parallel, true);
 }
 
@@ -230,7 +231,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         bool clear_first;
     } job{this, &in, cache, chunk_count, bands, clear_first};
 
-    parallel.run(parallel.user, chunk_count, [](void* data, std::size_t c) {
+    detail::run_tasks(parallel, chunk_count, [](void* data, std::size_t c) {
         const Job& j = *static_cast<Job*>(data);
         Chunk& chunk = j.self->chunks_[c];
         chunk.stats = RasterStats{};
@@ -245,7 +246,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         });
     }, &job);
 
-    parallel.run(parallel.user, bands, [](void* data, std::size_t band) {
+    detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
         const Job& j = *static_cast<Job*>(data);
         OcclusionBuffer& b = *j.self;
         const int row_begin = int(band) * kBandSubtileRows, row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);

@@ -10,6 +10,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_maps.hpp>
 
+#include "core/float_mode.hpp"
 #include "core/opacity_pyramid.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
@@ -97,6 +98,7 @@ float OcclusionMaps::opacity(int k, int x, int y) const {
 }
 
 void OcclusionMaps::build(const OcclusionBuffer& buffer) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     if (buffer.config().width != width_ || buffer.config().height != height_ || buffer.config().samples != samples_)
         throw Error("occlusion maps: build() needs a buffer shaped like the one the maps were made for");
     // Level 0: per buffer pixel, its covered samples, and the farthest and nearest bound of
@@ -273,11 +275,13 @@ OccludeeAnswer decided_answer(Visibility v) {
 }  // namespace
 
 OccludeeAnswer OcclusionMaps::test_rect(const ScreenRect& rect) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     double budget = hole_budget();
     return test_rect_within(rect, budget);
 }
 
 OccludeeAnswer OcclusionMaps::test_rect_within(const ScreenRect& rect, double& budget) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     detail::RectQuery q;
     Visibility decided;
     if (!built().prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
@@ -297,6 +301,7 @@ OccludeeAnswer OcclusionMaps::test_rect_within(const ScreenRect& rect, double& b
 }
 
 OccludeeAnswer OcclusionMaps::test_aabb(const Aabb& box, const std::array<float, 16>& m) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
     if (!detail::box_rectangle(&box.min.x, &box.max.x, m, built().config().near_w, r, decided)) return decided_answer(decided);

@@ -16,6 +16,7 @@
 // In approximate mode holes are tolerated, and the depth maps ignore uncovered samples.
 #include <homcull/occlusion_maps.hpp>
 
+#include "core/float_mode.hpp"
 #include "core/min_pyramid.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
@@ -38,6 +39,7 @@ void OcclusionMaps::clear() { std::fill(deb_.begin(), deb_.end(), INFINITY); }
 // Zhang 6.2.1: the far rectangle of an occluder's box, the box's screen rectangle at its
 // farthest depth, lowers every depth estimation buffer cell it touches to that depth.
 void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16>& m) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     const int gw = config_.deb_width, gh = config_.deb_height;
     const int sample_width = width_ * samples_, sample_height = height_ * samples_;
     glm::dvec4 corners[8];

@@ -1,5 +1,7 @@
 #include "raster/draw_order.hpp"
 
+#include "core/run_tasks.hpp"
+
 #include "raster/triangle_setup.hpp"
 
 #include <homcull/error.hpp>
@@ -162,11 +164,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         double near_w;
         DrawOrderScratch* scratch;
     } job{&in, cache, near_w, &scratch};
-    const auto run = [&](void (*task)(void*, std::size_t)) {
-        if (parallel.run && tasks > 1) parallel.run(parallel.user, tasks, task, &job);
-        else
-            for (std::size_t k = 0; k < tasks; ++k) task(&job, k);
-    };
+    const auto run = [&](void (*task)(void*, std::size_t)) { run_tasks(parallel, tasks, task, &job); };
     run([](void* data, std::size_t k) {
         const Job& j = *static_cast<Job*>(data);
         bucket_range(*j.in, j.cache, j.near_w, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),

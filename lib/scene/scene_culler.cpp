@@ -3,6 +3,7 @@
 #include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 
+#include "core/float_mode.hpp"
 #include "scene/scene_culler_frame.hpp"
 
 #include <algorithm>
@@ -103,6 +104,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
 }
 
 void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     validate_camera(camera);
     // The near plane is the camera's: rebuild the buffer only when it changes.
     if (buffer_.config().near_w != float(camera.near_plane)) {
