@@ -1,6 +1,7 @@
 // The library computes in IEEE round-to-nearest with subnormals kept (core/float_mode.hpp),
 // whatever floating-point mode the calling thread or the job system's threads run in: the same
-// bits with flush-to-zero and denormals-are-zero set, and the caller's mode given back.
+// bits with flush-to-zero, denormals-are-zero or rounding toward zero set, and each thread's
+// mode given back.
 #include "core/float_mode.hpp"
 #include "support.hpp"
 
@@ -20,13 +21,21 @@ namespace {
 
 #if defined(__SSE2__) || defined(_M_X64)
 constexpr unsigned kFlushToZero = 0x8040u;  // FTZ and DAZ
+constexpr unsigned kTowardZero = 0x6000u;    // rounding toward zero
+constexpr unsigned kControl = 0xFFC0u;
 
 // A job system whose one worker thread runs in flush-to-zero (as oneTBB's workers did after
-// Embree's ray queries): every task of a call on that thread, in order.
+// Embree's ray queries): every task of a call on that thread, in order. It counts the tasks
+// after which the worker's own mode was not given back.
+std::size_t worker_mode_lost = 0;
 void run_on_flushing_thread(void* /* user */, std::size_t count, void (*task)(void*, std::size_t), void* data) {
     std::thread worker([&] {
         _mm_setcsr(_mm_getcsr() | kFlushToZero);
-        for (std::size_t i = 0; i < count; ++i) task(data, i);
+        const unsigned mode = _mm_getcsr() & kControl;
+        for (std::size_t i = 0; i < count; ++i) {
+            task(data, i);
+            worker_mode_lost += (_mm_getcsr() & kControl) != mode;
+        }
     });
     worker.join();
 }
@@ -44,9 +53,10 @@ struct Result {
     std::vector<Visibility> answers;
 };
 
-Result render_and_test(const ParallelFor& parallel, bool flush_on_caller) {
+// caller_mode: MXCSR control bits set on the calling thread for the calls (0: the default).
+Result render_and_test(const ParallelFor& parallel, unsigned caller_mode) {
     const unsigned before = _mm_getcsr();
-    if (flush_on_caller) _mm_setcsr(before | kFlushToZero);
+    _mm_setcsr(before | caller_mode);
     const std::vector<float> xyzw = far_triangle();
     TriangleInput in = test::clip_space_input(xyzw);
     in.model_to_clip = {1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f};
@@ -68,9 +78,12 @@ Result render_and_test(const ParallelFor& parallel, bool flush_on_caller) {
             Visibility batch;
             b->test_rects(&rect, 1, &batch);
             r.answers.push_back(batch);
+            // The same rectangle as a flat box, (x, y, z) -> clip (x, y, 0, z).
+            const Aabb box{glm::vec3(rect.ndc_min_x * w, rect.ndc_min_y * w, w), glm::vec3(rect.ndc_max_x * w, rect.ndc_max_y * w, w)};
+            b->test_aabbs(&box, 1, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0}, &batch);
+            r.answers.push_back(batch);
         }
-    EXPECT_EQ(_mm_getcsr() & 0xFFC0u, (flush_on_caller ? before | kFlushToZero : before) & 0xFFC0u)
-        << "the caller's mode is given back";
+    EXPECT_EQ(_mm_getcsr() & kControl, (before | caller_mode) & kControl) << "the caller's mode is given back";
     _mm_setcsr(before);
     return r;
 }
@@ -85,15 +98,19 @@ bool same(const Result& a, const Result& b) {
 }
 
 TEST(FloatMode, FlushToZeroOnTheCallerOrTheJobSystemChangesNoBit) {
-    const Result reference = render_and_test({}, false);
-    // The wall hides the rectangles behind it (w = 3e38 and 3.4e38) and no other.
-    const std::vector<Visibility> behind_wall(reference.answers.end() - 12, reference.answers.end());
-    for (std::size_t k = 0; k < 12; ++k)
-        EXPECT_EQ(behind_wall[k], k >= 8 ? Visibility::occluded : Visibility::visible) << "rectangle " << k / 2 << " of the wall";
-    EXPECT_TRUE(same(render_and_test({}, true), reference)) << "flush-to-zero on the calling thread";
-    EXPECT_TRUE(same(render_and_test(ParallelFor{run_on_flushing_thread, nullptr}, false), reference))
-        << "flush-to-zero on the job system's thread";
-    EXPECT_TRUE(same(render_and_test(ParallelFor{run_on_flushing_thread, nullptr}, true), reference)) << "flush-to-zero on both";
+    const ParallelFor flushing{run_on_flushing_thread, nullptr};
+    const Result reference = render_and_test({}, 0);
+    // The wall hides the rectangles behind it (w = 3e38 and 3.4e38) and no other: 6 rectangles,
+    // each tested as a rectangle, in a batch and as a box.
+    const std::vector<Visibility> behind_wall(reference.answers.end() - 18, reference.answers.end());
+    for (std::size_t k = 0; k < 18; ++k)
+        EXPECT_EQ(behind_wall[k], k >= 12 ? Visibility::occluded : Visibility::visible) << "rectangle " << k / 3 << " of the wall";
+    EXPECT_TRUE(same(render_and_test({}, kFlushToZero), reference)) << "flush-to-zero on the calling thread";
+    EXPECT_TRUE(same(render_and_test({}, kTowardZero), reference)) << "rounding toward zero on the calling thread";
+    worker_mode_lost = 0;
+    EXPECT_TRUE(same(render_and_test(flushing, 0), reference)) << "flush-to-zero on the job system's thread";
+    EXPECT_TRUE(same(render_and_test(flushing, kFlushToZero | kTowardZero), reference)) << "on both";
+    EXPECT_EQ(worker_mode_lost, 0u) << "the job system's threads get their mode back after each task";
 }
 #else
 TEST(FloatMode, FlushToZeroOnTheCallerOrTheJobSystemChangesNoBit) { GTEST_SKIP() << "x86 only (MXCSR)"; }

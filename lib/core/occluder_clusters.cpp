@@ -1,6 +1,8 @@
 #include <homcull/error.hpp>
 #include <homcull/occluder_clusters.hpp>
 
+#include "core/float_mode.hpp"
+
 #include <meshoptimizer.h>
 
 #include <algorithm>
@@ -30,6 +32,7 @@ struct NumberedTriangle {
 OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                                          const std::uint32_t* indices, std::size_t triangle_count, const std::uint8_t* shared_edges,
                                          const ClusterLimits& limits) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     const auto fail = [](const std::string& why) { throw Error("build_occluder_clusters: " + why); };
     if (limits.max_vertices < 3 || limits.max_vertices > 255) fail("max_vertices must be in [3, 255]");
     if (limits.max_triangles < 4 || limits.max_triangles > 512 || limits.max_triangles % 4 != 0)

@@ -1,6 +1,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/float_mode.hpp"
 #include "core/render_bands.hpp"
 #include "core/run_tasks.hpp"
 #include "raster/draw_order.hpp"
@@ -10,6 +11,7 @@
 #include <hwy/cache_control.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 
 namespace homcull {
@@ -189,6 +191,8 @@ void OcclusionBuffer::render_frame(const TriangleInput& in, const ParallelFor& p
 
 void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first) {
     detail::check_triangle_input(in, "render");
+    if (in.order == DrawOrder::nearest_first && in.triangle_count > std::numeric_limits<std::uint32_t>::max())
+        throw Error("render: DrawOrder::nearest_first sorts at most 2^32 - 1 triangles per call; split the input or use DrawOrder::as_given");
     if (clear_first) stats_ = RasterStats{};
     detail::VertexClip storage;
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;
@@ -292,6 +296,7 @@ void OcclusionBuffer::read_coverage(std::vector<std::uint8_t>& covered) const {
 }
 
 void OcclusionBuffer::read_depth(std::vector<float>& w) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     w.assign(std::size_t(sample_width_) * std::size_t(sample_height_), INFINITY);
     for (int y = 0; y < sample_height_; ++y)
         for (int x = 0; x < sample_width_; ++x) {
@@ -315,6 +320,7 @@ void OcclusionBuffer::read_sample_depth(std::vector<float>& d) const {
 }
 
 std::array<float, 16> clip_from_world(const Camera& camera, double aspect) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     const glm::dmat4 m = projection_matrix(camera, aspect) * view_matrix(camera);
     std::array<float, 16> out{};
     for (int c = 0; c < 4; ++c)

@@ -27,6 +27,7 @@ constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtil
 }  // namespace
 
 OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config) : config_(config) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     const BufferConfig& b = buffer.config();
     width_ = b.width;
     height_ = b.height;
@@ -93,6 +94,7 @@ std::uint32_t OcclusionMaps::cell_samples(int k, int x, int y) const {
 }
 
 float OcclusionMaps::opacity(int k, int x, int y) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     const Level& l = levels_[std::size_t(k)];
     return float(covered_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)]) / float(cell_samples(k, x, y));
 }
@@ -260,7 +262,10 @@ void OcclusionMaps::overlap(int i0, int i1, int j0, int j1, double budget, Occlu
     uncovered = budget - q.budget;
 }
 
-double OcclusionMaps::hole_budget() const { return std::floor(config_.hole_pixels * samples_per_display_pixel_); }
+double OcclusionMaps::hole_budget() const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
+    return std::floor(config_.hole_pixels * samples_per_display_pixel_);
+}
 
 namespace {
 

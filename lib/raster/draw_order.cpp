@@ -32,7 +32,9 @@ std::uint32_t float_bits(float f) {
 // The bucket of a nearest clip w (not a NaN) in front of near_w > 0: from the bits of
 // float(max(w, near_w)), which increase with w for positive floats (+inf included).
 std::uint32_t depth_bucket(double w, std::uint32_t near_bits, double near_w) {
-    const std::uint32_t steps = (float_bits(float(std::max(w, near_w))) - near_bits) >> kDrawOrderBucketShift;
+    // Clamped to the largest float first: converting a larger double to float is undefined.
+    const double clamped = std::min(std::max(w, near_w), double(std::numeric_limits<float>::max()));
+    const std::uint32_t steps = (float_bits(float(clamped)) - near_bits) >> kDrawOrderBucketShift;
     return std::min(steps, kLastBucket - 1);
 }
 
@@ -66,21 +68,32 @@ void bucket_triangles(const Index* indices, std::size_t begin, std::size_t end, 
 
 void bucket_range(const TriangleInput& in, const VertexClip* cache, double near_w, std::size_t begin, std::size_t end, std::uint16_t* bucket,
                   std::uint32_t* count) {
-    // S1's kind of input (no indices, vertices packed): in float lanes, a triangle per lane.
-    const std::size_t packed = std::size_t(in.position_components) * sizeof(float);
-    if (!in.indices && in.position_stride == packed && reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0) {
-        const std::array<float, 16>& m = in.model_to_clip;
-        const float row[4] = {m[3], m[7], m[11], m[15]};
-        bucket_packed_soup(static_cast<const float*>(in.positions), in.position_components, begin, end, row, float(near_w), bucket, count);
+    // Without a cache, in float lanes, a triangle per lane: S1's kind of input (no indices,
+    // vertices packed), and indexed inputs whose positions are floats that 32-bit offsets reach.
+    // (Which pass an input takes depends only on the input, so its order is the same on every
+    // instruction set and with any job system.)
+    const std::array<float, 16>& m = in.model_to_clip;
+    const float row[4] = {m[3], m[7], m[11], m[15]};
+    const auto* positions = static_cast<const float*>(in.positions);
+    const bool float_aligned = reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0 && in.position_stride % sizeof(float) == 0;
+    const std::size_t stride = in.position_stride / sizeof(float);
+    if (!cache && !in.indices && float_aligned && stride == std::size_t(in.position_components)) {
+        bucket_packed_soup(positions, in.position_components, begin, end, row, float(near_w), bucket, count);
         return;
     }
+    if (!cache && in.indices && float_aligned && in.vertex_count > 0 && in.vertex_count <= (std::size_t(1) << 31) / stride) {
+        bucket_indexed(positions, stride, in.position_components, in.indices, in.indices_16bit, in.vertex_count, begin, end, row, float(near_w),
+                       bucket, count);
+        return;
+    }
+    // Otherwise in double: from the vertex cache, or transformed here.
     with_typed_indices(in, [&](const auto* indices) {
-        const unsigned char* positions = static_cast<const unsigned char*>(in.positions);
-        const std::size_t stride = in.position_stride;
+        const unsigned char* bytes = static_cast<const unsigned char*>(in.positions);
+        const std::size_t byte_stride = in.position_stride;
         const auto with = [&](auto&& w_of) { bucket_triangles(indices, begin, end, in.vertex_count, near_w, w_of, bucket, count); };
         if (cache) with([&](std::uint32_t v) { return cache->w[v]; });
-        else if (in.position_components == 4) with([&](std::uint32_t v) { return clip_w<4>(in.model_to_clip, positions + v * stride); });
-        else with([&](std::uint32_t v) { return clip_w<3>(in.model_to_clip, positions + v * stride); });
+        else if (in.position_components == 4) with([&](std::uint32_t v) { return clip_w<4>(in.model_to_clip, bytes + v * byte_stride); });
+        else with([&](std::uint32_t v) { return clip_w<3>(in.model_to_clip, bytes + v * byte_stride); });
     });
 }
 

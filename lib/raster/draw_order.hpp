@@ -42,18 +42,6 @@ struct DrawOrderScratch {
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 
-// When in.order is DrawOrder::nearest_first, sorts the input's triangles into kDrawOrderClasses
-// classes by the smallest clip w of their three vertices (from `cache` when there is one,
-// else transformed here in double as transform_to_clip does), each class in input order, and
-// returns true with `sorted` the same
-// triangles in that order: the same positions with sorted indices, or without indices sorted
-// copies of each triangle's positions (3 or 4 components, packed); shared-edge flags follow
-// their triangles, and `sorted` draws as given. A copy rather than a list of numbers: the
-// setup then reads its input front to back (reading S1's triangles through a sorted list of
-// numbers cost 1.9 ms of an 8.8 ms render on two threads). Triangles with an index out of range
-// or a coordinate that is not a number come last; those reaching in front of near_w (> 0)
-// first. Returns false, with nothing computed, for DrawOrder::as_given. Runs in tasks of
-// `parallel` when it has a job system. `sorted` points into `scratch`.
 // The first pass of the sort for an input without indices whose vertices are packed 3 or 4
 // floats: the bucket of each triangle of [begin, end) into bucket[t], counted into count[].
 // In float lanes (draw_order_simd.cpp), the same on every instruction set; row is the
@@ -61,6 +49,34 @@ static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 void bucket_packed_soup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
                         std::uint16_t* bucket, std::uint32_t* count);
 
+// The same for an indexed input, its positions gathered `stride` floats apart (stride *
+// vertex_count <= 2^31, vertex_count > 0); a triangle with an index out of range takes the
+// last bucket.
+void bucket_indexed(const float* positions, std::size_t stride, int components, const void* indices, bool indices_16bit,
+                    std::size_t vertex_count, std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
+                    std::uint32_t* count);
+
+// When in.order is DrawOrder::nearest_first, sorts the input's triangles into kDrawOrderClasses
+// classes by the smallest clip w of their three vertices, each class in input order, and
+// returns true with `sorted` the same triangles in that order: the same positions with sorted
+// indices, or without indices sorted copies of each triangle's positions (3 or 4 components,
+// packed); shared-edge flags follow their triangles, and `sorted` draws as given.
+//
+// The clip w comes from `cache` (double) when there is one; else it is computed in float lanes
+// (bucket_packed_soup, bucket_indexed) when the positions are float-aligned (address and
+// stride) and, without indices, packed; else in double as transform_to_clip computes it. Which
+// of these an input takes depends on the input alone (the cache on use_vertex_cache; the lanes
+// on its layout and address), never on the instruction set or the job system, so neither does
+// the order; but the same triangles at another address or stride may be ordered apart at a
+// bucket's edge.
+//
+// A copy rather than a list of numbers: the setup then reads its input front to back (reading
+// S1's triangles through a sorted list of numbers cost 1.9 ms of an 8.8 ms render on two
+// threads). Triangles with an index out of range or a coordinate that is not a number come
+// last; those reaching in front of near_w (> 0) first. Returns false, with nothing computed,
+// for DrawOrder::as_given. Runs in tasks of `parallel` when it has a job system. `sorted`
+// points into `scratch`. Throws homcull::Error for 2^32 triangles or more (render checks this
+// before it changes anything).
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted);
 

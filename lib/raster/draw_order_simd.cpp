@@ -1,6 +1,6 @@
-// The SIMD kernel of the draw order's first pass (draw_order.cpp) for the common input without
-// indices whose vertices are packed 3 or 4 floats (workload S1): each triangle's nearest clip w
-// in float lanes, one triangle per lane, and its bucket. Every target makes the same float
+// The SIMD kernels of the draw order's first pass (draw_order.cpp): each triangle's nearest
+// clip w in float lanes, one triangle per lane, and its bucket, for inputs without indices whose
+// vertices are packed 3 or 4 floats (workload S1), and for indexed inputs (positions gathered). Every target makes the same float
 // operations in the same order (no fused multiply-add), so every target gives the same buckets;
 // the order does not depend on the instruction set.
 #undef HWY_TARGET_INCLUDE
@@ -83,6 +83,66 @@ void BucketPackedSoup(const float* positions, int components, std::size_t begin,
     else BucketSoup<3>(positions, begin, end, row, near_w, bucket, count);
 }
 
+// Buckets triangles [begin, end) of an indexed input, a triangle per lane: its three vertex
+// numbers (a lane with one out of range takes the last bucket and reads vertex 0), their
+// positions gathered `stride` floats apart (3 or 4 components; stride * vertex_count < 2^31,
+// vertex_count > 0).
+template <typename Index>
+HWY_INLINE void BucketIndexedTyped(const float* positions, std::size_t stride, int components, const Index* indices, std::size_t vertex_count,
+                                   std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
+                                   std::uint32_t* count) {
+    const hn::CappedTag<float, 16> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::RebindToUnsigned<decltype(df)> du;
+    constexpr std::size_t kMaxLanes = 16;
+    const std::size_t lanes = hn::Lanes(df);
+    const auto m0 = hn::Set(df, row[0]), m1 = hn::Set(df, row[1]), m2 = hn::Set(df, row[2]), m3 = hn::Set(df, row[3]);
+    const auto near = hn::Set(df, near_w), one = hn::Set(df, 1.0f);
+    const auto stride_v = hn::Set(di, std::int32_t(stride));
+    HWY_ALIGN std::int32_t index[3 * kMaxLanes];
+    HWY_ALIGN std::uint32_t valid[kMaxLanes], out[kMaxLanes];
+    for (std::size_t t = begin; t < end; t += lanes) {
+        const std::size_t n = std::min(lanes, end - t);
+        for (std::size_t i = 0; i < lanes; ++i) {
+            bool ok = i < n;
+            for (std::size_t k = 0; k < 3; ++k) {
+                const std::size_t v = ok ? std::size_t(indices[3 * (t + i) + k]) : 0;
+                ok = ok && v < vertex_count;
+                index[3 * i + k] = std::int32_t(v < vertex_count ? v : 0);
+            }
+            valid[i] = ok ? ~0u : 0u;
+        }
+        hn::Vec<decltype(di)> i0, i1, i2;
+        hn::LoadInterleaved3(di, index, i0, i1, i2);
+        // Clip w of each lane's vertex k: ((m3 x + m7 y) + m11 z) + m15 w.
+        const auto clip_w = [&](hn::Vec<decltype(di)> vertex) {
+            const auto at = hn::Mul(vertex, stride_v);
+            const auto x = hn::GatherIndex(df, positions, at), y = hn::GatherIndex(df, positions + 1, at);
+            const auto z = hn::GatherIndex(df, positions + 2, at);
+            const auto w = components == 4 ? hn::GatherIndex(df, positions + 3, at) : one;
+            return hn::Add(hn::Add(hn::Add(hn::Mul(m0, x), hn::Mul(m1, y)), hn::Mul(m2, z)), hn::Mul(m3, w));
+        };
+        const auto buckets = Buckets(df, clip_w(i0), clip_w(i1), clip_w(i2), near);
+        const auto ok = hn::Ne(hn::Load(du, valid), hn::Zero(du));
+        hn::Store(hn::IfThenElse(ok, buckets, hn::Set(du, kDrawOrderBuckets - 1)), du, out);
+        for (std::size_t i = 0; i < n; ++i) {
+            bucket[t + i] = std::uint16_t(out[i]);
+            ++count[out[i]];
+        }
+    }
+}
+
+void BucketIndexed(const float* positions, std::size_t stride, int components, const void* indices, bool indices_16bit,
+                   std::size_t vertex_count, std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
+                   std::uint32_t* count) {
+    if (indices_16bit)
+        BucketIndexedTyped(positions, stride, components, static_cast<const std::uint16_t*>(indices), vertex_count, begin, end, row, near_w,
+                           bucket, count);
+    else
+        BucketIndexedTyped(positions, stride, components, static_cast<const std::uint32_t*>(indices), vertex_count, begin, end, row, near_w,
+                           bucket, count);
+}
+
 }  // namespace homcull::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -92,10 +152,18 @@ HWY_AFTER_NAMESPACE();
 namespace homcull::detail {
 
 HWY_EXPORT(BucketPackedSoup);
+HWY_EXPORT(BucketIndexed);
 
 void bucket_packed_soup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
                         std::uint16_t* bucket, std::uint32_t* count) {
     HOMCULL_RESOLVED_KERNEL(BucketPackedSoup)(positions, components, begin, end, row, near_w, bucket, count);
+}
+
+void bucket_indexed(const float* positions, std::size_t stride, int components, const void* indices, bool indices_16bit,
+                    std::size_t vertex_count, std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
+                    std::uint32_t* count) {
+    HOMCULL_RESOLVED_KERNEL(BucketIndexed)(positions, stride, components, indices, indices_16bit, vertex_count, begin, end, row, near_w,
+                                           bucket, count);
 }
 
 }  // namespace homcull::detail

@@ -2,6 +2,8 @@
 
 #include <homcull/error.hpp>
 
+#include "core/float_mode.hpp"
+
 #include <algorithm>
 #include <array>
 #include <limits>
@@ -106,6 +108,7 @@ struct Builder {
 }  // namespace
 
 ObjectHierarchy ObjectHierarchy::build(const Scene& scene, int leaf_size) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     if (leaf_size < 1) throw Error("object hierarchy: leaf_size must be at least 1");
     ObjectHierarchy h;
     Builder b{scene, leaf_size, h, std::vector<glm::vec3>(scene.objects.size())};

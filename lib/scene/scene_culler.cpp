@@ -63,6 +63,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
       hierarchy_(ObjectHierarchy::build(scene, config.hierarchy_leaf_size)),
       buffer_(scene_buffer_config(config, 0.1f)),
       maps_(buffer_, maps_config(config)) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     if (config.strategy == CullStrategy::progressive && config.progressive_batch_triangles == 0)
         throw Error("progressive culling needs a batch of at least one triangle");
     if (config.occluder_budget.ranking == OccluderRanking::baked && !config.occluder_budget.grid)

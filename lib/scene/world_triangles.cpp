@@ -1,5 +1,7 @@
 #include <homcull/world_triangles.hpp>
 
+#include "core/float_mode.hpp"
+
 namespace homcull {
 
 TriangleInput WorldTriangles::input(const std::array<float, 16>& clip_from_world, Backface backface) const {
@@ -22,6 +24,7 @@ void append_world_positions(const Scene& scene, const Object& object, std::vecto
 }
 
 WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     WorldTriangles out;
     for (std::uint32_t id : objects) {
         const Object& object = scene.objects.at(id);

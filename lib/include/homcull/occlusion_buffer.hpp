@@ -118,7 +118,7 @@ struct RasterStats {
 // order"). It costs a pass over the vertices and a sorted copy of the indices (or, without
 // indices, of the positions), kept by the buffer. as_given draws the triangles as they come,
 // for inputs already sorted. The order, and so the bits, are the same on every instruction
-// set and with any job system.
+// set and with any job system. nearest_first takes at most 2^32 - 1 triangles per call.
 enum class DrawOrder : std::uint8_t { nearest_first, as_given };
 
 // Vertex input as engines have it: positions (x, y, z, or x, y, z, w as floats) every
