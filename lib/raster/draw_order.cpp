@@ -38,13 +38,12 @@ std::uint32_t depth_bucket(double w, std::uint32_t near_bits, double near_w) {
     return std::min(steps, kLastBucket - 1);
 }
 
-// Clip w of a position (transform_to_clip's last row, the same operations), from 3 or 4
-// components.
+// Clip w of a position of 3 or 4 components (transform_to_clip; its other rows are dead code).
 template <int kComponents>
 double clip_w(const std::array<float, 16>& m, const unsigned char* vertex) {
     float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     std::memcpy(p, vertex, kComponents * sizeof(float));
-    return double(m[3]) * double(p[0]) + double(m[7]) * double(p[1]) + double(m[11]) * double(p[2]) + double(m[15]) * double(p[3]);
+    return transform_to_clip(m, p[0], p[1], p[2], p[3]).w;
 }
 
 // Buckets triangles [begin, end) into bucket[t] and counts them per bucket into count[].
