@@ -250,7 +250,7 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f), w(0.2f, 40.0f);
     // kUsed vertices referenced; the input may declare kUsed + kUnused (then more vertices than
     // triangles: no vertex cache).
-    constexpr std::size_t kUsed = 3001, kUnused = 30000, kStride = 6;  // x, y, z, w and two floats of padding
+    constexpr std::size_t kUsed = 3001, kUnused = 40000, kStride = 6;  // x, y, z, w and two floats of padding
     std::vector<float> vertices((kUsed + kUnused) * kStride, 1.0f);
     for (std::size_t v = 0; v < kUsed; ++v) {
         const float wv = (v % 97 == 0) ? -w(rng) : w(rng);  // some behind the eye
@@ -379,7 +379,7 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
     std::mt19937_64 rng(91);
     std::uniform_real_distribution<float> coordinate(-30.0f, 30.0f), jitter(-0.6f, 0.6f);
     constexpr std::size_t kVertices = 40009, kTriangles = 60013,
-                          kUnused = 30000;  // 40,009 vertices: three transform tasks
+                          kUnused = 90000;  // 40,009 vertices: three transform tasks; with the unused ones, more than 2 per triangle
     std::vector<float> positions;
     for (std::size_t v = 0; v < kVertices + kUnused; ++v)
         positions.insert(positions.end(), {coordinate(rng), coordinate(rng), coordinate(rng) - 40.0f});
@@ -416,7 +416,7 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
     const OcclusionBuffer reference = render(kVertices, {});
     EXPECT_GT(reference.stats().rasterized, 10000u);
     EXPECT_GT(reference.stats().outside + reference.stats().backface_culled, 10000u);
-    const OcclusionBuffer without_cache = render(kVertices + kUnused, {});  // more vertices than triangles: no cache
+    const OcclusionBuffer without_cache = render(kVertices + kUnused, {});  // more than two vertices per triangle: no cache
     EXPECT_TRUE(reference.stats() == without_cache.stats());
     EXPECT_TRUE(test::same_subtiles(reference, without_cache));
     for (const std::string& isa : available_isas()) {

@@ -64,11 +64,10 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 //
 // The clip w comes from `cache` (double) when there is one; else it is computed in float lanes
 // (bucket_packed_soup, bucket_indexed) when the positions are float-aligned (address and
-// stride) and, without indices, packed; else in double as transform_to_clip computes it. Which
-// of these an input takes depends on the input alone (the cache on use_vertex_cache; the lanes
-// on its layout and address), never on the instruction set or the job system, so neither does
-// the order; but the same triangles at another address or stride may be ordered apart at a
-// bucket's edge.
+// stride) and, without indices, packed; else in double as transform_to_clip computes it. Which of these an input takes depends
+// on the input alone (its layout and address, and use_vertex_cache), never on the instruction
+// set or the job system, so neither does the order; but the same triangles at another address
+// or stride may be ordered apart at a bucket's edge.
 //
 // A copy rather than a list of numbers: the setup then reads its input front to back (reading
 // S1's triangles through a sorted list of numbers cost 1.9 ms of an 8.8 ms render on two

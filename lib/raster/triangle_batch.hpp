@@ -66,8 +66,8 @@ using TransformVerticesKernel = void (*)(const TriangleInput& in, double near_w,
                                          const VertexClip& cache);
 void transform_vertices_reference(const TriangleInput& in, double near_w, std::size_t begin, std::size_t end, const VertexClip& cache);
 
-// Whether a render should transform the input's vertices once (indexed, and no more vertices
-// than triangles: then it transforms fewer points than three per triangle).
+// Whether a render should transform the input's vertices once (indexed, and at most two
+// vertices per triangle: then it transforms fewer points than three per triangle).
 bool use_vertex_cache(const TriangleInput& in);
 
 // Fetches triangles [first, first + count) (0 < count <= kSize) into the batch's lanes

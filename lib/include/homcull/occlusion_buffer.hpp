@@ -128,8 +128,8 @@ struct TriangleInput {
     const void* positions = nullptr;
     int position_components = 3;       // 3 or 4
     std::size_t position_stride = 12;  // bytes between consecutive positions
-    // Positions must hold vertex_count vertices: with indices and no more vertices than
-    // triangles, render() transforms every one of them once (not only those indexed).
+    // Positions must hold vertex_count vertices: with indices and at most two vertices per
+    // triangle, render() transforms every one of them once (not only those indexed).
     std::size_t vertex_count = 0;
     const void* indices = nullptr;     // nullptr: triangles are vertices 3k, 3k+1, 3k+2
     bool indices_16bit = false;
@@ -210,8 +210,8 @@ public:
     // rows, then each band is rasterized in submission order (so every subtile sees the same
     // sequence of triangles whatever the threads). Scratch memory (the per-chunk band bins) is
     // reused and only grows, so a frame allocates only when a bin outgrows every earlier frame's:
-    // after a few frames of a walkthrough, rarely. Indexed input with no more vertices than
-    // triangles has every one of its vertex_count positions read and transformed once (so
+    // after a few frames of a walkthrough, rarely. Indexed input with at most two vertices per
+    // triangle has every one of its vertex_count positions read and transformed once (so
     // vertex_count must not overstate the positions), into scratch of 33 bytes a vertex (up to
     // 4M vertices) that also only grows and stays allocated with the buffer. Statistics
     // accumulate until clear() or render_frame(). Not thread-safe with itself or with tests.
