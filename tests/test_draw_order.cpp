@@ -193,7 +193,7 @@ TEST(DrawOrder, HoldsEveryTriangleOnceNearestClassFirstAndInInputOrderWithin) {
             }
 }
 
-// Indexed meshes with no more vertices than triangles are sorted from the render's vertex
+// Indexed meshes with at most two vertices per triangle are sorted from the render's vertex
 // cache (clip w in double, as the selected instruction set transformed it): the same
 // properties.
 TEST(DrawOrder, SortsFromTheVertexCache) {

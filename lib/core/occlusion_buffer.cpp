@@ -11,7 +11,6 @@
 #include <hwy/cache_control.h>
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
 
 namespace homcull {
@@ -191,8 +190,7 @@ void OcclusionBuffer::render_frame(const TriangleInput& in, const ParallelFor& p
 
 void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first) {
     detail::check_triangle_input(in, "render");
-    if (in.order == DrawOrder::nearest_first && in.triangle_count > std::numeric_limits<std::uint32_t>::max())
-        throw Error("render: DrawOrder::nearest_first sorts at most 2^32 - 1 triangles per call; split the input or use DrawOrder::as_given");
+    detail::check_draw_order(in);
     if (clear_first) stats_ = RasterStats{};
     detail::VertexClip storage;
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;

@@ -147,12 +147,16 @@ void place_range(const TriangleInput& in, std::size_t begin, std::size_t end, co
 
 }  // namespace
 
+void check_draw_order(const TriangleInput& in) {
+    if (in.order == DrawOrder::nearest_first && in.triangle_count > std::size_t(std::numeric_limits<std::uint32_t>::max()))
+        throw Error("render: DrawOrder::nearest_first sorts at most 2^32 - 1 triangles per call; split the input or use DrawOrder::as_given");
+}
+
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted) {
     const std::size_t n = in.triangle_count;
     if (in.order == DrawOrder::as_given || n == 0) return false;
-    if (n > std::size_t(std::numeric_limits<std::uint32_t>::max()))
-        throw Error("render: DrawOrder::nearest_first sorts at most 2^32 - 1 triangles per call; split the input or use DrawOrder::as_given");
+    check_draw_order(in);
     // A counting sort in tasks of kDrawOrderTask triangles, in two passes:
     // 1. each task buckets its triangles (fine buckets, about 1 % of w each) and counts them
     //    per bucket;

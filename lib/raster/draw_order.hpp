@@ -79,4 +79,8 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted);
 
+// Throws homcull::Error when sort_nearest_first would refuse the input (nearest first, 2^32
+// triangles or more), so that render can check before it changes anything.
+void check_draw_order(const TriangleInput& in);
+
 }  // namespace homcull::detail
