@@ -168,11 +168,13 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
         return true;
     };
     const detail::FrontEndKernels kernels = detail::selected_front_end_kernels();
-    const auto set_up = [&](const PlacedCluster& p, const detail::VertexClip& cache, RasterStats& stats, auto&& emit) {
+    // drawn_into: as setup_triangle_range's (null when the triangles are kept for other bands).
+    const auto set_up = [&](const PlacedCluster& p, const detail::VertexClip& cache, const detail::RasterTarget* drawn_into,
+                            RasterStats& stats, auto&& emit) {
         const TriangleInput t = cluster_input(clusters, clusters.clusters[p.cluster], in);
         kernels.transform_vertices(t, double(config_.near_w), 0, t.vertex_count, cache);
         detail::setup_triangle_range(t, &cache, 0, t.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
-                                     stats, emit);
+                                     drawn_into, stats, emit);
     };
 
     if (parallel.run) {
@@ -205,7 +207,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
                     try {
                         s.triangles.clear();
                         s.stats = RasterStats{};
-                        (*j.set_up_cluster)(b.placed_clusters_[k], cache, s.stats,
+                        (*j.set_up_cluster)(b.placed_clusters_[k], cache, nullptr, s.stats,
                                             [&](const detail::RasterTriangle& tri) { s.triangles.push_back(tri); });
                     } catch (...) {  // the bands waiting for it must not wait for ever
                         s.state.store(ClusterSetup::kFailed, std::memory_order_release);
@@ -243,7 +245,10 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
             }
             if (runs.empty()) continue;
             RasterStats stats;
-            set_up(p, cache, stats, [&](const detail::RasterTriangle& tri) {
+            // No per-triangle hidden test in the setup (drawn_into null): the cluster's box just
+            // passed one, and of its triangles fewer are hidden (on castle C0, 29 % against 65 %
+            // drawn as one input), too few to pay for the test (0.729 -> 0.743 ms).
+            set_up(p, cache, nullptr, stats, [&](const detail::RasterTriangle& tri) {
                 detail::RasterTarget target = whole;
                 for (const auto& [row_begin, row_end] : runs) {
                     target.row_begin = row_begin, target.row_end = row_end;

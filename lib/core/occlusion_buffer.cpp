@@ -211,8 +211,8 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t updated = 0;
     RasterStats stats;
-    detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, stats,
-                     [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); });
+    detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
+                                 stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); });
     stats.subtiles_updated = updated;
     stats_ += stats;
     build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
@@ -242,7 +242,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         const std::size_t end = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
         const OcclusionBuffer& b = *j.self;
         detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end, b.config_.near_w, b.config_.edge_margin, b.sample_width_,
-                                     b.sample_height_, chunk.stats, [&](const detail::RasterTriangle& tri) {
+                                     b.sample_height_, nullptr, chunk.stats, [&](const detail::RasterTriangle& tri) {
             for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
                 chunk.bins[std::size_t(band)].push_back(tri);
         });

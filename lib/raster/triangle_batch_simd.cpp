@@ -255,19 +255,20 @@ HWY_INLINE M FloatRowEdge(int k, int g, V ox, V oy, V sa, V sb, V inverse_sa, do
     return hn::AndNot(hn::Eq(sa, zero), hn::And(in_range, hn::Le(error, hn::Set(d, 0x1.0p-8))));
 }
 
-// setup_clip_triangle's projection of an unclipped triangle and setup_raster_triangle's double
-// work (orient_triangle, sample_span, edge_functions, depth_plane_terms), lane by lane with
-// the same operations in the same order.
-void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height, double edge_margin, std::uint32_t silhouette_only,
-                BatchSetup& out) {
+// setup_clip_triangle's projection of an unclipped triangle and the parts of
+// setup_raster_triangle's double work that do not need the edges (orient_triangle,
+// sample_span, depth_plane_terms, finish_depth_plane), lane by lane with the same operations
+// in the same order; then nearest_conservative_depth over each lane's sample box, with
+// conservative_depth's float operations.
+void SetupPlanes(const TriangleBatch& batch, int sample_width, int sample_height, BatchSetup& out) {
     const D d;
     const hn::Rebind<std::int32_t, D> di;
+    const hn::Rebind<float, D> df;
     const int lanes = int(hn::Lanes(d));
     const V one = hn::Set(d, 1.0), half = hn::Set(d, 0.5), zero = hn::Zero(d), minus_one = hn::Set(d, -1.0);
     const V width = hn::Set(d, double(sample_width)), height = hn::Set(d, double(sample_height));
     out.flipped = 0;
     out.has_plane = 0;
-    out.float_ready = 0;
     for (int g = 0; g < batch.count; g += lanes) {
         // Projection to the sample grid, depth 1/w. (No arrays of vectors: SVE vectors cannot
         // be array elements.)
@@ -290,6 +291,12 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
         const V d1 = hn::IfThenElse(flip, pd2, pd1), d2 = hn::IfThenElse(flip, pd1, pd2);
         const V area = hn::IfThenElse(flip, hn::Neg(area2), area2);
         hn::Store(area, d, out.area2 + g);
+        hn::Store(x0, d, out.x[0] + g);
+        hn::Store(x1, d, out.x[1] + g);
+        hn::Store(x2, d, out.x[2] + g);
+        hn::Store(y0, d, out.y[0] + g);
+        hn::Store(y1, d, out.y[1] + g);
+        hn::Store(y2, d, out.y[2] + g);
 
         // sample_span of the bounding box (min and max are exact).
         auto span = [&](V lo, V hi, V count, std::int32_t* first, std::int32_t* last) {
@@ -302,8 +309,55 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
         };
         span(hn::Min(hn::Min(x0, x1), x2), hn::Max(hn::Max(x0, x1), x2), width, out.i0, out.i1);
         span(hn::Min(hn::Min(y0, y1), y2), hn::Max(hn::Max(y0, y1), y2), height, out.j0, out.j1);
+
+        // depth_plane_terms.
+        const V dzdx = hn::Div(hn::Sub(hn::Mul(hn::Sub(d1, d0), hn::Sub(y2, y0)), hn::Mul(hn::Sub(d2, d0), hn::Sub(y1, y0))), area);
+        const V dzdy = hn::Div(hn::Sub(hn::Mul(hn::Sub(d2, d0), hn::Sub(x1, x0)), hn::Mul(hn::Sub(d1, d0), hn::Sub(x2, x0))), area);
+        const V a = hn::Sub(hn::Sub(d0, hn::Mul(dzdx, x0)), hn::Mul(dzdy, y0));
+        const V magnitude = hn::Add(hn::Add(hn::Abs(a), hn::Mul(hn::Abs(dzdx), width)), hn::Mul(hn::Abs(dzdy), height));
+        const V terms = hn::Add(hn::Add(hn::Abs(d0), hn::Abs(hn::Mul(dzdx, x0))), hn::Abs(hn::Mul(dzdy, y0)));
+        const V error = hn::Add(hn::Mul(hn::Set(d, 0x1.0p-20), magnitude), hn::Mul(hn::Set(d, 0x1.0p-40), terms));
+        // finish_depth_plane: the plane in float where it is usable, else none.
+        const M usable = hn::And(hn::Lt(hn::Abs(error), hn::Set(d, HUGE_VAL)), hn::Lt(magnitude, hn::Set(d, 0x1.0p100)));
+        const auto usable_f = FloatLaneMask(usable);
+        const auto a_f = hn::IfThenElseZero(usable_f, hn::DemoteTo(df, a));
+        const auto dzdx_f = hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdx));
+        const auto dzdy_f = hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdy));
+        const auto error_f = hn::IfThenElseZero(usable_f, FloatOutward<true>(hn::IfThenElseZero(usable, error)));
+        const auto z_vertex_min = FloatOutward<false>(hn::Min(hn::Min(d0, d1), d2));
+        hn::Store(a_f, df, out.plane_a + g);
+        hn::Store(dzdx_f, df, out.plane_dzdx + g);
+        hn::Store(dzdy_f, df, out.plane_dzdy + g);
+        hn::Store(error_f, df, out.plane_error + g);
+        hn::Store(z_vertex_min, df, out.z_vertex_min + g);
+        out.has_plane |= LaneBits(d, usable) << g;
+
+        // nearest_conservative_depth over the box [i0, i1] x [j0, j1]: conservative_depth at the
+        // corner opposite the plane's far corner (set_far_corner), in the same float operations.
+        const auto zero_f = hn::Zero(df), half_f = hn::Set(df, 0.5f);
+        const auto column = hn::IfThenElse(hn::RebindMask(di, hn::Gt(dzdx_f, zero_f)), hn::Load(di, out.i1 + g), hn::Load(di, out.i0 + g));
+        const auto row = hn::IfThenElse(hn::RebindMask(di, hn::Gt(dzdy_f, zero_f)), hn::Load(di, out.j1 + g), hn::Load(di, out.j0 + g));
+        const auto x = hn::Add(hn::ConvertTo(df, column), half_f), y = hn::Add(hn::ConvertTo(df, row), half_f);
+        const auto plane = hn::Add(hn::Add(a_f, hn::Mul(dzdy_f, y)), hn::Mul(dzdx_f, x));
+        const auto bound = hn::Max(hn::Sub(plane, error_f), z_vertex_min);
+        hn::Store(hn::Mul(bound, hn::Set(df, 1.0f - 0x1.0p-20f)), df, out.nearest + g);
+    }
+}
+
+// setup_raster_triangle's edge_functions and prepare_float_row_edges for the lanes of
+// `lanes` (whole vectors of them: the others compute too, and their results go unused), from
+// SetupPlanes' oriented vertices and sample box.
+void SetupEdges(int count, double edge_margin, std::uint32_t silhouette_only, std::uint32_t lanes_wanted, BatchSetup& out) {
+    const D d;
+    const hn::Rebind<std::int32_t, D> di;
+    const int lanes = int(hn::Lanes(d));
+    const V one = hn::Set(d, 1.0), zero = hn::Zero(d), minus_one = hn::Set(d, -1.0);
+    out.float_ready = 0;
+    for (int g = 0; g < count; g += lanes) {
+        const std::uint32_t group = (1u << lanes) - 1u;  // lanes <= 8
+        if (((lanes_wanted >> g) & group) == 0) continue;
         const V i0 = hn::PromoteTo(d, hn::Load(di, out.i0 + g)), i1 = hn::PromoteTo(d, hn::Load(di, out.i1 + g));
-        const bool any_float = ((silhouette_only >> g) & ((1u << lanes) - 1u)) != 0;  // lanes <= 8
+        const bool any_float = ((silhouette_only >> g) & group) != 0;
         M float_ready = hn::FirstN(d, any_float ? std::size_t(lanes) : 0);
 
         // edge_functions: edge k from vertex k to vertex k + 1, measured from its lower end (by
@@ -323,27 +377,11 @@ void SetupBatch(const TriangleBatch& batch, int sample_width, int sample_height,
             hn::Store(inverse_sa, d, out.inverse_sa[k] + g);
             if (any_float) float_ready = hn::And(float_ready, FloatRowEdge(k, g, lo_x, lo_y, sa, sb, inverse_sa, edge_margin, i0, i1, out));
         };
+        const V x0 = hn::Load(d, out.x[0] + g), x1 = hn::Load(d, out.x[1] + g), x2 = hn::Load(d, out.x[2] + g);
+        const V y0 = hn::Load(d, out.y[0] + g), y1 = hn::Load(d, out.y[1] + g), y2 = hn::Load(d, out.y[2] + g);
         edge(0, x0, y0, x1, y1);
         edge(1, x1, y1, x2, y2);
         edge(2, x2, y2, x0, y0);
-
-        // depth_plane_terms.
-        const V dzdx = hn::Div(hn::Sub(hn::Mul(hn::Sub(d1, d0), hn::Sub(y2, y0)), hn::Mul(hn::Sub(d2, d0), hn::Sub(y1, y0))), area);
-        const V dzdy = hn::Div(hn::Sub(hn::Mul(hn::Sub(d2, d0), hn::Sub(x1, x0)), hn::Mul(hn::Sub(d1, d0), hn::Sub(x2, x0))), area);
-        const V a = hn::Sub(hn::Sub(d0, hn::Mul(dzdx, x0)), hn::Mul(dzdy, y0));
-        const V magnitude = hn::Add(hn::Add(hn::Abs(a), hn::Mul(hn::Abs(dzdx), width)), hn::Mul(hn::Abs(dzdy), height));
-        const V terms = hn::Add(hn::Add(hn::Abs(d0), hn::Abs(hn::Mul(dzdx, x0))), hn::Abs(hn::Mul(dzdy, y0)));
-        const V error = hn::Add(hn::Mul(hn::Set(d, 0x1.0p-20), magnitude), hn::Mul(hn::Set(d, 0x1.0p-40), terms));
-        // finish_depth_plane: the plane in float where it is usable, else none.
-        const hn::Rebind<float, D> df;
-        const M usable = hn::And(hn::Lt(hn::Abs(error), hn::Set(d, HUGE_VAL)), hn::Lt(magnitude, hn::Set(d, 0x1.0p100)));
-        const auto usable_f = FloatLaneMask(usable);
-        hn::Store(hn::IfThenElseZero(usable_f, hn::DemoteTo(df, a)), df, out.plane_a + g);
-        hn::Store(hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdx)), df, out.plane_dzdx + g);
-        hn::Store(hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdy)), df, out.plane_dzdy + g);
-        hn::Store(hn::IfThenElseZero(usable_f, FloatOutward<true>(hn::IfThenElseZero(usable, error))), df, out.plane_error + g);
-        hn::Store(FloatOutward<false>(hn::Min(hn::Min(d0, d1), d2)), df, out.z_vertex_min + g);
-        out.has_plane |= LaneBits(d, usable) << g;
         out.float_ready |= LaneBits(d, float_ready) << g;
     }
 }
@@ -360,13 +398,15 @@ HWY_EXPORT(TransformVertices);
 HWY_EXPORT(TransformBatch);
 HWY_EXPORT(GatherDirectBatch);
 HWY_EXPORT(ClassifyBatch);
-HWY_EXPORT(SetupBatch);
+HWY_EXPORT(SetupPlanes);
+HWY_EXPORT(SetupEdges);
 
 FrontEndKernels selected_front_end_kernels() {
     if (scalar_reference_selected())
-        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr};
+        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr, nullptr};
     return {HOMCULL_RESOLVED_KERNEL(TransformVertices), HOMCULL_RESOLVED_KERNEL(TransformBatch), HOMCULL_RESOLVED_KERNEL(ClassifyBatch),
-            HOMCULL_RESOLVED_KERNEL(SetupBatch), HOMCULL_RESOLVED_KERNEL(GatherDirectBatch)};
+            HOMCULL_RESOLVED_KERNEL(SetupPlanes), HOMCULL_RESOLVED_KERNEL(SetupEdges),
+            HOMCULL_RESOLVED_KERNEL(GatherDirectBatch)};
 }
 
 }  // namespace homcull::detail
