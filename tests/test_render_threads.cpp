@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
+#include <new>
 #include <numeric>
 #include <random>
 
@@ -67,9 +68,13 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
 }
 
 // render_frame is clear() then render(): the same bits with and without a job system, over a
-// buffer that still holds another frame, and the same statistics.
+// buffer that still holds another frame, and the same statistics. With more than 8,192
+// triangles a render with a job system goes in several waves, the later ones dropping what
+// the earlier ones hid; render() after that adds to the frame, its first wave already testing
+// against it.
 TEST(RenderThreads, RenderFrameIsClearThenRender) {
-    const std::vector<float> first = test::random_clip_triangles(21, 7000, 0.4f), second = test::random_clip_triangles(22, 5000, 0.3f);
+    const std::vector<float> first = test::random_clip_triangles(21, 7000, 0.4f), second = test::random_clip_triangles(22, 30000, 0.3f);
+    const std::vector<float> third = test::random_clip_triangles(23, 20000, 0.2f);
     BufferConfig config;
     config.width = 301;  // odd sizes: partial subtiles, a last band of a few rows, odd pyramid levels
     config.height = 277;
@@ -89,6 +94,11 @@ TEST(RenderThreads, RenderFrameIsClearThenRender) {
         EXPECT_EQ(reference.stats().rasterized, framed.stats().rasterized);
         EXPECT_EQ(reference.stats().triangles_in, framed.stats().triangles_in);
         EXPECT_EQ(reference.stats().subtiles_updated, framed.stats().subtiles_updated);
+        reference.render(test::clip_space_input(third));
+        framed.render(test::clip_space_input(third), parallel);
+        EXPECT_TRUE(test::same_subtiles(reference, framed));
+        EXPECT_TRUE(test::same_pyramid(reference, framed));
+        EXPECT_TRUE(reference.stats() == framed.stats());
         // No triangles: an empty frame.
         TriangleInput none = test::clip_space_input(second);
         none.triangle_count = 0;
@@ -115,6 +125,71 @@ TEST(RenderThreads, RenderFrameThrowsBeforeClearing) {
     EXPECT_THROW(buffer.render_frame(bad, tbb_parallel_for()), Error);
     EXPECT_TRUE(test::same_subtiles(reference, buffer));
     EXPECT_TRUE(test::same_pyramid(reference, buffer));
+}
+
+// A job system that runs tasks in order on the calling thread and throws std::bad_alloc at
+// its throw_at-th call, as a bin growing out of memory would in the middle of a render.
+struct FailingJobs {
+    int calls = 0, throw_at = 0;
+    static void run(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data) {
+        auto& self = *static_cast<FailingJobs*>(user);
+        if (++self.calls == self.throw_at) throw std::bad_alloc();
+        for (std::size_t k = 0; k < count; ++k) task(data, k);
+    }
+};
+
+// Whether the buffer's pyramid is its d0 (level 0) and the minimum of 2 x 2 cells above.
+bool pyramid_matches_subtiles(const OcclusionBuffer& buffer) {
+    std::vector<float> cells;
+    buffer.read_pyramid(cells);
+    const int w0 = buffer.subtiles_x(), h0 = buffer.subtiles_y();
+    std::size_t offset = 0;
+    for (int ty = 0; ty < h0; ++ty)
+        for (int tx = 0; tx < w0; ++tx)
+            if (cells[offset + std::size_t(ty) * std::size_t(w0) + std::size_t(tx)] != buffer.subtile(tx, ty).d0) return false;
+    for (int w = w0, h = h0; w > 1 || h > 1;) {
+        const int upper_w = (w + 1) / 2, upper_h = (h + 1) / 2;
+        const std::size_t upper = offset + std::size_t(w) * std::size_t(h);
+        for (int y = 0; y < upper_h; ++y)
+            for (int x = 0; x < upper_w; ++x) {
+                float m = std::numeric_limits<float>::infinity();
+                for (int dy = 0; dy < 2; ++dy)
+                    for (int dx = 0; dx < 2; ++dx)
+                        if (2 * x + dx < w && 2 * y + dy < h)
+                            m = std::min(m, cells[offset + std::size_t(2 * y + dy) * std::size_t(w) + std::size_t(2 * x + dx)]);
+                if (cells[upper + std::size_t(y) * std::size_t(upper_w) + std::size_t(x)] != m) return false;
+            }
+        offset = upper;
+        w = upper_w, h = upper_h;
+    }
+    return offset + 1 == cells.size();
+}
+
+// A render that fails part-way, after some of its waves were drawn, leaves a pyramid that
+// matches what the buffer holds (never the last frame's, which could hide what is now
+// visible), whichever call of the job system fails.
+TEST(RenderThreads, ARenderFailingBetweenWavesLeavesAMatchingPyramid) {
+    const std::vector<float> last = test::random_clip_triangles(31, 3000, 0.4f, 0.5f), frame = test::random_clip_triangles(32, 30000, 0.3f);
+    BufferConfig config;
+    config.width = 301;
+    config.height = 277;
+    config.samples = 2;
+    config.near_w = 1.0f;
+    int failures = 0;
+    for (int throw_at = 1; throw_at <= 12; ++throw_at) {
+        OcclusionBuffer buffer(config);
+        buffer.render(test::clip_space_input(last));
+        FailingJobs jobs;
+        jobs.throw_at = throw_at;
+        try {
+            buffer.render_frame(test::clip_space_input(frame), ParallelFor{&FailingJobs::run, &jobs});
+        } catch (const std::bad_alloc&) {
+            ++failures;
+        }
+        EXPECT_TRUE(pyramid_matches_subtiles(buffer)) << "the job system's call " << throw_at << " failed";
+    }
+    EXPECT_GE(failures, 6);  // the sort's two calls, and at least two of the three waves' two each
+    EXPECT_LT(failures, 12);  // and a render that did not fail
 }
 
 TEST(RenderThreads, CityFromAboveSameBits) {

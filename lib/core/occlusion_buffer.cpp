@@ -244,44 +244,58 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         bool clear_first, last_wave;
     };
     const detail::RasterTarget whole = raster_target(0, subtiles_y_);
-    for (std::size_t first = 0, wave_chunks = kFirstWaveChunks; first < chunk_count; first += wave_chunks, wave_chunks *= 2) {
-        const std::size_t end = std::min(chunk_count, first + wave_chunks);
-        const bool nothing_drawn = first == 0 && clear_first;  // the buffer still holds the last frame
-        Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count};
+    std::size_t drawn_chunks = 0;  // the chunks of the waves drawn so far
+    try {
+        // At least one wave, so that render_frame clears and builds the pyramid whatever the count.
+        for (std::size_t first = 0, wave_chunks = kFirstWaveChunks; first == 0 || first < chunk_count; first += wave_chunks, wave_chunks *= 2) {
+            const std::size_t end = std::min(chunk_count, first + wave_chunks);
+            const bool nothing_drawn = first == 0 && clear_first;  // the buffer still holds the last frame
+            Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count};
 
-        detail::run_tasks(parallel, end - first, [](void* data, std::size_t k) {
-            const Job& j = *static_cast<Job*>(data);
-            const std::size_t c = j.first_chunk + k;
-            Chunk& chunk = j.self->chunks_[c];
-            chunk.stats = RasterStats{};
-            if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
-            for (auto& bin : chunk.bins) bin.clear();
-            const std::size_t end_triangle = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
-            const OcclusionBuffer& b = *j.self;
-            detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
-                                         b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, [&](const detail::RasterTriangle& tri) {
-                for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
-                    chunk.bins[std::size_t(band)].push_back(tri);
-            });
-        }, &job);
+            detail::run_tasks(parallel, end - first, [](void* data, std::size_t k) {
+                const Job& j = *static_cast<Job*>(data);
+                const std::size_t c = j.first_chunk + k;
+                Chunk& chunk = j.self->chunks_[c];
+                chunk.stats = RasterStats{};
+                if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
+                for (auto& bin : chunk.bins) bin.clear();
+                const std::size_t end_triangle = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
+                const OcclusionBuffer& b = *j.self;
+                detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
+                                             b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, [&](const detail::RasterTriangle& tri) {
+                    for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
+                        chunk.bins[std::size_t(band)].push_back(tri);
+                });
+            }, &job);
 
-        detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
-            const Job& j = *static_cast<Job*>(data);
-            OcclusionBuffer& b = *j.self;
-            const int row_begin = int(band) * kBandSubtileRows, row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);
-            if (j.clear_first) b.clear_rows(row_begin, row_end);
-            const detail::RasterTarget target = b.raster_target(row_begin, row_end);
-            std::uint64_t updated = 0;
-            for (std::size_t c = j.first_chunk; c < j.end_chunk; ++c) {
-                const std::vector<detail::RasterTriangle>& bin = b.chunks_[c].bins[band];
-                for (std::size_t k = 0; k < bin.size(); ++k) {
-                    if (k + kPrefetchTriangles < bin.size()) prefetch_triangle(bin[k + kPrefetchTriangles]);
-                    updated += target.kernel(target, bin[k]);
+            detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
+                const Job& j = *static_cast<Job*>(data);
+                OcclusionBuffer& b = *j.self;
+                const int row_begin = int(band) * kBandSubtileRows, row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);
+                if (j.clear_first) b.clear_rows(row_begin, row_end);
+                const detail::RasterTarget target = b.raster_target(row_begin, row_end);
+                std::uint64_t updated = 0;
+                for (std::size_t c = j.first_chunk; c < j.end_chunk; ++c) {
+                    const std::vector<detail::RasterTriangle>& bin = b.chunks_[c].bins[band];
+                    for (std::size_t k = 0; k < bin.size(); ++k) {
+                        if (k + kPrefetchTriangles < bin.size()) prefetch_triangle(bin[k + kPrefetchTriangles]);
+                        updated += target.kernel(target, bin[k]);
+                    }
                 }
-            }
-            b.band_updated_[band] += updated;
-            if (j.last_wave) b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
-        }, &job);
+                b.band_updated_[band] += updated;
+                if (j.last_wave) b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
+            }, &job);
+            drawn_chunks = end;
+        }
+    } catch (...) {
+        // Out of memory growing a bin after earlier waves were drawn (input errors throw before
+        // any wave): the buffer keeps those waves' triangles, a partial but conservative render,
+        // with its statistics and a pyramid rebuilt to match, so that no test reads a pyramid
+        // of the frame before.
+        for (std::size_t c = 0; c < drawn_chunks; ++c) stats_ += chunks_[c].stats;
+        for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
+        build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+        throw;
     }
     reduce_pyramid_above_bands();
 
