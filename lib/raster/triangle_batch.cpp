@@ -144,7 +144,7 @@ bool assemble_raster_triangle(const BatchSetup& s, int t, std::uint8_t shared_bi
             out.edges.threshold[k] = edge_threshold(shared[k], edge_margin, s.sa[k][t], s.sb[k][t]);
         }
     }
-    PreparedTriangle& plane = out.plane;  // finish_depth_plane's, from SetupBatch
+    PreparedTriangle& plane = out.plane;  // finish_depth_plane's, from SetupPlanes
     plane.a = s.plane_a[t], plane.dzdx = s.plane_dzdx[t], plane.dzdy = s.plane_dzdy[t], plane.error = s.plane_error[t];
     plane.z_vertex_min = s.z_vertex_min[t];
     plane.has_plane = (s.has_plane >> t) & 1u;

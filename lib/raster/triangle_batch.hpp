@@ -149,9 +149,10 @@ inline bool gather_direct_ready(const TriangleInput& in, std::size_t first, std:
 
 FrontEndKernels selected_front_end_kernels();
 
-// Whether lane t of SetupPlanes' output is hidden in the target's rows: its box holds no
-// sample there, or every subtile of its box there lies behind the reference layer at the
-// nearest depth of its plane over the whole box (hidden_behind_reference_layer). The target's
+// Whether lane t of SetupPlanes' output is hidden in the target's rows: its box reaches none
+// of them, or every subtile of its box there lies behind the reference layer at the nearest
+// depth of its plane over the whole box (hidden_behind_reference_layer). A lane without area
+// or with an empty box is not (assembly rejects it; its plane may be NaN). The target's
 // row loop would then skip every chunk of it (each chunk's nearest depth is at most the box's,
 // over fewer subtiles): not drawing it changes no bit.
 inline bool hidden_in_target(const BatchSetup& setup, int t, const RasterTarget& target, HiddenTestKernel hidden_test) {

@@ -206,11 +206,16 @@ public:
     explicit OcclusionBuffer(const BufferConfig& config);
 
     void clear();
-    // Rasterizes occluders: triangles are set up in chunks and binned into bands of subtile
-    // rows, then each band is rasterized in submission order (so every subtile sees the same
-    // sequence of triangles whatever the threads). Scratch memory (the per-chunk band bins) is
-    // reused and only grows, so a frame allocates only when a bin outgrows every earlier frame's:
-    // after a few frames of a walkthrough, rarely. Indexed input with at most two vertices per
+    // Rasterizes occluders in draw order (TriangleInput::order, nearest first by default).
+    // Without a job system each triangle is set up and drawn in turn; with one, in waves of
+    // chunks of triangles (4, 8, 16, ... chunks), each set up and binned into bands of subtile
+    // rows in parallel, then each band rasterized in draw order (so every subtile sees the
+    // same sequence of triangles whatever the threads). Triangles already hidden in the buffer
+    // are dropped before their edges are set up, which changes no bit. Scratch memory (the
+    // per-chunk band bins) is reused and only grows, so a frame allocates only when a bin
+    // outgrows every earlier frame's: after a few frames of a walkthrough, rarely. Should that
+    // allocation fail (std::bad_alloc) after some waves were drawn, the buffer keeps them, with
+    // a pyramid and statistics to match. Indexed input with at most two vertices per
     // triangle has every one of its vertex_count positions read and transformed once (so
     // vertex_count must not overstate the positions), into scratch of 33 bytes a vertex (up to
     // 4M vertices) that also only grows and stays allocated with the buffer. Statistics
