@@ -151,10 +151,10 @@ FrontEndKernels selected_front_end_kernels();
 
 // Whether lane t of SetupPlanes' output is hidden in the target's rows: its box reaches none
 // of them, or every subtile of its box there lies behind the reference layer at the nearest
-// depth of its plane over the whole box (hidden_behind_reference_layer). A lane without area
-// or with an empty box is not (assembly rejects it; its plane may be NaN). The target's
-// row loop would then skip every chunk of it (each chunk's nearest depth is at most the box's,
-// over fewer subtiles): not drawing it changes no bit.
+// depth of its plane over the whole box (hidden_behind_reference_layer). The target's row loop
+// would then skip every chunk of it (each chunk's nearest depth is at most the box's, over
+// fewer subtiles): not drawing it changes no bit. A lane without area or with an empty box is
+// never called hidden: assembly rejects it, and its plane may be NaN.
 inline bool hidden_in_target(const BatchSetup& setup, int t, const RasterTarget& target, HiddenTestKernel hidden_test) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     if (setup.area2[t] == 0.0 || setup.i0[t] > setup.i1[t] || setup.j0[t] > setup.j1[t]) return false;  // assembly rejects it
