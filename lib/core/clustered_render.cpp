@@ -158,8 +158,8 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     const auto band_draws = [&](const PlacedCluster& p, std::size_t band, const detail::SubtilePlanes& planes) {
         int row_begin, row_end;
         band_rows(band, row_begin, row_end);
-        const int ty0 = std::max(p.j0 / kH, row_begin), ty1 = std::min(p.j1 / kH, row_end - 1);
-        if (ty0 > ty1) return false;
+        int ty0, ty1;
+        if (!detail::subtile_rows_within(p.j0, p.j1, row_begin, row_end, ty0, ty1)) return false;
         if (p.testable && hidden_test(planes, p.i0 / kW, p.i1 / kW, ty0, ty1, p.d_near)) {
             ++band_stats_[band].cluster_bands_hidden;
             return false;

@@ -209,7 +209,8 @@ bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1
 std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriangle& triangle) {
     const PreparedTriangle& prepared = triangle.plane;
     const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
-    const int ty_first = std::max(j0 / kH, t.row_begin), ty_last = std::min(j1 / kH, t.row_end - 1);
+    int ty_first, ty_last;
+    if (!subtile_rows_within(j0, j1, t.row_begin, t.row_end, ty_first, ty_last)) return 0;
     std::uint64_t updated = 0;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);

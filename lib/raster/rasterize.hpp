@@ -55,6 +55,16 @@ struct RasterTarget {
     bool skip_hidden;  // hidden_skip_enabled() when the target was made
 };
 
+// The subtile rows [ty0, ty1] that hold sample rows [j0, j1] and lie within subtile rows
+// [row_begin, row_end) (a target's, or a band's); false when there are none. The one clamp of
+// the row loops, the setup's hidden test and the clustered render's band test.
+inline bool subtile_rows_within(int j0, int j1, int row_begin, int row_end, int& ty0, int& ty1) {
+    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    ty0 = std::max(j0 / kH, row_begin);
+    ty1 = std::min(j1 / kH, row_end - 1);
+    return ty0 <= ty1;
+}
+
 // The three edge functions of a triangle oriented positive inside: for edge k,
 // E(P) = sa (P.x - ox) + sb (P.y - oy), (ox, oy) its lower endpoint (by y, then x); covered
 // samples have E > threshold, or E >= 0 on a shared edge (threshold 0).

@@ -412,8 +412,8 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     const PreparedTriangle& tri = triangle.plane;
     const int i0 = triangle.i0, i1 = triangle.i1, j1 = triangle.j1;
     constexpr int kH = OcclusionBuffer::kSubtileHeight;
-    const int ty_first = std::max(triangle.j0 / kH, t.row_begin), ty_last = std::min(j1 / kH, t.row_end - 1);
-    if (ty_first > ty_last) return 0;
+    int ty_first, ty_last;
+    if (!subtile_rows_within(triangle.j0, j1, t.row_begin, t.row_end, ty_first, ty_last)) return 0;
     const auto sample_lane = hn::Iota(hn::CappedTag<std::int32_t, kMaxSimdLanes>(), 0);
 
     constexpr int kChunkRows = kChunkSubtileRows * kH, kW = OcclusionBuffer::kSubtileWidth;

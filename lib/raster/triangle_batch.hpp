@@ -156,10 +156,10 @@ FrontEndKernels selected_front_end_kernels();
 // fewer subtiles): not drawing it changes no bit. A lane without area or with an empty box is
 // never called hidden: assembly rejects it, and its plane may be NaN.
 inline bool hidden_in_target(const BatchSetup& setup, int t, const RasterTarget& target, HiddenTestKernel hidden_test) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kW = OcclusionBuffer::kSubtileWidth;
     if (setup.area2[t] == 0.0 || setup.i0[t] > setup.i1[t] || setup.j0[t] > setup.j1[t]) return false;  // assembly rejects it
-    const int ty0 = std::max(setup.j0[t] / kH, target.row_begin), ty1 = std::min(setup.j1[t] / kH, target.row_end - 1);
-    return ty0 > ty1 || hidden_test(target.planes, setup.i0[t] / kW, setup.i1[t] / kW, ty0, ty1, setup.nearest[t]);
+    int ty0, ty1;
+    return !subtile_rows_within(setup.j0[t], setup.j1[t], target.row_begin, target.row_end, ty0, ty1) || hidden_test(target.planes, setup.i0[t] / kW, setup.i1[t] / kW, ty0, ty1, setup.nearest[t]);
 }
 
 // Sets up triangles [begin, end) of the input in batches and hands every triangle of their
