@@ -192,13 +192,14 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
         // Each lane's shared-edge bits, read once. The float row rule needs three silhouette
         // edges: the setup skips it for groups of lanes that all have a shared edge (most of
         // a closed mesh's).
-        std::uint8_t lane_shared[TriangleBatch::kSize];
-        std::uint32_t silhouette_only = 0;
-        for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
-            const int t = __builtin_ctz(bits);
-            lane_shared[t] = in.shared_edges ? in.shared_edges[batch.triangle[t]] : 0;
-            silhouette_only |= std::uint32_t(lane_shared[t] == 0) << t;
-        }
+        std::uint8_t lane_shared[TriangleBatch::kSize] = {};
+        std::uint32_t silhouette_only = batch.needs_setup;
+        if (in.shared_edges)
+            for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
+                const int t = __builtin_ctz(bits);
+                lane_shared[t] = in.shared_edges[batch.triangle[t]];
+                if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
+            }
         std::uint32_t emitted = batch.simple;  // the simple lanes that go on to assembly
         if (batch.simple) {
             kernels.setup_planes(batch, sample_width, sample_height, simple);
@@ -209,13 +210,15 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
                 }
             if (emitted) kernels.setup_edges(batch.count, edge_margin, silhouette_only & emitted, emitted, simple);
         }
-        for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
+        // Every simple lane counts as rasterized (what setup_clip_triangle counts for it); the
+        // loop visits those emitted and the lanes left to the one-triangle setup, in order.
+        stats.rasterized += std::uint64_t(__builtin_popcount(batch.simple));
+        for (std::uint32_t bits = emitted | (batch.needs_setup & ~batch.simple); bits != 0; bits &= bits - 1) {
             const int t = __builtin_ctz(bits);
             const std::uint8_t shared = lane_shared[t];
             if ((batch.simple >> t) & 1u) {
-                ++stats.rasterized;  // what setup_clip_triangle counts for it
                 RasterTriangle tri;
-                if (((emitted >> t) & 1u) && assemble_raster_triangle(simple, t, shared, edge_margin, tri)) emit(tri);
+                if (assemble_raster_triangle(simple, t, shared, edge_margin, tri)) emit(tri);
                 continue;
             }
             const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
