@@ -365,23 +365,19 @@ HWY_INLINE bool HiddenBehindReferenceLayer(const SubtilePlanes& planes, int tx0,
     const int columns = tx1 - tx0 + 1;
 #if HWY_TARGET != HWY_SCALAR
     if (lanes == 16 && columns <= 8) {
-        // A narrow box (S1's triangles span about 5 subtile columns): two rows of 8 subtiles
-        // per vector, or four of 4, the lanes past the box's columns masked out. An odd last
-        // row is loaded twice.
+        // A narrow box (S1's triangles span about 5 subtile columns): four rows of 8 subtiles
+        // per step, in two vectors, the lanes past the box's columns masked out; rows past the
+        // box repeat its last. One shape for every narrow box: a choice of shape by width was
+        // a branch the predictor missed.
         const hn::Half<decltype(df)> dh;
-        const hn::Half<decltype(dh)> dq;
-        const int rows_per_vector = columns <= 4 ? 4 : 2;
-        const std::uint32_t row_bits = (1u << columns) - 1u;
-        const std::uint32_t bits = rows_per_vector == 4 ? row_bits * 0x1111u : row_bits * 0x0101u;
+        const std::uint32_t bits = ((1u << columns) - 1u) * 0x0101u;
         const std::uint8_t bit_bytes[8] = {std::uint8_t(bits), std::uint8_t(bits >> 8)};
         const auto in_box = hn::LoadMaskBits(df, bit_bytes);
-        for (int ty = ty0; ty <= ty1; ty += rows_per_vector) {
+        for (int ty = ty0; ty <= ty1; ty += 4) {
             const auto row = [&](int r) { return d0 + std::size_t(std::min(ty + r, ty1)) * stride; };
-            const auto v = rows_per_vector == 4
-                               ? hn::Combine(df, hn::Combine(dh, hn::LoadU(dq, row(3)), hn::LoadU(dq, row(2))),
-                                             hn::Combine(dh, hn::LoadU(dq, row(1)), hn::LoadU(dq, row(0))))
-                               : hn::Combine(df, hn::LoadU(dh, row(1)), hn::LoadU(dh, row(0)));
-            if (!hn::AllFalse(df, hn::And(in_box, hn::Lt(v, bound)))) return false;
+            const auto v01 = hn::Combine(df, hn::LoadU(dh, row(1)), hn::LoadU(dh, row(0)));
+            const auto v23 = hn::Combine(df, hn::LoadU(dh, row(3)), hn::LoadU(dh, row(2)));
+            if (!hn::AllFalse(df, hn::And(in_box, hn::Or(hn::Lt(v01, bound), hn::Lt(v23, bound))))) return false;
         }
         return true;
     }
