@@ -399,8 +399,9 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
 // Triangle soups (no indices, 4 floats per vertex), which the SIMD targets gather 16
 // triangles at a time with a transpose (gather_direct_ready): NaN, infinite, behind-the-eye and
 // huge vertices, padding between vertices, a partial last batch, and inputs the fast gather
-// must leave to the generic one (x, y, z only; positions not aligned as floats). Every
-// instruction set gives the scalar reference's statistics and bits.
+// must leave to the generic one (x, y, z only; positions not aligned as floats); under the
+// identity (TransformBatch's shortcut, with a z alone not finite and signed zeros) and under
+// another matrix. Every instruction set gives the scalar reference's statistics and bits.
 TEST(Isa, TriangleSoupsGiveTheReferenceBits) {
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f), w(0.2f, 40.0f);
@@ -416,6 +417,10 @@ TEST(Isa, TriangleSoupsGiveTheReferenceBits) {
         p[0] = (cx + unit(rng) * spread) * wv, p[1] = (cy + unit(rng) * spread) * wv, p[2] = 0.0f, p[3] = wv;
         if (v % 211 == 0) p[v % 2] = std::numeric_limits<float>::quiet_NaN();
         if (v % 223 == 0) p[3] = std::numeric_limits<float>::infinity();
+        // Only z not finite: the identity's product makes x NaN (0 * z), so must its shortcut.
+        if (v % 227 == 0) p[2] = (v % 2 == 0 ? 1.0f : -1.0f) * std::numeric_limits<float>::infinity();
+        if (v % 229 == 0) p[2] = std::numeric_limits<float>::quiet_NaN();
+        if (v % 7 == 0) p[v % 3 == 0 ? 0 : 1] = -0.0f;  // zeros whose sign the product may change
     }
     // The same vertices one byte further on: floats no longer aligned.
     std::vector<unsigned char> misaligned(vertices.size() * sizeof(float) + 1);
@@ -423,18 +428,22 @@ TEST(Isa, TriangleSoupsGiveTheReferenceBits) {
 
     auto render_all = [&](std::vector<OcclusionBuffer>& out) {
         for (const int components : {4, 3})
-            for (const bool aligned : {true, false}) {
-                TriangleInput in;
-                in.positions = aligned ? static_cast<const void*>(vertices.data()) : misaligned.data() + 1;
-                in.position_components = components;
-                in.position_stride = kStride * sizeof(float);
-                in.vertex_count = 3 * kTriangles;
-                in.triangle_count = kTriangles;  // not a multiple of 16
-                in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-                in.backface = Backface::none;
-                out.emplace_back(test::buffer_config(203, 117, 2, 0.5f));
-                out.back().render(in);
-            }
+            for (const bool aligned : {true, false})
+                for (const bool identity : {true, false}) {
+                    TriangleInput in;
+                    in.positions = aligned ? static_cast<const void*>(vertices.data()) : misaligned.data() + 1;
+                    in.position_components = components;
+                    in.position_stride = kStride * sizeof(float);
+                    in.vertex_count = 3 * kTriangles;
+                    in.triangle_count = kTriangles;  // not a multiple of 16
+                    // The identity (positions in clip space: TransformBatch's shortcut), and
+                    // a matrix that is not (the product).
+                    in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+                    if (!identity) in.model_to_clip = {1.5f, 0, 0, 0, 0, -1.25f, 0, 0, 0, 0, 1, 0, 0.25f, 0, 0, 1};
+                    in.backface = Backface::none;
+                    out.emplace_back(test::buffer_config(203, 117, 2, 0.5f));
+                    out.back().render(in);
+                }
     };
     select_isa("scalar");
     std::vector<OcclusionBuffer> reference;
@@ -445,8 +454,8 @@ TEST(Isa, TriangleSoupsGiveTheReferenceBits) {
     EXPECT_GT(stats.near_clipped, 0u);
     EXPECT_GT(stats.too_large, 0u);
     EXPECT_GT(stats.rasterized, 1000u);
-    EXPECT_TRUE(reference[0].stats() == reference[1].stats());  // alignment changes nothing
-    EXPECT_TRUE(test::same_subtiles(reference[0], reference[1]));
+    EXPECT_TRUE(reference[0].stats() == reference[2].stats());  // alignment changes nothing
+    EXPECT_TRUE(test::same_subtiles(reference[0], reference[2]));
     expect_every_isa_gives(reference, render_all);
 }
 

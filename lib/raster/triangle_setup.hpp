@@ -20,6 +20,14 @@ inline glm::dvec4 transform_to_clip(const std::array<float, 16>& m, double x, do
     return r;
 }
 
+// Whether m is the identity (a -0 counts as 0): transform_to_clip then returns the position,
+// but for the sign of a zero and for a position with a coordinate that is not finite (all NaN).
+inline bool is_identity(const std::array<float, 16>& m) {
+    for (int i = 0; i < 16; ++i)
+        if (m[std::size_t(i)] != (i % 5 == 0 ? 1.0f : 0.0f)) return false;
+    return true;
+}
+
 inline bool finite_clip(const glm::dvec4& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.w); }
 
 // Throws homcull::Error, naming `caller`, for input no triangle can be read from: 3 or 4
