@@ -1,7 +1,8 @@
 // The nearest-first draw order (raster/draw_order.hpp, TriangleInput::order): the sorted copy
 // holds every triangle once with its flags, depth classes come nearest first and keep input
-// order within, bad triangles come last, every instruction set sorts alike, and a render in
-// that order equals a render of the same triangles handed over in that order.
+// order within, bad triangles come last, every instruction set sorts alike, the list of
+// numbers a render on one thread reads instead follows the copy, and a render in that order
+// equals a render of the same triangles handed over in that order.
 #include "raster/draw_order.hpp"
 #include "support.hpp"
 
@@ -257,9 +258,51 @@ TEST(DrawOrder, EveryInstructionSetSortsAlike) {
     }
 }
 
+// On one thread (a DrawList given), a soup of 4 floats per vertex is sorted as a list of
+// numbers instead of a copy: the input itself, its own flags, and the list in the copy's order.
+// Other inputs, and a soup with a vertex cache, still get the copy and no list.
+TEST(DrawOrder, OneThreadSortsSoupsOfFourFloatsAsAListInTheCopysOrder) {
+    std::mt19937_64 rng(6);
+    for (const Kind kind : kKinds)
+        for (const std::size_t n : {std::size_t(1), std::size_t(31), std::size_t(20005)}) {
+            const std::string where = name(kind) + ", " + std::to_string(n) + " triangles";
+            const Input input = make_input(kind, n, rng, /*bad=*/true);
+            DrawOrderScratch copy_scratch, list_scratch;
+            TriangleInput copy, listed;
+            DrawList list;
+            ASSERT_TRUE(sort_nearest_first(input.in, nullptr, 1.0, {}, copy_scratch, copy)) << where;
+            ASSERT_TRUE(sort_nearest_first(input.in, nullptr, 1.0, {}, list_scratch, listed, &list)) << where;
+            if (kind != Kind::soup4) {
+                EXPECT_EQ(list.order, nullptr) << where;
+                EXPECT_TRUE(std::equal(copy_scratch.data.begin(), copy_scratch.data.end(), list_scratch.data.begin())) << where;
+                continue;
+            }
+            ASSERT_NE(list.order, nullptr) << where;
+            EXPECT_EQ(listed.positions, input.in.positions) << where;
+            EXPECT_EQ(listed.shared_edges, input.in.shared_edges) << where;
+            EXPECT_EQ(listed.order, DrawOrder::as_given) << where;
+            const std::vector<std::size_t> from = input_positions(input.in, copy, where);
+            ASSERT_EQ(from.size(), n) << where;
+            for (std::size_t k = 0; k < n; ++k) ASSERT_EQ(list.order[k], from[k]) << where << ", position " << k;
+        }
+    // With a vertex cache there is no list (the setup reads the cache).
+    const Input input = make_input(Kind::soup4, 100, rng, /*bad=*/false);
+    std::vector<double> planes(4 * (input.in.vertex_count + kVertexClipPadding));
+    std::vector<std::uint8_t> outcodes(input.in.vertex_count);
+    const std::size_t plane = input.in.vertex_count + kVertexClipPadding;
+    const VertexClip cache{planes.data(), planes.data() + plane, planes.data() + 2 * plane, planes.data() + 3 * plane, outcodes.data()};
+    selected_front_end_kernels().transform_vertices(input.in, 1.0, 0, input.in.vertex_count, cache);
+    DrawOrderScratch scratch;
+    TriangleInput sorted;
+    DrawList list;
+    ASSERT_TRUE(sort_nearest_first(input.in, &cache, 1.0, {}, scratch, sorted, &list));
+    EXPECT_EQ(list.order, nullptr);
+}
+
 // Rendering nearest first gives the bits of rendering, as given, the triangles in the order the
-// sort chose; and it updates fewer subtiles than rendering them as they come (random in depth):
-// more triangles are found hidden.
+// sort chose (on one thread through the list, with a job system from the copy); and it updates
+// fewer subtiles than rendering them as they come (random in depth): more triangles are found
+// hidden.
 TEST(DrawOrder, ARenderNearestFirstIsTheRenderOfTheSortedTriangles) {
     std::mt19937_64 rng(9);
     Input input = make_input(Kind::soup4, 30000, rng, /*bad=*/false);

@@ -202,21 +202,23 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     // serves it too.
     if (!draw_order_) draw_order_ = std::make_unique<detail::DrawOrderScratch>();
     TriangleInput sorted;
-    const TriangleInput& drawn = detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted) ? sorted : in;
+    detail::DrawList list;  // one thread: the order as a list of numbers, when the input allows
+    const TriangleInput& drawn =
+        detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted, parallel.run ? nullptr : &list) ? sorted : in;
     if (parallel.run) render_binned(drawn, parallel, cache, clear_first);
-    else render_serial(drawn, cache, clear_first);
+    else render_serial(drawn, cache, clear_first, list);
 }
 
 // One thread: each triangle is rasterized over the whole buffer as soon as it is set up, in
 // input order; nothing is binned. Every subtile sees the triangles in the same order as in
 // render_binned, so both give the same bits.
-void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first) {
+void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list) {
     if (clear_first) clear_rows(0, subtiles_y_);
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t updated = 0;
     RasterStats stats;
     detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
-                                 stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); });
+                                 stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); }, list);
     stats.subtiles_updated = updated;
     stats_ += stats;
     build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);

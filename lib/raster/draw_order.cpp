@@ -107,8 +107,12 @@ void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bu
     for (std::size_t t = begin; t < end; ++t) copy(t, std::size_t(start[class_of[bucket[t]]]++));
 }
 
-void place_range(const TriangleInput& in, std::size_t begin, std::size_t end, const std::uint16_t* bucket, const std::uint8_t* class_of,
-                 std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges) {
+void place_range(const TriangleInput& in, bool listed, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
+                 const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges) {
+    if (listed) {  // the triangles' numbers only (DrawList): shared-edge flags stay the input's
+        place_triangles(begin, end, bucket, class_of, start, [&](std::size_t t, std::size_t p) { data[p] = std::uint32_t(t); });
+        return;
+    }
     const auto place = [&](auto&& copy) {
         if (shared_edges) {
             place_triangles(begin, end, bucket, class_of, start, [&](std::size_t t, std::size_t p) {
@@ -153,10 +157,12 @@ void check_draw_order(const TriangleInput& in) {
 }
 
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
-                        DrawOrderScratch& scratch, TriangleInput& sorted) {
+                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list) {
     const std::size_t n = in.triangle_count;
+    if (list) list->order = nullptr;
     if (in.order == DrawOrder::as_given || n == 0) return false;
     check_draw_order(in);
+    const bool listed = list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
     // A counting sort in tasks of kDrawOrderTask triangles, in two passes:
     // 1. each task buckets its triangles (fine buckets, about 1 % of w each) and counts them
     //    per bucket;
@@ -168,10 +174,12 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     // (S1's render with 1,024 classes was slower than with none), and drawing S1 in 32 classes
     // of depth is within 2 % of drawing it fully sorted (docs/occlusion-buffer.md, "Draw order").
     const std::size_t tasks = (n + kDrawOrderTask - 1) / kDrawOrderTask;
-    const std::size_t words = in.indices ? (in.indices_16bit ? (3 * n + 1) / 2 : 3 * n) : 3 * n * std::size_t(in.position_components);
+    const std::size_t words = listed        ? n
+                              : in.indices ? (in.indices_16bit ? (3 * n + 1) / 2 : 3 * n)
+                                           : 3 * n * std::size_t(in.position_components);
     if (scratch.bucket.size() < n) scratch.bucket.resize(n);
     if (scratch.data.size() < words) scratch.data.resize(words);
-    if (in.shared_edges && scratch.shared_edges.size() < n) scratch.shared_edges.resize(n);
+    if (in.shared_edges && !listed && scratch.shared_edges.size() < n) scratch.shared_edges.resize(n);
     if (scratch.count.size() < tasks * kDrawOrderBuckets) scratch.count.resize(tasks * kDrawOrderBuckets);
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
     std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
@@ -181,7 +189,8 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         const VertexClip* cache;
         double near_w;
         DrawOrderScratch* scratch;
-    } job{&in, cache, near_w, &scratch};
+        bool listed;
+    } job{&in, cache, near_w, &scratch, listed};
     const auto run = [&](void (*task)(void*, std::size_t)) { run_tasks(parallel, tasks, task, &job); };
     run([](void* data, std::size_t k) {
         const Job& j = *static_cast<Job*>(data);
@@ -221,12 +230,17 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     run([](void* data, std::size_t k) {
         const Job& j = *static_cast<Job*>(data);
         DrawOrderScratch& s = *j.scratch;
-        place_range(*j.in, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(), s.class_of,
-                    s.start.data() + k * kDrawOrderClasses, s.data.data(), j.in->shared_edges ? s.shared_edges.data() : nullptr);
+        place_range(*j.in, j.listed, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(),
+                    s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
+                    j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr);
     });
 
     sorted = in;
     sorted.order = DrawOrder::as_given;
+    if (listed) {
+        list->order = scratch.data.data();
+        return true;
+    }
     sorted.shared_edges = in.shared_edges ? scratch.shared_edges.data() : nullptr;
     if (in.indices) {
         sorted.indices = scratch.data.data();

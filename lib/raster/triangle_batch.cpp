@@ -7,13 +7,13 @@ namespace homcull::detail {
 namespace {
 
 template <typename Index>
-std::uint32_t read_indices(const Index* indices, std::size_t first, int count, std::size_t vertex_count,
+std::uint32_t read_indices(const Index* indices, const std::size_t* triangle, int count, std::size_t vertex_count,
                            std::uint32_t (&index)[3][TriangleBatch::kSize]) {
     std::uint32_t valid = 0;
     for (int t = 0; t < count; ++t) {
         bool ok = true;
         for (int k = 0; k < 3; ++k) {
-            index[k][t] = vertex_index(indices, first + std::size_t(t), k);
+            index[k][t] = vertex_index(indices, triangle[t], k);
             ok = ok && index[k][t] < vertex_count;
         }
         valid |= std::uint32_t(ok) << t;
@@ -94,11 +94,11 @@ bool use_vertex_cache(const TriangleInput& in) {
     return in.indices && in.vertex_count > 0 && in.vertex_count <= 2 * in.triangle_count && in.vertex_count <= kMaxCachedVertices;
 }
 
-void gather_triangle_batch(const TriangleInput& in, std::size_t first, int count, TriangleBatch& batch) {
+void gather_triangle_batch(const TriangleInput& in, std::size_t first, int count, TriangleBatch& batch, const std::uint32_t* order) {
     std::uint32_t index[3][TriangleBatch::kSize];
+    for (int t = 0; t < count; ++t) batch.triangle[t] = order ? std::size_t(order[first + std::size_t(t)]) : first + std::size_t(t);
     batch.indices_valid =
-        with_typed_indices(in, [&](const auto* indices) { return read_indices(indices, first, count, in.vertex_count, index); });
-    for (int t = 0; t < count; ++t) batch.triangle[t] = first + std::size_t(t);
+        with_typed_indices(in, [&](const auto* indices) { return read_indices(indices, batch.triangle, count, in.vertex_count, index); });
     for (int k = 0; k < 3; ++k)
         for (int t = 0; t < TriangleBatch::kSize; ++t) {
             float p[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // lanes without valid indices (and past count) read nothing

@@ -88,15 +88,16 @@ void TransformVertices(const TriangleInput& in, double near_w, std::size_t begin
 }
 
 // gather_triangle_batch for a full batch of triangles without indices and with 4 float
-// components per vertex (engines' clip-space soups, workload S1): four vertices at a time,
-// one 128-bit load each, a 4 x 4 transpose into x, y, z and w, widened to double. The same
-// values as the scalar gather (float to double is exact).
-void GatherDirectBatch(const TriangleInput& in, std::size_t first, TriangleBatch& batch) {
+// components per vertex (engines' clip-space soups, workload S1), consecutive or listed in
+// `order`: four vertices at a time, one 128-bit load each, a 4 x 4 transpose into x, y, z and
+// w, widened to double. The same values as the scalar gather (float to double is exact).
+void GatherDirectBatch(const TriangleInput& in, std::size_t first, const std::uint32_t* order, TriangleBatch& batch) {
     constexpr int kSize = TriangleBatch::kSize;
     const unsigned char* positions = static_cast<const unsigned char*>(in.positions);
     const std::size_t stride = in.position_stride;
+    for (int t = 0; t < kSize; ++t) batch.triangle[t] = order ? std::size_t(order[first + std::size_t(t)]) : first + std::size_t(t);
     const auto vertex = [&](int t, int k) {
-        return reinterpret_cast<const float*>(positions + (3 * (first + std::size_t(t)) + std::size_t(k)) * stride);
+        return reinterpret_cast<const float*>(positions + (3 * batch.triangle[t] + std::size_t(k)) * stride);
     };
 #if HWY_TARGET == HWY_SCALAR
     for (int k = 0; k < 3; ++k)
@@ -126,7 +127,6 @@ void GatherDirectBatch(const TriangleInput& in, std::size_t first, TriangleBatch
         }
 #endif
     batch.indices_valid = (1u << kSize) - 1u;
-    for (int t = 0; t < kSize; ++t) batch.triangle[t] = first + std::size_t(t);
 }
 
 void TransformBatch(const TriangleInput& in, TriangleBatch& batch) {

@@ -41,6 +41,7 @@ struct RectQuery;
 struct SubtileView;
 struct RasterTarget;
 struct VertexClip;
+struct DrawList;
 struct RasterTriangle;
 struct DrawOrderScratch;
 }  // namespace detail
@@ -359,7 +360,7 @@ private:
     detail::RasterTarget raster_target(int row_begin, int row_end);
     // clear_first: render_frame, which clears the rows where it rasterizes them.
     void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
-    void render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first);
+    void render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list);
     void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
