@@ -54,6 +54,11 @@ HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_
         }
         return hn::Add(hn::Add(hn::Add(hn::Mul(m0, x), hn::Mul(m1, y)), hn::Mul(m2, z)), hn::Mul(m3, w));
     };
+    // The input is read once, front to back, but the hardware prefetcher did not keep up: its
+    // lines are prefetched this many vectors of triangles ahead (S1 at 1080p, one thread: 7.78
+    // -> 7.43 ms with 8; 2, 4 and 32 ahead 7.59, 7.65, 7.52; two threads 4.91 -> 4.75 ms).
+    constexpr std::size_t kPrefetchVectors = 8;
+    const std::size_t vector_bytes = 3 * kComponents * lanes * sizeof(float);
     HWY_ALIGN float w[3 * kMaxLanes];
     HWY_ALIGN float tail[3 * kMaxLanes * kComponents];
     HWY_ALIGN std::uint32_t out[kMaxLanes];
@@ -64,6 +69,10 @@ HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_
             std::fill_n(tail, 3 * kMaxLanes * kComponents, 0.0f);
             std::memcpy(tail, p, 3 * kComponents * n * sizeof(float));
             p = tail;
+        }
+        if (t + kPrefetchVectors * lanes < end) {
+            const char* ahead = reinterpret_cast<const char*>(p + kPrefetchVectors * 3 * kComponents * lanes);
+            for (std::size_t b = 0; b < vector_bytes; b += 64) __builtin_prefetch(ahead + b);
         }
         // The clip w of the 3 * lanes vertices in vertex order, then regrouped by corner.
         for (std::size_t k = 0; k < 3; ++k) hn::Store(clip_w(p + k * lanes * kComponents), df, w + k * lanes);
