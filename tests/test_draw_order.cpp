@@ -214,6 +214,82 @@ TEST(DrawOrder, SortsFromTheVertexCache) {
     }
 }
 
+// Given statistics to count into, the sort from the vertex cache leaves out the triangles the
+// setup would skip by their indices and outcodes, counted as the setup counts them, and keeps
+// the others in the order the full sort gives them.
+TEST(DrawOrder, FromTheVertexCacheLeavesOutWhatTheSetupWouldSkipWithoutReorderingTheRest) {
+    std::mt19937_64 rng(8);
+    for (const Kind kind : {Kind::indexed32, Kind::indexed16}) {
+        Input input = make_input(kind, 30000, rng, /*bad=*/true);
+        for (std::size_t v = 0; v < input.in.vertex_count; v += 2) input.positions[3 * v] = 1e3f;  // half the vertices beyond x = w
+        ASSERT_TRUE(use_vertex_cache(input.in));
+        const TriangleInput& in = input.in;
+        const std::size_t plane = in.vertex_count + kVertexClipPadding;
+        std::vector<double> planes(4 * plane);
+        std::vector<std::uint8_t> outcodes(in.vertex_count);
+        const VertexClip cache{planes.data(), planes.data() + plane, planes.data() + 2 * plane, planes.data() + 3 * plane, outcodes.data()};
+        selected_front_end_kernels().transform_vertices(in, 1.0, 0, in.vertex_count, cache);
+        // What the setup keeps and counts.
+        RasterStats expected;
+        std::vector<bool> kept(in.triangle_count, false);
+        std::size_t kept_count = 0;
+        TriangleBatch batch{};
+        for (std::size_t first = 0; first < in.triangle_count;) {
+            first = gather_cached_batch(in, cache, first, in.triangle_count, batch, expected);
+            for (int t = 0; t < batch.count; ++t) kept[batch.triangle[t]] = true, ++kept_count;
+        }
+        ASSERT_GT(expected.invalid, 0u);
+        ASSERT_GT(expected.outside, 1000u);
+        for (const bool threads : {false, true}) {
+            const std::string where = name(kind) + (threads ? ", job system" : "");
+            const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+            DrawOrderScratch all_scratch, left_scratch;
+            TriangleInput all, left;
+            RasterStats skipped;
+            ASSERT_TRUE(sort_nearest_first(in, &cache, 1.0, parallel, all_scratch, all));
+            ASSERT_TRUE(sort_nearest_first(in, &cache, 1.0, parallel, left_scratch, left, nullptr, &skipped));
+            EXPECT_EQ(skipped.invalid, expected.invalid) << where;
+            EXPECT_EQ(skipped.outside, expected.outside) << where;
+            EXPECT_EQ(skipped.triangles_in, in.triangle_count - kept_count) << where;
+            ASSERT_EQ(left.triangle_count, kept_count) << where;
+            const std::vector<std::size_t> from = input_positions(in, all, where);
+            ASSERT_EQ(from.size(), in.triangle_count) << where;
+            std::size_t p = 0;
+            for (const std::size_t t : from) {
+                if (!kept[t]) continue;
+                ASSERT_EQ(triangle_words(left, p), triangle_words(in, t)) << where << ", position " << p;
+                ++p;
+            }
+        }
+    }
+}
+
+// A render nearest first counts what a render as given counts (the triangles the sort leaves
+// out included), but for the subtiles updated: indexed input with a vertex cache, triangles
+// outside the view and invalid ones, on one thread and with a job system.
+TEST(DrawOrder, ARenderFromTheCacheNearestFirstCountsAsARenderAsGiven) {
+    std::mt19937_64 rng(10);
+    Input input = make_input(Kind::indexed32, 30000, rng, /*bad=*/true);
+    for (std::size_t v = 0; v < input.in.vertex_count; v += 2) input.positions[3 * v] = 1e3f;  // half the vertices beyond x = w
+    TriangleInput in = input.in;
+    ASSERT_TRUE(use_vertex_cache(in));
+    in.model_to_clip = {0.5f, 0, 0, 0, 0, 0.5f, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0};
+    for (const bool threads : {false, true}) {
+        const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+        OcclusionBuffer nearest_first(test::buffer_config(320, 180, 2, 0.1f)), as_given(test::buffer_config(320, 180, 2, 0.1f));
+        nearest_first.render_frame(in, parallel);
+        TriangleInput unsorted = in;
+        unsorted.order = DrawOrder::as_given;
+        as_given.render_frame(unsorted, parallel);
+        RasterStats a = nearest_first.stats(), b = as_given.stats();
+        EXPECT_EQ(a.triangles_in, in.triangle_count);
+        EXPECT_GT(a.outside, 1000u);
+        EXPECT_GT(a.invalid, 0u);
+        a.subtiles_updated = b.subtiles_updated = 0;
+        EXPECT_TRUE(a == b) << (threads ? "job system" : "one thread");
+    }
+}
+
 TEST(DrawOrder, TrianglesInFrontOfTheNearPlaneComeFirstAndTiesKeepInputOrder) {
     // Five triangles: w = 8, 0.5 (in front of near_w = 1, so as near), 8, 1, 3: drawn 0.5 and 1
     // (one bucket, input order), then 3, then the two at 8 in input order.

@@ -203,8 +203,12 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     if (!draw_order_) draw_order_ = std::make_unique<detail::DrawOrderScratch>();
     TriangleInput sorted;
     detail::DrawList list;  // one thread: the order as a list of numbers, when the input allows
+    RasterStats skipped;    // the triangles the sort leaves out (with a vertex cache)
     const TriangleInput& drawn =
-        detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted, parallel.run ? nullptr : &list) ? sorted : in;
+        detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted, parallel.run ? nullptr : &list, &skipped)
+            ? sorted
+            : in;
+    stats_ += skipped;
     if (parallel.run) render_binned(drawn, parallel, cache, clear_first);
     else render_serial(drawn, cache, clear_first, list);
 }

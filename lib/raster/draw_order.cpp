@@ -21,6 +21,10 @@ namespace {
 // range or a w that is not a number. A fixed scale, not the input's range, so that a task can
 // bucket its triangles without waiting for the others.
 constexpr std::uint32_t kLastBucket = kDrawOrderBuckets - 1;
+// A bit of bucket[t] above the buckets: triangle t is left out of the sorted copy (counted by
+// the sort instead of the setup).
+constexpr std::uint32_t kSkippedTriangle = 0x8000;
+static_assert(kDrawOrderBuckets <= kSkippedTriangle, "buckets fit below the flag");
 static_assert(((kLastBucket - 1) >> (23 - kDrawOrderBucketShift)) == 15, "the scale reaches 2^16 near_w");
 
 std::uint32_t float_bits(float f) {
@@ -65,8 +69,62 @@ void bucket_triangles(const Index* indices, std::size_t begin, std::size_t end, 
     }
 }
 
-void bucket_range(const TriangleInput& in, const VertexClip* cache, double near_w, std::size_t begin, std::size_t end, std::uint16_t* bucket,
-                  std::uint32_t* count) {
+// Per vertex of the cache, what bucket_triangles and gather_cached_batch read of it in one
+// word: depth_bucket of its w (kVertexNaN when w is NaN) and its outcode above.
+constexpr std::uint32_t kVertexBucketBits = 0x3FF, kVertexNaN = 0x400;
+constexpr int kVertexOutcodeShift = 16;
+static_assert(kLastBucket <= kVertexBucketBits, "a bucket fits its bits");
+void code_vertices(const VertexClip& cache, double near_w, std::size_t begin, std::size_t end, std::uint32_t* code) {
+    const std::uint32_t near_bits = float_bits(float(near_w));
+    for (std::size_t v = begin; v < end; ++v) {
+        const double w = cache.w[v];
+        const std::uint32_t b = std::isnan(w) ? kVertexNaN : depth_bucket(w, near_bits, near_w);
+        code[v] = b | std::uint32_t(cache.outcode[v]) << kVertexOutcodeShift;
+    }
+}
+
+// bucket_triangles from the vertices' codes, leaving out the triangles gather_cached_batch
+// would skip (an index out of range, a vertex not finite, all three beyond one frustum plane):
+// they are marked kSkippedTriangle in bucket[t], counted per bucket into excluded[] as well as
+// count[] (the bucket depth_bucket gives the nearest w is the smallest of the vertices',
+// as it increases with w), and into `skipped` as that setup counts them.
+template <typename Index>
+void bucket_from_codes(const Index* indices, std::size_t begin, std::size_t end, std::size_t vertex_count, const std::uint32_t* code,
+                       std::uint16_t* bucket, std::uint32_t* count, std::uint32_t* excluded, RasterStats& skipped) {
+    std::uint64_t invalid = 0, outside = 0;
+    for (std::size_t t = begin; t < end; ++t) {
+        const std::uint32_t v0 = vertex_index(indices, t, 0), v1 = vertex_index(indices, t, 1), v2 = vertex_index(indices, t, 2);
+        std::uint32_t b = kLastBucket;
+        bool skip = true;
+        if (v0 < vertex_count && v1 < vertex_count && v2 < vertex_count) {
+            const std::uint32_t c0 = code[v0], c1 = code[v1], c2 = code[v2];
+            const std::uint32_t any = c0 | c1 | c2, all = c0 & c1 & c2;
+            const bool not_finite = ((any >> kVertexOutcodeShift) & kNotFinite) != 0;
+            const bool beyond = ((all >> kVertexOutcodeShift) & kOutsidePlanes) != 0;
+            if (!(any & kVertexNaN)) b = std::min(std::min(c0 & kVertexBucketBits, c1 & kVertexBucketBits), c2 & kVertexBucketBits);
+            invalid += not_finite;
+            outside += beyond;  // (a vertex not finite has no plane bits)
+            skip = not_finite || beyond;
+        } else {
+            ++invalid;
+        }
+        bucket[t] = std::uint16_t(b | (skip ? kSkippedTriangle : 0u));
+        ++count[b];
+        excluded[b] += skip;
+    }
+    skipped.triangles_in += invalid + outside;
+    skipped.invalid += invalid;
+    skipped.outside += outside;
+}
+
+void bucket_range(const TriangleInput& in, const VertexClip* cache, const std::uint32_t* vertex_code, double near_w, std::size_t begin,
+                  std::size_t end, std::uint16_t* bucket, std::uint32_t* count, std::uint32_t* excluded, RasterStats& skipped) {
+    if (vertex_code) {
+        with_typed_indices(in, [&](const auto* indices) {
+            bucket_from_codes(indices, begin, end, in.vertex_count, vertex_code, bucket, count, excluded, skipped);
+        });
+        return;
+    }
     // Without a vertex cache, in float lanes, a triangle per lane: S1's kind of input (no
     // indices, vertices packed), and indexed inputs whose positions are floats that 32-bit
     // offsets reach. (With a cache, its w is read: gathering the positions instead made castle
@@ -103,24 +161,30 @@ void bucket_range(const TriangleInput& in, const VertexClip* cache, double near_
 // compile time (a copy of run-time size went through a library call per triangle).
 template <typename Copy>
 void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bucket, const std::uint8_t* class_of, std::uint32_t* start,
-                     Copy&& copy) {
-    for (std::size_t t = begin; t < end; ++t) copy(t, std::size_t(start[class_of[bucket[t]]]++));
+                     bool some_skipped, Copy&& copy) {
+    if (!some_skipped) {
+        for (std::size_t t = begin; t < end; ++t) copy(t, std::size_t(start[class_of[bucket[t]]]++));
+        return;
+    }
+    for (std::size_t t = begin; t < end; ++t)
+        if (!(bucket[t] & kSkippedTriangle)) copy(t, std::size_t(start[class_of[bucket[t]]]++));
 }
 
-void place_range(const TriangleInput& in, bool listed, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
+void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
                  const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges) {
     if (listed) {  // the triangles' numbers only (DrawList): shared-edge flags stay the input's
-        place_triangles(begin, end, bucket, class_of, start, [&](std::size_t t, std::size_t p) { data[p] = std::uint32_t(t); });
+        place_triangles(begin, end, bucket, class_of, start, some_skipped,
+                        [&](std::size_t t, std::size_t p) { data[p] = std::uint32_t(t); });
         return;
     }
     const auto place = [&](auto&& copy) {
         if (shared_edges) {
-            place_triangles(begin, end, bucket, class_of, start, [&](std::size_t t, std::size_t p) {
+            place_triangles(begin, end, bucket, class_of, start, some_skipped, [&](std::size_t t, std::size_t p) {
                 copy(t, p);
                 shared_edges[p] = in.shared_edges[t];
             });
         } else {
-            place_triangles(begin, end, bucket, class_of, start, copy);
+            place_triangles(begin, end, bucket, class_of, start, some_skipped, copy);
         }
     };
     const unsigned char* positions = static_cast<const unsigned char*>(in.positions);
@@ -157,9 +221,10 @@ void check_draw_order(const TriangleInput& in) {
 }
 
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
-                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list) {
+                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list, RasterStats* skipped) {
     const std::size_t n = in.triangle_count;
     if (list) list->order = nullptr;
+    const VertexClip* skip_by = skipped ? cache : nullptr;  // the cache whose outcodes leave triangles out
     if (in.order == DrawOrder::as_given || n == 0) return false;
     check_draw_order(in);
     const bool listed = list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
@@ -181,27 +246,49 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     if (scratch.data.size() < words) scratch.data.resize(words);
     if (in.shared_edges && !listed && scratch.shared_edges.size() < n) scratch.shared_edges.resize(n);
     if (scratch.count.size() < tasks * kDrawOrderBuckets) scratch.count.resize(tasks * kDrawOrderBuckets);
+    if (scratch.excluded.size() < tasks * kDrawOrderBuckets) scratch.excluded.resize(tasks * kDrawOrderBuckets);
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
+    if (scratch.skipped.size() < tasks) scratch.skipped.resize(tasks);
     std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
+    std::fill_n(scratch.excluded.begin(), tasks * kDrawOrderBuckets, 0u);
+    std::fill_n(scratch.skipped.begin(), tasks, RasterStats{});
 
     struct Job {
         const TriangleInput* in;
         const VertexClip* cache;
+        const VertexClip* skip_by;
         double near_w;
         DrawOrderScratch* scratch;
         bool listed;
-    } job{&in, cache, near_w, &scratch, listed};
+    } job{&in, cache, skip_by, near_w, &scratch, listed};
+    if (skip_by) {  // each vertex's bucket and outcode in a word, read by its triangles
+        if (scratch.vertex_code.size() < in.vertex_count) scratch.vertex_code.resize(in.vertex_count);
+        run_tasks(parallel, (in.vertex_count + kDrawOrderTask - 1) / kDrawOrderTask, [](void* data, std::size_t k) {
+            const Job& j = *static_cast<Job*>(data);
+            code_vertices(*j.skip_by, j.near_w, k * kDrawOrderTask, std::min(j.in->vertex_count, (k + 1) * kDrawOrderTask),
+                          j.scratch->vertex_code.data());
+        }, &job);
+    }
     const auto run = [&](void (*task)(void*, std::size_t)) { run_tasks(parallel, tasks, task, &job); };
     run([](void* data, std::size_t k) {
         const Job& j = *static_cast<Job*>(data);
-        bucket_range(*j.in, j.cache, j.near_w, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
-                     j.scratch->bucket.data(), j.scratch->count.data() + k * kDrawOrderBuckets);
+        DrawOrderScratch& s = *j.scratch;
+        bucket_range(*j.in, j.cache, j.skip_by ? s.vertex_code.data() : nullptr, j.near_w, k * kDrawOrderTask,
+                     std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(), s.count.data() + k * kDrawOrderBuckets,
+                     s.excluded.data() + k * kDrawOrderBuckets, s.skipped[k]);
     });
+    // The triangles left out, counted as the setup would have (in any task order: sums).
+    std::size_t left_out = 0;
+    for (std::size_t k = 0; k < tasks; ++k) {
+        left_out += std::size_t(scratch.skipped[k].triangles_in);
+        if (skipped) *skipped += scratch.skipped[k];
+    }
 
     // The classes: bad triangles (the last bucket) alone in the last class; the other buckets
     // grouped into the classes before it, a new class starting after the bucket where the
     // running count reaches its share, (c + 1) m / (kDrawOrderClasses - 1) for class c of m
-    // good triangles (a bucket is never split).
+    // good triangles (a bucket is never split). Triangles left out count here too, so that
+    // leaving them out does not change the order of the others; their places are not counted.
     std::fill_n(scratch.start.begin(), tasks * kDrawOrderClasses, 0u);
     std::uint64_t good = 0;
     for (std::uint32_t b = 0; b < kLastBucket; ++b)
@@ -214,7 +301,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         scratch.class_of[b] = std::uint8_t(c);
         for (std::size_t k = 0; k < tasks; ++k) {
             const std::uint32_t count = scratch.count[k * kDrawOrderBuckets + b];
-            scratch.start[k * kDrawOrderClasses + c] += count;
+            scratch.start[k * kDrawOrderClasses + c] += count - scratch.excluded[k * kDrawOrderBuckets + b];
             running += count;
         }
         if (c + 1 < kGoodClasses && running * kGoodClasses >= std::uint64_t(c + 1) * good) ++c;
@@ -230,13 +317,14 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     run([](void* data, std::size_t k) {
         const Job& j = *static_cast<Job*>(data);
         DrawOrderScratch& s = *j.scratch;
-        place_range(*j.in, j.listed, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(),
+        place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(),
                     s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
                     j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr);
     });
 
     sorted = in;
     sorted.order = DrawOrder::as_given;
+    sorted.triangle_count = n - left_out;
     if (listed) {
         list->order = scratch.data.data();
         return true;

@@ -35,6 +35,9 @@ constexpr std::size_t kDrawOrderTask = 8192;
 struct DrawOrderScratch {
     std::vector<std::uint16_t> bucket;  // per triangle
     std::vector<std::uint32_t> count;   // per task and bucket
+    std::vector<std::uint32_t> excluded;  // per task and bucket: of count, the triangles left out
+    std::vector<RasterStats> skipped;     // per task: the counts of the triangles left out
+    std::vector<std::uint32_t> vertex_code;  // per vertex of the cache: its bucket and outcode (when leaving triangles out)
     std::vector<std::uint32_t> start;   // per task and class: a count, then the next position
     std::uint8_t class_of[kDrawOrderBuckets];
     std::vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
@@ -81,8 +84,16 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // DrawOrder::as_given. Runs in tasks of `parallel` when it has a job system. `sorted` and the
 // list point into `scratch`. Throws homcull::Error for 2^32 triangles or more (render checks
 // this before it changes anything).
+//
+// Given `skipped` and a cache, the triangles the setup would skip by their indices and
+// outcodes (gather_cached_batch: an index out of range, a vertex not finite, all three
+// vertices beyond one frustum plane) are left out of `sorted` (its triangle_count is then
+// smaller) and counted into *skipped as the setup counts them (triangles_in, invalid,
+// outside); the others keep the order they would have with them. The sort reads each vertex's
+// w anyway, and its three outcodes decide without a branch per triangle where the setup's
+// loop mispredicted (castle view C0, one input, one thread: see docs/occlusion-buffer.md).
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
-                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr);
+                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr);
 
 // Throws homcull::Error when sort_nearest_first would refuse the input (nearest first, 2^32
 // triangles or more), so that render can check before it changes anything.
