@@ -288,6 +288,21 @@ TEST(DrawOrder, ARenderFromTheCacheNearestFirstCountsAsARenderAsGiven) {
         a.subtiles_updated = b.subtiles_updated = 0;
         EXPECT_TRUE(a == b) << (threads ? "job system" : "one thread");
     }
+    // Every triangle left out: the frame is cleared and counted, on one thread and with a job
+    // system, over a buffer that held the frame above.
+    for (const bool threads : {false, true}) {
+        const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+        OcclusionBuffer buffer(test::buffer_config(320, 180, 2, 0.1f)), cleared(test::buffer_config(320, 180, 2, 0.1f));
+        TriangleInput inside = in;
+        for (std::size_t v = 0; v < in.vertex_count; ++v) input.positions[3 * v] = 0.0f;
+        buffer.render_frame(inside, parallel);
+        for (std::size_t v = 0; v < in.vertex_count; ++v) input.positions[3 * v] = 1e9f;  // beyond x = w
+        buffer.render_frame(in, parallel);
+        cleared.clear();
+        EXPECT_TRUE(test::same_subtiles(buffer, cleared)) << (threads ? "job system" : "one thread");
+        EXPECT_EQ(buffer.stats().triangles_in, in.triangle_count);
+        EXPECT_EQ(buffer.stats().outside + buffer.stats().invalid, in.triangle_count);
+    }
 }
 
 TEST(DrawOrder, TrianglesInFrontOfTheNearPlaneComeFirstAndTiesKeepInputOrder) {
