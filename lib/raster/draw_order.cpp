@@ -317,8 +317,8 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     run([](void* data, std::size_t k) {
         const Job& j = *static_cast<Job*>(data);
         DrawOrderScratch& s = *j.scratch;
-        place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(),
-                    s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
+        place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
+                    s.bucket.data(), s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
                     j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr);
     });
 
