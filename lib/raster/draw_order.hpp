@@ -29,9 +29,10 @@ constexpr std::uint32_t kDrawOrderClasses = 32;
 constexpr std::size_t kDrawOrderTask = 8192;
 
 // Scratch of sort_nearest_first, kept by the buffer and grown to the largest input, so that a
-// render allocates nothing after the first: 2 bytes per triangle, 4 KB per task, and the
-// sorted copy (the indices, 6 or 12 bytes per triangle; without indices the positions, 36 or
-// 48; and a byte of shared-edge flags).
+// render allocates nothing after the first: 2 bytes per triangle, 8 KB and a RasterStats per
+// task, 4 bytes per vertex of a vertex cache, and the sorted copy (the indices, 6 or 12 bytes
+// per triangle; without indices the positions, 36 or 48; and a byte of shared-edge flags) or,
+// on one thread for a soup of 4 floats per vertex, the list of numbers (4 bytes per triangle).
 struct DrawOrderScratch {
     std::vector<std::uint16_t> bucket;  // per triangle
     std::vector<std::uint32_t> count;   // per task and bucket

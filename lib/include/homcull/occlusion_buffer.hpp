@@ -117,7 +117,8 @@ struct RasterStats {
 // vertex before drawing them (raster/draw_order.hpp): on workload S1, whose triangles come in
 // random depth order, that renders faster and culls more (docs/occlusion-buffer.md, "Draw
 // order"). It costs a pass over the vertices and a sorted copy of the indices (or, without
-// indices, of the positions), kept by the buffer. as_given draws the triangles as they come,
+// indices, of the positions; on one thread, for positions of 4 floats, a sorted list of the
+// triangles' numbers instead), kept by the buffer. as_given draws the triangles as they come,
 // for inputs already sorted. The order, and so the bits, are the same on every instruction
 // set and with any job system. nearest_first takes at most 2^32 - 1 triangles per call.
 enum class DrawOrder : std::uint8_t { nearest_first, as_given };
