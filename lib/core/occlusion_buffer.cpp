@@ -6,6 +6,7 @@
 #include "core/run_tasks.hpp"
 #include "raster/draw_order.hpp"
 #include "raster/rasterize.hpp"
+#include "raster/reference_cells.hpp"
 #include "raster/triangle_batch.hpp"
 
 #include <hwy/cache_control.h>
@@ -24,6 +25,9 @@ constexpr std::size_t kChunkTriangles = 2048;  // triangles set up per task
 // has twice as many chunks as the one before. S1 at 1080p, two threads: one wave 6.88 ms; a
 // first wave of 2, 4 or 8 chunks 5.06, 5.07, 5.18 ms.
 constexpr std::size_t kFirstWaveChunks = 4;
+// One thread: the triangles set up between two refreshes of the reference cells of the rows
+// drawn into (render_serial).
+constexpr std::size_t kCellRefreshTriangles = 4096;
 // A band reads its bins' triangles in order, but they were written by whichever thread set up
 // their chunk, and a kernel call per triangle is too short for the hardware prefetcher to
 // follow: they are prefetched this many triangles ahead (S1 at 1080p, two threads: 14.0 ->
@@ -82,6 +86,8 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
         size += std::size_t(levels_.back().width) * std::size_t(levels_.back().height);
     }
     pyramid_.assign(size + detail::kMaxSimdLanes, 0.0f);  // padded: RectScan loads whole vectors of a level's row
+    reference_cells_width_ = detail::reference_cells_width(subtiles_x_);
+    reference_cells_.assign(std::size_t(reference_cells_width_) * std::size_t(detail::reference_cells_height(subtiles_y_)), 0.0f);
     for (const detail::PyramidLevel& l : levels_) {
         level_offset_.push_back(std::int32_t(l.offset));
         level_width_.push_back(l.width);
@@ -137,6 +143,21 @@ void OcclusionBuffer::reduce_pyramid_rows(int level, int y_begin, int y_end) {
 void OcclusionBuffer::read_pyramid(std::vector<float>& cells) const {
     const detail::PyramidLevel& top = levels_.back();
     cells.assign(pyramid_.begin(), pyramid_.begin() + std::ptrdiff_t(top.offset + std::size_t(top.width) * std::size_t(top.height)));
+}
+
+detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first) {
+    if (!detail::hidden_skip_enabled() || !detail::selected_refresh_cells()) return {};
+    const detail::ReferenceCells cells{reference_cells_.data(), reference_cells_width_};
+    if (clear_first) std::fill(reference_cells_.begin(), reference_cells_.end(), 0.0f);  // d0 >= 0 everywhere
+    else refresh_reference_cells(cells, 0, subtiles_y_);
+    return cells;
+}
+
+void OcclusionBuffer::refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end) {
+    if (!cells.min_d0 || row_begin >= row_end) return;
+    const detail::SubtilePlanes planes{d0_.data(), d1_.data(), mask_.data(), covered_.data(), stride_, nullptr, 0};
+    detail::selected_refresh_cells()(planes, subtiles_x_, subtiles_y_, row_begin >> detail::kReferenceCellShift,
+                                     ((row_end - 1) >> detail::kReferenceCellShift) + 1, cells);
 }
 
 detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) {
@@ -204,10 +225,15 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     TriangleInput sorted;
     detail::DrawList list;  // one thread: the order as a list of numbers, when the input allows
     RasterStats skipped;    // the triangles the sort leaves out (with a vertex cache)
-    const TriangleInput& drawn =
-        detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted, parallel.run ? nullptr : &list, &skipped)
-            ? sorted
-            : in;
+    // One thread: cell records with the list, when the buffer keeps cells and they fit a byte.
+    const detail::CellRecordSpec record_spec{sample_width_, sample_height_, reference_cells_width_,
+                                             detail::reference_cells_height(subtiles_y_), config_.near_w, in.backface};
+    const bool note = !parallel.run && detail::hidden_skip_enabled() && detail::selected_refresh_cells() && record_spec.cells_width <= 256 &&
+                      record_spec.cells_height <= 256;
+    const TriangleInput& drawn = detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted,
+                                                            parallel.run ? nullptr : &list, &skipped, note ? &record_spec : nullptr)
+                                     ? sorted
+                                     : in;
     stats_ += skipped;
     if (parallel.run) render_binned(drawn, parallel, cache, clear_first);
     else render_serial(drawn, cache, clear_first, list);
@@ -215,14 +241,50 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
 
 // One thread: each triangle is rasterized over the whole buffer as soon as it is set up, in
 // input order; nothing is binned. Every subtile sees the triangles in the same order as in
-// render_binned, so both give the same bits.
+// render_binned, so both give the same bits. With cell records (a clip-space soup drawn
+// nearest first, reference_cells.hpp), the list is taken in slices: a noted triangle hidden
+// behind the reference cells is dropped unread, the others go through the setup, and the cells
+// of the rows the slice changed are refreshed after it.
 void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list) {
     if (clear_first) clear_rows(0, subtiles_y_);
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t updated = 0;
     RasterStats stats;
-    detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
-                                 stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); }, list);
+    const detail::ReferenceCells cells = list.records && target.skip_hidden ? start_reference_cells(clear_first) : detail::ReferenceCells{};
+    if (!cells.min_d0) {
+        detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
+                                     &target, stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); }, list);
+    } else {
+        int changed_begin = subtiles_y_, changed_end = 0;  // the subtile rows changed since the last refresh
+        const auto draw = [&](const detail::RasterTriangle& tri) {
+            const std::uint64_t n = target.kernel(target, tri);
+            updated += n;
+            if (n != 0) {
+                changed_begin = std::min(changed_begin, tri.j0 / kH);
+                changed_end = std::max(changed_end, tri.j1 / kH + 1);
+            }
+        };
+        if (undecided_.size() < kCellRefreshTriangles) undecided_.resize(kCellRefreshTriangles);
+        for (std::size_t begin = 0; begin < in.triangle_count; begin += kCellRefreshTriangles) {
+            const std::size_t end = std::min(in.triangle_count, begin + kCellRefreshTriangles);
+            // A dropped triangle counts as the setup counts a hidden one (rasterized).
+            std::size_t undecided = 0;
+            std::uint64_t hidden = 0;
+            for (std::size_t k = begin; k < end; ++k) {
+                if (k + 16 < end) __builtin_prefetch(list.records + list.order[k + 16]);  // scattered over the notes
+                const bool drop = detail::hidden_by_record(cells, list.records[list.order[k]]);
+                hidden += drop;
+                undecided_[undecided] = list.order[k];
+                undecided += !drop;
+            }
+            stats.triangles_in += hidden;
+            stats.rasterized += hidden;
+            detail::setup_triangle_range(in, cache, 0, undecided, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
+                                         stats, draw, detail::DrawList{undecided_.data(), nullptr});
+            refresh_reference_cells(cells, changed_begin, changed_end);
+            changed_begin = subtiles_y_, changed_end = 0;
+        }
+    }
     stats.subtiles_updated = updated;
     stats_ += stats;
     build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);

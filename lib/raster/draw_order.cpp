@@ -118,7 +118,8 @@ void bucket_from_codes(const Index* indices, std::size_t begin, std::size_t end,
 }
 
 void bucket_range(const TriangleInput& in, const VertexClip* cache, const std::uint32_t* vertex_code, double near_w, std::size_t begin,
-                  std::size_t end, std::uint16_t* bucket, std::uint32_t* count, std::uint32_t* excluded, RasterStats& skipped) {
+                  std::size_t end, std::uint16_t* bucket, std::uint32_t* count, std::uint32_t* excluded, RasterStats& skipped,
+                  const CellRecordSpec* spec, CellRecord* noted) {
     if (vertex_code) {
         with_typed_indices(in, [&](const auto* indices) {
             bucket_from_codes(indices, begin, end, in.vertex_count, vertex_code, bucket, count, excluded, skipped);
@@ -137,7 +138,7 @@ void bucket_range(const TriangleInput& in, const VertexClip* cache, const std::u
     const bool float_aligned = reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0 && in.position_stride % sizeof(float) == 0;
     const std::size_t stride = in.position_stride / sizeof(float);
     if (!cache && !in.indices && float_aligned && stride == std::size_t(in.position_components)) {
-        bucket_packed_soup(positions, in.position_components, begin, end, row, float(near_w), bucket, count);
+        bucket_packed_soup(positions, in.position_components, begin, end, row, float(near_w), bucket, count, spec, noted);
         return;
     }
     if (!cache && in.indices && float_aligned && in.vertex_count > 0 && in.vertex_count <= (std::size_t(1) << 31) / stride) {
@@ -221,13 +222,16 @@ void check_draw_order(const TriangleInput& in) {
 }
 
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
-                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list, RasterStats* skipped) {
+                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list, RasterStats* skipped, const CellRecordSpec* records) {
     const std::size_t n = in.triangle_count;
-    if (list) list->order = nullptr;
+    if (list) *list = DrawList{};
     const VertexClip* skip_by = skipped ? cache : nullptr;  // the cache whose outcodes leave triangles out
     if (in.order == DrawOrder::as_given || n == 0) return false;
     check_draw_order(in);
     const bool listed = list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
+    // Notes for the cells: the bucket pass of a packed soup (the list's input) in clip space.
+    const bool noting = listed && records && is_identity(in.model_to_clip) && !in.indices &&
+                        in.position_stride == std::size_t(in.position_components) * sizeof(float);
     // A counting sort in tasks of kDrawOrderTask triangles, in two passes:
     // 1. each task buckets its triangles (fine buckets, about 1 % of w each) and counts them
     //    per bucket;
@@ -249,6 +253,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     if (scratch.excluded.size() < tasks * kDrawOrderBuckets) scratch.excluded.resize(tasks * kDrawOrderBuckets);
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
     if (scratch.skipped.size() < tasks) scratch.skipped.resize(tasks);
+    if (noting && scratch.noted.size() < n) scratch.noted.resize(n);
     std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.excluded.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.skipped.begin(), tasks, RasterStats{});
@@ -260,7 +265,8 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         double near_w;
         DrawOrderScratch* scratch;
         bool listed;
-    } job{&in, cache, skip_by, near_w, &scratch, listed};
+        const CellRecordSpec* records;  // null: no notes
+    } job{&in, cache, skip_by, near_w, &scratch, listed, noting ? records : nullptr};
     if (skip_by) {  // each vertex's bucket and outcode in a word, read by its triangles
         if (scratch.vertex_code.size() < in.vertex_count) scratch.vertex_code.resize(in.vertex_count);
         run_tasks(parallel, (in.vertex_count + kDrawOrderTask - 1) / kDrawOrderTask, [](void* data, std::size_t k) {
@@ -275,7 +281,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         DrawOrderScratch& s = *j.scratch;
         bucket_range(*j.in, j.cache, j.skip_by ? s.vertex_code.data() : nullptr, j.near_w, k * kDrawOrderTask,
                      std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(), s.count.data() + k * kDrawOrderBuckets,
-                     s.excluded.data() + k * kDrawOrderBuckets, s.skipped[k]);
+                     s.excluded.data() + k * kDrawOrderBuckets, s.skipped[k], j.records, j.records ? s.noted.data() : nullptr);
     });
     // The triangles left out, counted as the setup would have (in any task order: sums).
     std::size_t left_out = 0;
@@ -327,6 +333,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     sorted.triangle_count = n - left_out;
     if (listed) {
         list->order = scratch.data.data();
+        if (noting) list->records = scratch.noted.data();
         return true;
     }
     sorted.shared_edges = in.shared_edges ? scratch.shared_edges.data() : nullptr;

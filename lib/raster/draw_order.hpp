@@ -11,6 +11,7 @@
 // of that w as a float (a logarithmic scale, about 1 % of w per bucket), in tasks of the
 // caller's job system. It depends only on the input, so the order, and the bits rendered in
 // it, are the same on every instruction set and with any job system.
+#include "raster/reference_cells.hpp"
 #include "raster/triangle_batch.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -43,6 +44,7 @@ struct DrawOrderScratch {
     std::uint8_t class_of[kDrawOrderBuckets];
     std::vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
     std::vector<std::uint8_t> shared_edges;
+    std::vector<CellRecord> noted;  // with the list: each triangle's cell record
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 
@@ -50,8 +52,10 @@ static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 // floats: the bucket of each triangle of [begin, end) into bucket[t], counted into count[].
 // In float lanes (draw_order_simd.cpp), the same on every instruction set; row is the
 // matrix's last row (m[3], m[7], m[11], m[15]).
+// With `records` (and its spec; the matrix must then be the identity), also the cell record
+// of each triangle into records[t] (reference_cells.hpp).
 void bucket_packed_soup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
-                        std::uint16_t* bucket, std::uint32_t* count);
+                        std::uint16_t* bucket, std::uint32_t* count, const CellRecordSpec* spec = nullptr, CellRecord* records = nullptr);
 
 // The same for an indexed input, its positions gathered `stride` floats apart (stride *
 // vertex_count <= 2^31, vertex_count > 0); a triangle with an index out of range takes the
@@ -93,8 +97,15 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // outside); the others keep the order they would have with them. The sort reads each vertex's
 // w anyway, and its three outcodes decide without a branch per triangle where the setup's
 // loop mispredicted (castle view C0, one input, one thread: see docs/occlusion-buffer.md).
+//
+// Given `records` as well as `list`, when the list is made and the input is a clip-space soup
+// (the matrix is the identity), the first pass also notes each triangle for the reference
+// cells (bucket_packed_soup), and list->records holds the notes in the list's order: 8 more
+// bytes a triangle, so that the setup can drop most hidden triangles without reading them
+// (OcclusionBuffer::render_serial). Otherwise list->records is null.
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
-                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr);
+                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr,
+                        const CellRecordSpec* records = nullptr);
 
 // Throws homcull::Error when sort_nearest_first would refuse the input (nearest first, 2^32
 // triangles or more), so that render can check before it changes anything.

@@ -9,11 +9,16 @@
 
 #include <hwy/highway.h>
 
+#include "raster/clip_fates-inl.h"
 #include "raster/draw_order.hpp"
+#include "raster/lane_bits-inl.h"
+#include "raster/reference_cells.hpp"
 
 #include <algorithm>
 #include <cstdint>
+#include <cstddef>
 #include <cstring>
+#include <limits>
 
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
@@ -31,12 +36,80 @@ HWY_INLINE hn::Vec<hn::RebindToUnsigned<DF>> Buckets(DF /* df */, hn::Vec<DF> w0
     return hn::IfThenElse(hn::RebindMask(du, is_nan), hn::Set(du, kDrawOrderBuckets - 1), bucket);
 }
 
+// The cell records (reference_cells.hpp) of `count` triangles of a clip-space soup, their
+// corners' coordinates in corner[c][k][i] (c: x, y, z, w; k: corner; i: triangle). A triangle is
+// noted when the setup would surely count it as rasterized: its fate in double lanes exactly as
+// ClassifyBatch decides it (its clip coordinates are its positions, exact in double), z finite
+// too (TransformBatch makes the triangle invalid otherwise), and w at most 2^64 (depths far
+// from float's denormals, where the plane's error bound holds). Its box is rounded out by a
+// sample (the float projection below is within a fifth of a sample of the setup's for any
+// buffer of at most 256 cells a side), and its depth is 1/(smallest w) rounded up.
+template <class DF>
+HWY_INLINE void NoteTriangles(DF df, const CellRecordSpec& spec, const float (*corner)[3][16], std::size_t count, CellRecord* records) {
+    const hn::CappedTag<double, 8> dd;
+    const hn::Rebind<float, decltype(dd)> dh;
+    const std::size_t lanes = hn::Lanes(df);
+    std::uint32_t surely_drawn = 0;  // bit i: triangle i is noted
+    for (std::size_t g = 0; g < lanes; g += hn::Lanes(dd)) {
+        const auto load = [&](int c, int k) { return hn::PromoteTo(dd, hn::Load(dh, corner[c][k] + g)); };
+        hn::Mask<decltype(dd)> finite, outside, unsettled, away;
+        hn::Vec<decltype(dd)> det;
+        ClipFates(dd, spec.backface, double(spec.near_w), load(0, 0), load(1, 0), load(3, 0), load(0, 1), load(1, 1), load(3, 1), load(0, 2),
+                  load(1, 2), load(3, 2), finite, outside, unsettled, det, away);
+        const auto settled = hn::AndNot(hn::Or(hn::Or(outside, unsettled), hn::Or(hn::Eq(det, hn::Zero(dd)), away)), finite);
+        surely_drawn |= LaneBits(dd, settled) << g;
+    }
+    const hn::RebindToSigned<DF> di;
+    const auto one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f), margin = hn::Set(df, 1.0f);
+    const auto width = hn::Set(df, float(spec.sample_width)), height = hn::Set(df, float(spec.sample_height));
+    auto sane = hn::FirstN(df, lanes);
+    auto x_lo = hn::Set(df, HUGE_VALF), x_hi = hn::Neg(x_lo), y_lo = x_lo, y_hi = x_hi, w_min = x_lo;
+    for (int k = 0; k < 3; ++k) {
+        const auto x = hn::Load(df, corner[0][k]), y = hn::Load(df, corner[1][k]), z = hn::Load(df, corner[2][k]);
+        const auto w = hn::Load(df, corner[3][k]);
+        sane = hn::And(sane, hn::And(hn::IsFinite(z), hn::Le(w, hn::Set(df, 0x1.0p64f))));
+        const auto inv_w = hn::Div(one, w);
+        const auto sx = hn::Mul(hn::Mul(hn::Add(hn::Mul(x, inv_w), one), half), width);
+        const auto sy = hn::Mul(hn::Mul(hn::Sub(one, hn::Mul(y, inv_w)), half), height);
+        x_lo = hn::Min(x_lo, sx), x_hi = hn::Max(x_hi, sx), y_lo = hn::Min(y_lo, sy), y_hi = hn::Max(y_hi, sy);
+        w_min = hn::Min(w_min, w);
+    }
+    surely_drawn &= LaneBits(df, sane);
+    // Cells: 64 samples wide (8 subtiles of 8), 32 high (8 subtiles of 4).
+    const hn::RebindToUnsigned<DF> du;
+    const auto cell = [&](auto v, float samples_per_cell, int cells) {
+        const auto c = hn::Floor(hn::Mul(v, hn::Set(df, 1.0f / samples_per_cell)));  // exact scaling by a power of two
+        return hn::BitCast(du, hn::ConvertTo(di, hn::Min(hn::Max(c, hn::Zero(df)), hn::Set(df, float(cells - 1)))));
+    };
+    auto box = hn::Or(hn::Or(cell(hn::Sub(x_lo, margin), 64.0f, spec.cells_width),
+                                   hn::ShiftLeft<8>(cell(hn::Add(x_hi, margin), 64.0f, spec.cells_width))),
+                            hn::Or(hn::ShiftLeft<16>(cell(hn::Sub(y_lo, margin), 32.0f, spec.cells_height)),
+                                   hn::ShiftLeft<24>(cell(hn::Add(y_hi, margin), 32.0f, spec.cells_height))));
+    // 1/w_min to nearest, at most 2^-24 off; times 1 + 2^-20, above the double 1/w_min the
+    // setup computes (and at least 2^-64). NaN for a triangle not noted: no cell is at least that.
+    // The box of a triangle not noted may come from NaNs: cell 0 instead, within the cells.
+    const std::uint8_t noted_bits[8] = {std::uint8_t(surely_drawn), std::uint8_t(surely_drawn >> 8)};
+    const auto noted = hn::LoadMaskBits(df, noted_bits);
+    const auto nearest = hn::IfThenElse(noted, hn::Mul(hn::Div(one, w_min), hn::Set(df, 1.0f + 0x1.0p-20f)),
+                                        hn::Set(df, std::numeric_limits<float>::quiet_NaN()));
+    box = hn::IfThenElseZero(hn::RebindMask(du, noted), box);
+    static_assert(sizeof(CellRecord) == 2 * sizeof(std::uint32_t) && offsetof(CellRecord, nearest) == sizeof(std::uint32_t),
+                  "a record is its four cell bytes (little-endian: cx0 lowest) and its float");
+    if (count == lanes) {
+        hn::StoreInterleaved2(box, hn::BitCast(du, nearest), du, reinterpret_cast<std::uint32_t*>(records));
+    } else {
+        HWY_ALIGN std::uint32_t both[2 * 16];
+        hn::StoreInterleaved2(box, hn::BitCast(du, nearest), du, both);
+        std::memcpy(records, both, count * sizeof(CellRecord));
+    }
+}
+
 // Buckets triangles [begin, end) of a packed soup (kComponents floats per vertex, x y z [w]),
 // into bucket[t], and counts them into count[]. row: the matrix's last row (m[3], m[7], m[11],
 // m[15]).
 template <int kComponents>
 HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
-                           std::uint32_t* count) {
+                           std::uint32_t* count, const CellRecordSpec* spec, CellRecord* records) {
     const hn::CappedTag<float, 16> df;
     const hn::RebindToUnsigned<decltype(df)> du;
     constexpr std::size_t kMaxLanes = 16;
@@ -76,6 +149,27 @@ HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_
         }
         // The clip w of the 3 * lanes vertices in vertex order, then regrouped by corner.
         for (std::size_t k = 0; k < 3; ++k) hn::Store(clip_w(p + k * lanes * kComponents), df, w + k * lanes);
+        if (records) {  // the positions, by corner (the matrix is the identity)
+            HWY_ALIGN float by_vertex[4][3 * kMaxLanes];
+            for (std::size_t k = 0; k < 3; ++k) {
+                hn::Vec<decltype(df)> x, y, z, v;
+                if constexpr (kComponents == 4) {
+                    hn::LoadInterleaved4(df, p + k * lanes * kComponents, x, y, z, v);
+                } else {
+                    hn::LoadInterleaved3(df, p + k * lanes * kComponents, x, y, z);
+                    v = hn::Set(df, 1.0f);
+                }
+                hn::Store(x, df, by_vertex[0] + k * lanes), hn::Store(y, df, by_vertex[1] + k * lanes);
+                hn::Store(z, df, by_vertex[2] + k * lanes), hn::Store(v, df, by_vertex[3] + k * lanes);
+            }
+            HWY_ALIGN float corner[4][3][kMaxLanes];
+            for (int c = 0; c < 4; ++c) {
+                hn::Vec<decltype(df)> c0, c1, c2;
+                hn::LoadInterleaved3(df, by_vertex[c], c0, c1, c2);
+                hn::Store(c0, df, corner[c][0]), hn::Store(c1, df, corner[c][1]), hn::Store(c2, df, corner[c][2]);
+            }
+            NoteTriangles(df, *spec, corner, n, records + t);
+        }
         hn::Vec<decltype(df)> w0, w1, w2;
         hn::LoadInterleaved3(df, w, w0, w1, w2);
         hn::Store(Buckets(df, w0, w1, w2, near), du, out);
@@ -87,9 +181,9 @@ HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_
 }
 
 void BucketPackedSoup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
-                      std::uint16_t* bucket, std::uint32_t* count) {
-    if (components == 4) BucketSoup<4>(positions, begin, end, row, near_w, bucket, count);
-    else BucketSoup<3>(positions, begin, end, row, near_w, bucket, count);
+                      std::uint16_t* bucket, std::uint32_t* count, const CellRecordSpec* spec, CellRecord* records) {
+    if (components == 4) BucketSoup<4>(positions, begin, end, row, near_w, bucket, count, spec, records);
+    else BucketSoup<3>(positions, begin, end, row, near_w, bucket, count, spec, records);
 }
 
 // Buckets triangles [begin, end) of an indexed input, a triangle per lane: its three vertex
@@ -164,8 +258,8 @@ HWY_EXPORT(BucketPackedSoup);
 HWY_EXPORT(BucketIndexed);
 
 void bucket_packed_soup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
-                        std::uint16_t* bucket, std::uint32_t* count) {
-    HOMCULL_RESOLVED_KERNEL(BucketPackedSoup)(positions, components, begin, end, row, near_w, bucket, count);
+                        std::uint16_t* bucket, std::uint32_t* count, const CellRecordSpec* spec, CellRecord* records) {
+    HOMCULL_RESOLVED_KERNEL(BucketPackedSoup)(positions, components, begin, end, row, near_w, bucket, count, spec, records);
 }
 
 void bucket_indexed(const float* positions, std::size_t stride, int components, const void* indices, bool indices_16bit,

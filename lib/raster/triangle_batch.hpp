@@ -13,6 +13,7 @@
 // transformed once per render into a VertexClip cache with its frustum outcode, and a
 // triangle is rejected as invalid or outside from its three outcodes before anything is
 // fetched (MOC's TransformVertices, and Blinn and Newell's outcodes).
+#include "raster/reference_cells.hpp"
 #include "raster/triangle_setup.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -162,6 +163,7 @@ inline bool gather_listed_ready(const TriangleInput& in, std::size_t first, std:
 // order[k]. The setup reads them through the list, prefetching the next batch's positions.
 struct DrawList {
     const std::uint32_t* order = nullptr;  // null: the input's own order
+    const CellRecord* records = nullptr;   // null, or the cell record of each listed triangle (sort_nearest_first)
 };
 
 FrontEndKernels selected_front_end_kernels();

@@ -9,6 +9,7 @@
 
 #include <hwy/highway.h>
 
+#include "raster/clip_fates-inl.h"
 #include "raster/lane_bits-inl.h"
 #include "raster/triangle_batch.hpp"
 
@@ -167,50 +168,23 @@ void TransformBatch(const TriangleInput& in, TriangleBatch& batch) {
 void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
     const D d;
     const int lanes = int(hn::Lanes(d));
-    const V near = hn::Set(d, near_w), guard = hn::Set(d, kGuardBand), infinity = hn::Set(d, HUGE_VAL);
-    const V zero = hn::Zero(d), limit = hn::Set(d, 0x1.0p28);
+    const V zero = hn::Zero(d);
     batch.needs_setup = 0;
     batch.simple = 0;
     for (int g = 0; g < batch.count; g += lanes) {
         const M live = hn::FirstN(d, std::size_t(batch.count - g));
-        M finite = hn::FirstN(d, std::size_t(lanes)), behind = finite, right = finite, left = finite, above = finite,
-          below = finite, needs_clip = hn::Not(finite);
-        V extent = zero, min_w = infinity;
-        for (int k = 0; k < 3; ++k) {
-            const V x = hn::Load(d, batch.cx[k] + g), y = hn::Load(d, batch.cy[k] + g), w = hn::Load(d, batch.cw[k] + g);
-            const V ax = hn::Abs(x), ay = hn::Abs(y);
-            finite = hn::And(finite, hn::And(hn::And(hn::Lt(ax, infinity), hn::Lt(ay, infinity)), hn::Lt(hn::Abs(w), infinity)));
-            behind = hn::And(behind, hn::Lt(w, near));  // outside_frustum
-            right = hn::And(right, hn::Gt(x, w));       // outside_side_plane
-            left = hn::And(left, hn::Lt(x, hn::Neg(w)));
-            above = hn::And(above, hn::Gt(y, w));
-            below = hn::And(below, hn::Lt(y, hn::Neg(w)));
-            extent = hn::Max(extent, hn::Max(ax, ay));  // too_large_to_clip (max and min are exact)
-            min_w = hn::Min(min_w, w);
-            const V band = hn::Mul(guard, w);  // needs_clipping
-            needs_clip = hn::Or(needs_clip, hn::Or(hn::Lt(w, near), hn::Or(hn::Gt(ax, band), hn::Gt(ay, band))));
-        }
-        const M outside = hn::Or(behind, hn::Or(hn::Or(right, left), hn::Or(above, below)));
-        const M too_large = hn::Gt(extent, hn::Mul(limit, hn::Max(near, min_w)));
-        // homogeneous_det(v0, v1, v2), plus 0.0 as setup_clip_triangle sums it. (SVE vectors
-        // cannot be array elements: the vertices are loaded again.)
-        const V x0 = hn::Load(d, batch.cx[0] + g), x1 = hn::Load(d, batch.cx[1] + g), x2 = hn::Load(d, batch.cx[2] + g);
-        const V y0 = hn::Load(d, batch.cy[0] + g), y1 = hn::Load(d, batch.cy[1] + g), y2 = hn::Load(d, batch.cy[2] + g);
-        const V w0 = hn::Load(d, batch.cw[0] + g), w1 = hn::Load(d, batch.cw[1] + g), w2 = hn::Load(d, batch.cw[2] + g);
-        const V det = hn::Add(zero, hn::Add(hn::Sub(hn::Mul(x0, hn::Sub(hn::Mul(y1, w2), hn::Mul(w1, y2))),
-                                                    hn::Mul(y0, hn::Sub(hn::Mul(x1, w2), hn::Mul(w1, x2)))),
-                                            hn::Mul(w0, hn::Sub(hn::Mul(x1, y2), hn::Mul(y1, x2)))));
-        const M ccw = hn::Gt(det, zero);
-        M away = hn::FirstN(d, 0);  // facing_away: nothing with Backface::none
-        if (backface == Backface::cw) away = hn::Not(ccw);
-        else if (backface == Backface::ccw) away = ccw;
+        M finite, outside, unsettled, away;
+        V det;
+        ClipFates(d, backface, near_w, hn::Load(d, batch.cx[0] + g), hn::Load(d, batch.cy[0] + g), hn::Load(d, batch.cw[0] + g),
+                  hn::Load(d, batch.cx[1] + g), hn::Load(d, batch.cy[1] + g), hn::Load(d, batch.cw[1] + g), hn::Load(d, batch.cx[2] + g),
+                  hn::Load(d, batch.cy[2] + g), hn::Load(d, batch.cw[2] + g), finite, outside, unsettled, det, away);
 
         // The fates in unclipped_fate's order of precedence, each live lane in exactly one.
         const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};
         const M invalid = hn::And(live, hn::Not(hn::And(finite, hn::LoadMaskBits(d, index_bits))));
         const M valid = hn::AndNot(invalid, live);
         const M out = hn::And(valid, outside);
-        const M open = hn::AndNot(hn::Or(outside, hn::Or(too_large, needs_clip)), valid);  // neither decided nor set up
+        const M open = hn::AndNot(hn::Or(outside, unsettled), valid);  // neither decided nor set up
         const M degenerate = hn::And(open, hn::Eq(det, zero));
         const M backfacing = hn::And(hn::AndNot(degenerate, open), away);
         stats.invalid += hn::CountTrue(d, invalid);

@@ -44,6 +44,7 @@ struct VertexClip;
 struct DrawList;
 struct RasterTriangle;
 struct DrawOrderScratch;
+struct ReferenceCells;
 }  // namespace detail
 
 enum class Backface : std::uint8_t {
@@ -377,6 +378,18 @@ private:
                        ClusterPlace& out) const noexcept;
     // After the bands: the pyramid levels above those each band built (kBandPyramidLevels).
     void reduce_pyramid_above_bands();
+
+    // The smallest d0 of each cell of 8 x 8 subtiles, valid only while a render draws
+    // (raster/reference_cells.hpp); sized with the buffer.
+    std::vector<float> reference_cells_;
+    int reference_cells_width_ = 0;
+    std::vector<std::uint32_t> undecided_;  // one thread: the triangles of a slice the cells did not drop
+    // At the start of a render on one thread with cell records: the cells, zeroed when the
+    // render clears the buffer first, else refreshed from d0; none (null) when the selected
+    // instruction set sets triangles up one by one or hidden triangles are not skipped.
+    detail::ReferenceCells start_reference_cells(bool clear_first);
+    // Refreshes the cells holding subtile rows [row_begin, row_end).
+    void refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end);
 
     // Render scratch, reused across frames (grown, never shrunk).
     struct Chunk;

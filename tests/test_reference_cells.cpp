@@ -1,0 +1,215 @@
+// The reference cells (raster/reference_cells.hpp): their refresh, and the draw order's notes
+// that let one thread drop a triangle behind them unread. That the drops change no bit on real
+// input is HiddenTriangleSkip.ChangesNoBitOnS1's to show (every instruction set against a render
+// without any skip); here, each piece's own promise.
+#include "raster/draw_order.hpp"
+#include "raster/reference_cells.hpp"
+#include "support.hpp"
+
+#include <homcull/occlusion_buffer.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace homcull::detail {
+namespace {
+
+constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+
+// Every cell of the refreshed rows holds the smallest d0 of its subtiles, those of the grid
+// only (the rows' padding holds smaller values that must not count); other rows are left alone.
+// Each trial plants every cell's smallest value at a random subtile of it, edges included.
+TEST(ReferenceCells, RefreshGivesTheSmallestD0OfEachCellOfTheRows) {
+    const int subtiles_x = 37, subtiles_y = 21;  // cells of 5 and 5 subtiles at the right and bottom edges
+    const std::size_t stride = 64;               // padded rows, as the buffer's
+    const int width = reference_cells_width(subtiles_x), height = reference_cells_height(subtiles_y);
+    ASSERT_EQ(width, 5);
+    ASSERT_EQ(height, 3);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<float> depth(0.5f, 1.0f);
+    for (int trial = 0; trial < 50; ++trial) {
+        std::vector<float> d0(stride * std::size_t(subtiles_y), -1.0f);
+        for (int ty = 0; ty < subtiles_y; ++ty)
+            for (int tx = 0; tx < subtiles_x; ++tx) d0[std::size_t(ty) * stride + std::size_t(tx)] = depth(rng);
+        std::vector<float> smallest(std::size_t(width * height));
+        for (int cy = 0; cy < height; ++cy)
+            for (int cx = 0; cx < width; ++cx) {
+                const int tx = std::min(subtiles_x - 1, cx * 8 + int(rng() % 8)), ty = std::min(subtiles_y - 1, cy * 8 + int(rng() % 8));
+                smallest[std::size_t(cy * width + cx)] = d0[std::size_t(ty) * stride + std::size_t(tx)] = 0.25f * depth(rng);
+            }
+        const SubtilePlanes planes{d0.data(), nullptr, nullptr, nullptr, stride, nullptr, 0};
+        for (const std::string& isa : available_isas()) {
+            select_isa(isa);
+            const RefreshCellsKernel refresh = selected_refresh_cells();
+            if (isa == "scalar") {  // the reference sets triangles up one by one, without cells
+                EXPECT_EQ(refresh, nullptr);
+                continue;
+            }
+            ASSERT_NE(refresh, nullptr) << isa;
+            std::vector<float> cells(std::size_t(width * height), 99.0f);
+            refresh(planes, subtiles_x, subtiles_y, 1, 3, {cells.data(), width});
+            for (int cy = 0; cy < height; ++cy)
+                for (int cx = 0; cx < width; ++cx)
+                    ASSERT_EQ(cells[std::size_t(cy * width + cx)], cy == 0 ? 99.0f : smallest[std::size_t(cy * width + cx)])
+                        << isa << ", trial " << trial << ", cell " << cx << ", " << cy;
+        }
+    }
+    select_isa("best");
+}
+
+// Random clip-space triangles (x, y, z, w floats): small and large, on screen, beyond its sides
+// and the guard band, behind the near plane, degenerate, with coordinates not finite, very far.
+std::vector<float> random_soup(std::size_t triangles, std::mt19937_64& rng) {
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), w(0.3f, 60.0f), fraction(0.0f, 1.0f);
+    std::vector<float> xyzw(12 * triangles);
+    for (std::size_t t = 0; t < triangles; ++t) {
+        const float cx = unit(rng) * 1.2f, cy = unit(rng) * 1.2f;
+        const float spread = t % 11 == 0 ? 40.0f : t % 5 == 0 ? 0.6f : t % 3 == 0 ? 0.002f : 0.1f;
+        float* p = &xyzw[12 * t];
+        for (int k = 0; k < 3; ++k) {
+            const float wv = t % 17 == 0 ? 1e25f * w(rng) : t % 23 == 0 && k == 1 ? -w(rng) : w(rng);
+            p[4 * k + 0] = (cx + unit(rng) * spread) * wv, p[4 * k + 1] = (cy + unit(rng) * spread) * wv;
+            p[4 * k + 2] = unit(rng), p[4 * k + 3] = wv;
+        }
+        if (t % 19 == 0) {  // degenerate: the third vertex on the line through the first two
+            const float s = fraction(rng);
+            for (int c = 0; c < 4; ++c) p[8 + c] = p[c] + s * (p[4 + c] - p[c]);
+        }
+        if (t % 29 == 0) p[4 * (t % 3) + t % 4] = std::numeric_limits<float>::quiet_NaN();
+        if (t % 31 == 0) p[4 * (t % 3) + 2] = std::numeric_limits<float>::infinity();  // z alone
+    }
+    return xyzw;
+}
+
+// A note promises what drawing the triangle can do: the setup counts it as rasterized (so
+// dropping it keeps the statistics), every subtile it covers lies in the noted cells, and every
+// depth it writes (d0, d1 and per-sample depth) is at most the noted depth. Checked by drawing
+// each noted triangle alone, for every backface mode; the notes are the same on every
+// instruction set.
+TEST(ReferenceCells, NotesBoundWhatDrawingTheTriangleCanDo) {
+    std::mt19937_64 rng(17);
+    const std::size_t n = 3000;
+    const std::vector<float> xyzw = random_soup(n, rng);
+    const int width = 203, height = 117, samples = 2;
+    const float near_w = 0.5f;
+    OcclusionBuffer alone(test::buffer_config(width, height, samples, near_w, true));
+    const int subtiles_x = (alone.sample_width() + kW - 1) / kW, subtiles_y = (alone.sample_height() + kH - 1) / kH;
+    std::size_t noted = 0, not_noted = 0, covering = 0;
+    for (const Backface backface : {Backface::none, Backface::cw, Backface::ccw}) {
+        const CellRecordSpec spec{alone.sample_width(), alone.sample_height(), reference_cells_width(subtiles_x),
+                                  reference_cells_height(subtiles_y), near_w, backface};
+        const float row[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // the identity's last row
+        std::vector<CellRecord> records, first_records;
+        for (const std::string& isa : available_isas()) {
+            if (isa == "scalar") continue;
+            select_isa(isa);
+            std::vector<std::uint16_t> bucket(n);
+            std::vector<std::uint32_t> count(kDrawOrderBuckets, 0u);
+            records.assign(n, CellRecord{});
+            bucket_packed_soup(xyzw.data(), 4, 0, n, row, near_w, bucket.data(), count.data(), &spec, records.data());
+            if (first_records.empty()) first_records = records;
+            else EXPECT_EQ(std::memcmp(records.data(), first_records.data(), n * sizeof(CellRecord)), 0) << isa;
+        }
+        select_isa("best");
+        if (records.empty()) GTEST_SKIP() << "no SIMD instruction set";
+        for (std::size_t t = 0; t < n; ++t) {
+            const CellRecord& r = records[t];
+            if (std::isnan(r.nearest)) {
+                ++not_noted;
+                continue;
+            }
+            ++noted;
+            const std::string where = "triangle " + std::to_string(t) + ", backface " + std::to_string(int(backface));
+            ASSERT_LE(r.cx0, r.cx1) << where;
+            ASSERT_LE(r.cy0, r.cy1) << where;
+            ASSERT_LT(int(r.cx1), spec.cells_width) << where;
+            ASSERT_LT(int(r.cy1), spec.cells_height) << where;
+            ASSERT_GE(r.nearest, 0x1.0p-64f) << where;
+            const std::vector<float> one(xyzw.begin() + std::ptrdiff_t(12 * t), xyzw.begin() + std::ptrdiff_t(12 * t + 12));
+            TriangleInput in = test::clip_space_input(one);
+            in.backface = backface;
+            alone.render_frame(in);
+            const RasterStats& stats = alone.stats();
+            ASSERT_EQ(stats.triangles_in, 1u) << where;
+            ASSERT_EQ(stats.rasterized, 1u) << where;
+            ASSERT_EQ(stats.invalid + stats.outside + stats.degenerate + stats.backface_culled + stats.near_clipped + stats.too_large, 0u)
+                << where;
+            bool covers = false;
+            for (int ty = 0; ty < subtiles_y; ++ty)
+                for (int tx = 0; tx < subtiles_x; ++tx) {
+                    const OcclusionBuffer::Subtile s = alone.subtile(tx, ty);
+                    if (s.covered == 0) continue;
+                    covers = true;
+                    EXPECT_TRUE((tx >> kReferenceCellShift) >= r.cx0 && (tx >> kReferenceCellShift) <= r.cx1 &&
+                                (ty >> kReferenceCellShift) >= r.cy0 && (ty >> kReferenceCellShift) <= r.cy1)
+                        << where << ": subtile " << tx << ", " << ty << " outside the noted cells";
+                    EXPECT_LE(s.d0, r.nearest) << where;
+                    EXPECT_LE(s.d1, r.nearest) << where;
+                }
+            covering += covers;
+            std::vector<float> depth;
+            alone.read_sample_depth(depth);
+            EXPECT_LE(*std::max_element(depth.begin(), depth.end()), r.nearest) << where;
+        }
+    }
+    EXPECT_GT(noted, 3000u);
+    EXPECT_GT(covering, 2000u);
+    EXPECT_GT(not_noted, 1500u);
+}
+
+// The cells are a render's scratch: a frame after another, or a render after clear(), must
+// not drop triangles behind the last frame's cells. A near frame that fills the screen, then a
+// far one: drawn after it (render_frame, or clear() and render()), the far frame gives what it
+// gives in a new buffer; drawn over it (render), what a render without any skip gives.
+TEST(ReferenceCells, ANewFrameForgetsTheLastFramesCells) {
+    const auto quads = [](float w, int copies) {  // the screen as two triangles, `copies` times
+        std::vector<float> xyzw;
+        for (int c = 0; c < copies; ++c)
+            for (const float v : {-1.0f, -1.0f, 0.0f, 1.0f, 1.0f, -1.0f, 0.0f, 1.0f, 1.0f, 1.0f, 0.0f, 1.0f,  // (x, y) corners; z; w = 1
+                                  -1.0f, -1.0f, 0.0f, 1.0f, 1.0f, 1.0f, 0.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1.0f})
+                xyzw.push_back(v * w);
+        return xyzw;
+    };
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<float> unit(-0.9f, 0.9f);
+    std::vector<float> far_soup;  // small triangles all over the screen, far away
+    for (int t = 0; t < 400; ++t) {
+        const float cx = unit(rng), cy = unit(rng), w = 20.0f;
+        const float corners[6] = {cx, cy, cx + 0.1f, cy, cx, cy + 0.1f};
+        for (int k = 0; k < 3; ++k) far_soup.insert(far_soup.end(), {corners[2 * k] * w, corners[2 * k + 1] * w, 0.0f, w});
+    }
+    const std::vector<float> near_soup = quads(1.0f, 16);
+    const TriangleInput near_in = test::clip_space_input(near_soup), far_in = test::clip_space_input(far_soup);
+    const BufferConfig config = test::buffer_config(320, 180, 1, 0.5f);
+
+    OcclusionBuffer fresh(config);
+    fresh.render_frame(far_in);
+    ASSERT_GT(fresh.stats().subtiles_updated, 100u);
+    OcclusionBuffer next_frame(config), after_clear(config), over(config), over_oracle(config);
+    next_frame.render_frame(near_in);
+    next_frame.render_frame(far_in);
+    EXPECT_TRUE(test::same_subtiles(next_frame, fresh));
+    EXPECT_TRUE(next_frame.stats() == fresh.stats());
+    after_clear.render_frame(near_in);
+    after_clear.clear();
+    after_clear.render(far_in);
+    EXPECT_TRUE(test::same_subtiles(after_clear, fresh));
+    over.render_frame(near_in);
+    over.render(far_in);
+    set_hidden_skip(false);
+    over_oracle.render_frame(near_in);
+    over_oracle.render(far_in);
+    set_hidden_skip(true);
+    EXPECT_TRUE(test::same_subtiles(over, over_oracle));
+    EXPECT_TRUE(over.stats() == over_oracle.stats());
+}
+
+}  // namespace
+}  // namespace homcull::detail
