@@ -48,6 +48,7 @@ void prefetch_triangle(const detail::RasterTriangle& tri) {
 struct OcclusionBuffer::Chunk {
     std::vector<std::vector<detail::RasterTriangle>> bins;
     RasterStats stats;
+    std::vector<std::uint32_t> undecided;  // with cell records: the triangles the cells did not drop
 };
 
 OcclusionBuffer::~OcclusionBuffer() = default;
@@ -228,14 +229,14 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     // One thread: cell records with the list, when the buffer keeps cells and they fit a byte.
     const detail::CellRecordSpec record_spec{sample_width_, sample_height_, reference_cells_width_,
                                              detail::reference_cells_height(subtiles_y_), config_.near_w, in.backface};
-    const bool note = !parallel.run && detail::hidden_skip_enabled() && detail::selected_refresh_cells() && record_spec.cells_width <= 256 &&
+    const bool note = detail::hidden_skip_enabled() && detail::selected_refresh_cells() && record_spec.cells_width <= 256 &&
                       record_spec.cells_height <= 256;
-    const TriangleInput& drawn = detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted,
-                                                            parallel.run ? nullptr : &list, &skipped, note ? &record_spec : nullptr)
+    const TriangleInput& drawn = detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted, &list, &skipped,
+                                                            note ? &record_spec : nullptr, !parallel.run)
                                      ? sorted
                                      : in;
     stats_ += skipped;
-    if (parallel.run) render_binned(drawn, parallel, cache, clear_first);
+    if (parallel.run) render_binned(drawn, parallel, cache, clear_first, list.records);
     else render_serial(drawn, cache, clear_first, list);
 }
 
@@ -268,19 +269,11 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
         for (std::size_t begin = 0; begin < in.triangle_count; begin += kCellRefreshTriangles) {
             const std::size_t end = std::min(in.triangle_count, begin + kCellRefreshTriangles);
             // A dropped triangle counts as the setup counts a hidden one (rasterized).
-            std::size_t undecided = 0;
-            std::uint64_t hidden = 0;
-            for (std::size_t k = begin; k < end; ++k) {
-                if (k + 16 < end) __builtin_prefetch(list.records + list.order[k + 16]);  // scattered over the notes
-                const bool drop = detail::hidden_by_record(cells, list.records[list.order[k]]);
-                hidden += drop;
-                undecided_[undecided] = list.order[k];
-                undecided += !drop;
-            }
+            const std::uint64_t hidden = detail::drop_hidden_noted(cells, list.records, list.order, begin, end, undecided_.data());
             stats.triangles_in += hidden;
             stats.rasterized += hidden;
-            detail::setup_triangle_range(in, cache, 0, undecided, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
-                                         stats, draw, detail::DrawList{undecided_.data(), nullptr});
+            detail::setup_triangle_range(in, cache, 0, end - begin - hidden, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
+                                         &target, stats, draw, detail::DrawList{undecided_.data(), nullptr});
             refresh_reference_cells(cells, changed_begin, changed_end);
             changed_begin = subtiles_y_, changed_end = 0;
         }
@@ -297,7 +290,8 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
 // the triangles already hidden in it before their edges are set up and they are binned
 // (hidden_in_target, as on one thread). Dropping them changes no bit, so the waves' sizes are
 // free; only the speed depends on them.
-void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
+void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first,
+                                    const detail::CellRecord* records) {
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_updated_.size();
     if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
@@ -310,15 +304,19 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         std::size_t first_chunk, end_chunk, bands;
         const detail::RasterTarget* drawn_into;  // phase 1's: the whole buffer, or null while nothing is drawn
         bool clear_first, last_wave;
+        const detail::CellRecord* records;   // the triangles' cell records, or null
+        const detail::ReferenceCells* cells;  // with records: refreshed by each band after each wave but the last
     };
     const detail::RasterTarget whole = raster_target(0, subtiles_y_);
+    const detail::ReferenceCells cells = records && whole.skip_hidden ? start_reference_cells(clear_first) : detail::ReferenceCells{};
     std::size_t drawn_chunks = 0;  // the chunks of the waves drawn so far
     try {
         // At least one wave, so that render_frame clears and builds the pyramid whatever the count.
         for (std::size_t first = 0, wave_chunks = kFirstWaveChunks; first == 0 || first < chunk_count; first += wave_chunks, wave_chunks *= 2) {
             const std::size_t end = std::min(chunk_count, first + wave_chunks);
             const bool nothing_drawn = first == 0 && clear_first;  // the buffer still holds the last frame
-            Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count};
+            Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count,
+                    cells.min_d0 ? records : nullptr, &cells};
 
             detail::run_tasks(parallel, end - first, [](void* data, std::size_t k) {
                 const Job& j = *static_cast<Job*>(data);
@@ -329,11 +327,23 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                 for (auto& bin : chunk.bins) bin.clear();
                 const std::size_t end_triangle = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
                 const OcclusionBuffer& b = *j.self;
-                detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
-                                             b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, [&](const detail::RasterTriangle& tri) {
+                const auto bin = [&](const detail::RasterTriangle& tri) {
                     for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
                         chunk.bins[std::size_t(band)].push_back(tri);
-                });
+                };
+                if (j.records && j.drawn_into) {  // as render_serial: noted triangles hidden behind the cells dropped unread
+                    if (chunk.undecided.size() < kChunkTriangles) chunk.undecided.resize(kChunkTriangles);
+                    const std::uint64_t hidden =
+                        detail::drop_hidden_noted(*j.cells, j.records, nullptr, c * kChunkTriangles, end_triangle, chunk.undecided.data());
+                    chunk.stats.triangles_in += hidden;
+                    chunk.stats.rasterized += hidden;
+                    detail::setup_triangle_range(*j.in, j.cache, 0, end_triangle - c * kChunkTriangles - hidden, b.config_.near_w,
+                                                 b.config_.edge_margin, b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin,
+                                                 detail::DrawList{chunk.undecided.data(), nullptr});
+                } else {
+                    detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
+                                                 b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin);
+                }
             }, &job);
 
             detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
@@ -351,6 +361,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                     }
                 }
                 b.band_updated_[band] += updated;
+                if (j.records && updated != 0 && !j.last_wave) b.refresh_reference_cells(*j.cells, row_begin, row_end);  // its own cells
                 if (j.last_wave) b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
             }, &job);
             drawn_chunks = end;

@@ -44,7 +44,7 @@ struct DrawOrderScratch {
     std::uint8_t class_of[kDrawOrderBuckets];
     std::vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
     std::vector<std::uint8_t> shared_edges;
-    std::vector<CellRecord> noted;  // with the list: each triangle's cell record
+    std::vector<CellRecord> noted, noted_sorted;  // each triangle's cell record, in input order and in the sorted copy's
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 
@@ -98,14 +98,17 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // w anyway, and its three outcodes decide without a branch per triangle where the setup's
 // loop mispredicted (castle view C0, one input, one thread: see docs/occlusion-buffer.md).
 //
-// Given `records` as well as `list`, when the list is made and the input is a clip-space soup
-// (the matrix is the identity), the first pass also notes each triangle for the reference
-// cells (bucket_packed_soup), and list->records holds the notes in the list's order: 8 more
-// bytes a triangle, so that the setup can drop most hidden triangles without reading them
-// (OcclusionBuffer::render_serial). Otherwise list->records is null.
+// Given `records` as well as `list`, when the input is a packed clip-space soup (the matrix is
+// the identity, no shared-edge flags), the first pass also notes each triangle for the
+// reference cells (bucket_packed_soup), and list->records holds the note of each triangle of
+// what is drawn: of the input's triangles (read through the list), or of the sorted copy's (the
+// notes sorted with the copy). 8 more bytes a triangle, or 16 with the copy, so that the render
+// can drop most hidden triangles without reading them (OcclusionBuffer::render_serial,
+// render_binned). Otherwise list->records is null. may_list false: no list of numbers (a job
+// system's render), `list` only for the notes.
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr,
-                        const CellRecordSpec* records = nullptr);
+                        const CellRecordSpec* records = nullptr, bool may_list = true);
 
 // Throws homcull::Error when sort_nearest_first would refuse the input (nearest first, 2^32
 // triangles or more), so that render can check before it changes anything.

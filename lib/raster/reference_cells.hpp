@@ -85,6 +85,22 @@ inline bool hidden_by_record(const ReferenceCells& cells, const CellRecord& r) {
     return true;
 }
 
+// Positions [begin, end) of what is drawn (triangle order[k], or k without a list): writes
+// the triangles not hidden behind the cells by their notes (hidden_by_record) to undecided[],
+// in order, and returns how many it dropped. The notes are read through the list, scattered:
+// they are prefetched 16 positions ahead.
+inline std::uint64_t drop_hidden_noted(const ReferenceCells& cells, const CellRecord* records, const std::uint32_t* order, std::size_t begin,
+                                       std::size_t end, std::uint32_t* undecided) {
+    std::size_t kept = 0;
+    for (std::size_t k = begin; k < end; ++k) {
+        const std::uint32_t t = order ? order[k] : std::uint32_t(k);
+        if (order && k + 16 < end) __builtin_prefetch(records + order[k + 16]);
+        undecided[kept] = t;
+        kept += !hidden_by_record(cells, records[t]);
+    }
+    return std::uint64_t((end - begin) - kept);
+}
+
 // Sets the cells of cell rows [cell_row_begin, cell_row_end) to the smallest d0 of their
 // subtiles (those of the subtiles_x x subtiles_y grid: a cell at the right or bottom edge
 // takes only its subtiles within it). Min is exact: every target gives the same cells.

@@ -163,7 +163,7 @@ inline bool gather_listed_ready(const TriangleInput& in, std::size_t first, std:
 // order[k]. The setup reads them through the list, prefetching the next batch's positions.
 struct DrawList {
     const std::uint32_t* order = nullptr;  // null: the input's own order
-    const CellRecord* records = nullptr;   // null, or the cell record of each listed triangle (sort_nearest_first)
+    const CellRecord* records = nullptr;   // null, or records[t]: the cell record of triangle t of the input drawn (sort_nearest_first)
 };
 
 FrontEndKernels selected_front_end_kernels();

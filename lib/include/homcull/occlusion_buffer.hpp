@@ -45,6 +45,7 @@ struct DrawList;
 struct RasterTriangle;
 struct DrawOrderScratch;
 struct ReferenceCells;
+struct CellRecord;
 }  // namespace detail
 
 enum class Backface : std::uint8_t {
@@ -363,7 +364,8 @@ private:
     // clear_first: render_frame, which clears the rows where it rasterizes them.
     void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
     void render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list);
-    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first);
+    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first,
+                       const detail::CellRecord* records);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
     bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
