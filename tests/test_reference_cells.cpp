@@ -7,6 +7,7 @@
 #include "support.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/tbb_parallel_for.hpp>
 
 #include <gtest/gtest.h>
 
@@ -188,27 +189,30 @@ TEST(ReferenceCells, ANewFrameForgetsTheLastFramesCells) {
     const std::vector<float> near_soup = quads(1.0f, 16);
     const TriangleInput near_in = test::clip_space_input(near_soup), far_in = test::clip_space_input(far_soup);
     const BufferConfig config = test::buffer_config(320, 180, 1, 0.5f);
-
-    OcclusionBuffer fresh(config);
-    fresh.render_frame(far_in);
-    ASSERT_GT(fresh.stats().subtiles_updated, 100u);
-    OcclusionBuffer next_frame(config), after_clear(config), over(config), over_oracle(config);
-    next_frame.render_frame(near_in);
-    next_frame.render_frame(far_in);
-    EXPECT_TRUE(test::same_subtiles(next_frame, fresh));
-    EXPECT_TRUE(next_frame.stats() == fresh.stats());
-    after_clear.render_frame(near_in);
-    after_clear.clear();
-    after_clear.render(far_in);
-    EXPECT_TRUE(test::same_subtiles(after_clear, fresh));
-    over.render_frame(near_in);
-    over.render(far_in);
-    set_hidden_skip(false);
-    over_oracle.render_frame(near_in);
-    over_oracle.render(far_in);
-    set_hidden_skip(true);
-    EXPECT_TRUE(test::same_subtiles(over, over_oracle));
-    EXPECT_TRUE(over.stats() == over_oracle.stats());
+    for (const bool threads : {false, true}) {
+        const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+        const std::string where = threads ? "two threads" : "one thread";
+        OcclusionBuffer fresh(config);
+        fresh.render_frame(far_in, parallel);
+        ASSERT_GT(fresh.stats().subtiles_updated, 100u) << where;
+        OcclusionBuffer next_frame(config), after_clear(config), over(config), over_oracle(config);
+        next_frame.render_frame(near_in, parallel);
+        next_frame.render_frame(far_in, parallel);
+        EXPECT_TRUE(test::same_subtiles(next_frame, fresh)) << where;
+        EXPECT_TRUE(next_frame.stats() == fresh.stats()) << where;
+        after_clear.render_frame(near_in, parallel);
+        after_clear.clear();
+        after_clear.render(far_in, parallel);
+        EXPECT_TRUE(test::same_subtiles(after_clear, fresh)) << where;
+        over.render_frame(near_in, parallel);
+        over.render(far_in, parallel);
+        set_hidden_skip(false);
+        over_oracle.render_frame(near_in, parallel);
+        over_oracle.render(far_in, parallel);
+        set_hidden_skip(true);
+        EXPECT_TRUE(test::same_subtiles(over, over_oracle)) << where;
+        EXPECT_TRUE(over.stats() == over_oracle.stats()) << where;
+    }
 }
 
 }  // namespace
