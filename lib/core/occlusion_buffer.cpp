@@ -236,7 +236,7 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
                                      ? sorted
                                      : in;
     stats_ += skipped;
-    if (parallel.run) render_binned(drawn, parallel, cache, clear_first, list.records);
+    if (parallel.run) render_binned(drawn, parallel, cache, clear_first, list);
     else render_serial(drawn, cache, clear_first, list);
 }
 
@@ -291,7 +291,7 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
 // (hidden_in_target, as on one thread). Dropping them changes no bit, so the waves' sizes are
 // free; only the speed depends on them.
 void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first,
-                                    const detail::CellRecord* records) {
+                                    detail::DrawList list) {
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_updated_.size();
     if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
@@ -304,11 +304,12 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         std::size_t first_chunk, end_chunk, bands;
         const detail::RasterTarget* drawn_into;  // phase 1's: the whole buffer, or null while nothing is drawn
         bool clear_first, last_wave;
-        const detail::CellRecord* records;   // the triangles' cell records, or null
+        detail::DrawList list;                // the order as a list, and the cell records, or null
         const detail::ReferenceCells* cells;  // with records: refreshed by each band after each wave but the last
     };
     const detail::RasterTarget whole = raster_target(0, subtiles_y_);
-    const detail::ReferenceCells cells = records && whole.skip_hidden ? start_reference_cells(clear_first) : detail::ReferenceCells{};
+    const detail::ReferenceCells cells = list.records && whole.skip_hidden ? start_reference_cells(clear_first) : detail::ReferenceCells{};
+    if (!cells.min_d0) list.records = nullptr;
     std::size_t drawn_chunks = 0;  // the chunks of the waves drawn so far
     try {
         // At least one wave, so that render_frame clears and builds the pyramid whatever the count.
@@ -316,7 +317,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
             const std::size_t end = std::min(chunk_count, first + wave_chunks);
             const bool nothing_drawn = first == 0 && clear_first;  // the buffer still holds the last frame
             Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count,
-                    cells.min_d0 ? records : nullptr, &cells};
+                    list, &cells};
 
             detail::run_tasks(parallel, end - first, [](void* data, std::size_t k) {
                 const Job& j = *static_cast<Job*>(data);
@@ -331,10 +332,10 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                     for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
                         chunk.bins[std::size_t(band)].push_back(tri);
                 };
-                if (j.records && j.drawn_into) {  // as render_serial: noted triangles hidden behind the cells dropped unread
+                if (j.list.records && j.drawn_into) {  // as render_serial: noted triangles hidden behind the cells dropped unread
                     if (chunk.undecided.size() < kChunkTriangles) chunk.undecided.resize(kChunkTriangles);
-                    const std::uint64_t hidden =
-                        detail::drop_hidden_noted(*j.cells, j.records, nullptr, c * kChunkTriangles, end_triangle, chunk.undecided.data());
+                    const std::uint64_t hidden = detail::drop_hidden_noted(*j.cells, j.list.records, j.list.order, c * kChunkTriangles,
+                                                                           end_triangle, chunk.undecided.data());
                     chunk.stats.triangles_in += hidden;
                     chunk.stats.rasterized += hidden;
                     detail::setup_triangle_range(*j.in, j.cache, 0, end_triangle - c * kChunkTriangles - hidden, b.config_.near_w,
@@ -342,7 +343,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                                                  detail::DrawList{chunk.undecided.data(), nullptr});
                 } else {
                     detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
-                                                 b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin);
+                                                 b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin, j.list);
                 }
             }, &job);
 
@@ -361,7 +362,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                     }
                 }
                 b.band_updated_[band] += updated;
-                if (j.records && updated != 0 && !j.last_wave) b.refresh_reference_cells(*j.cells, row_begin, row_end);  // its own cells
+                if (j.list.records && updated != 0 && !j.last_wave) b.refresh_reference_cells(*j.cells, row_begin, row_end);  // its own cells
                 if (j.last_wave) b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
             }, &job);
             drawn_chunks = end;

@@ -172,20 +172,14 @@ void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bu
 }
 
 void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
-                 const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges, const CellRecord* noted,
-                 CellRecord* noted_sorted) {
+                 const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges) {
     if (listed) {  // the triangles' numbers only (DrawList): shared-edge flags stay the input's
         place_triangles(begin, end, bucket, class_of, start, some_skipped,
                         [&](std::size_t t, std::size_t p) { data[p] = std::uint32_t(t); });
         return;
     }
     const auto place = [&](auto&& copy) {
-        if (noted) {  // a soup's copy with its notes (the soup has no shared-edge flags then)
-            place_triangles(begin, end, bucket, class_of, start, some_skipped, [&](std::size_t t, std::size_t p) {
-                copy(t, p);
-                noted_sorted[p] = noted[t];
-            });
-        } else if (shared_edges) {
+        if (shared_edges) {
             place_triangles(begin, end, bucket, class_of, start, some_skipped, [&](std::size_t t, std::size_t p) {
                 copy(t, p);
                 shared_edges[p] = in.shared_edges[t];
@@ -235,12 +229,13 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     const VertexClip* skip_by = skipped ? cache : nullptr;  // the cache whose outcodes leave triangles out
     if (in.order == DrawOrder::as_given || n == 0) return false;
     check_draw_order(in);
-    const bool listed = may_list && list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
-    // Notes for the cells: bucket_range's pass over a packed soup, in clip space, without
-    // shared-edge flags (a soup's triangles share no edge the setup knows of).
-    const bool noting = list && records && !cache && !in.indices && !in.shared_edges && is_identity(in.model_to_clip) &&
-                        reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0 &&
-                        in.position_stride == std::size_t(in.position_components) * sizeof(float);
+    // Notes for the cells: bucket_range's pass over a packed soup of 4 floats per vertex in clip
+    // space, without shared-edge flags, drawn through a list (with or without a job system:
+    // with notes, the list's scattered reads are mostly of the notes).
+    const bool clip_space_soup = list && records && !cache && !in.indices && !in.shared_edges && is_identity(in.model_to_clip) &&
+                                 in.position_stride == 4 * sizeof(float);
+    const bool listed = (may_list || clip_space_soup) && list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
+    const bool noting = clip_space_soup && listed;
     // A counting sort in tasks of kDrawOrderTask triangles, in two passes:
     // 1. each task buckets its triangles (fine buckets, about 1 % of w each) and counts them
     //    per bucket;
@@ -263,7 +258,6 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
     if (scratch.skipped.size() < tasks) scratch.skipped.resize(tasks);
     if (noting && scratch.noted.size() < n) scratch.noted.resize(n);
-    if (noting && !listed && scratch.noted_sorted.size() < n) scratch.noted_sorted.resize(n);
     std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.excluded.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.skipped.begin(), tasks, RasterStats{});
@@ -335,8 +329,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         DrawOrderScratch& s = *j.scratch;
         place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
                     s.bucket.data(), s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
-                    j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr, j.records && !j.listed ? s.noted.data() : nullptr,
-                    j.records && !j.listed ? s.noted_sorted.data() : nullptr);
+                    j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr);
     });
 
     sorted = in;
@@ -355,7 +348,6 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         sorted.position_stride = std::size_t(in.position_components) * sizeof(float);
         sorted.vertex_count = 3 * n;
     }
-    if (noting) list->records = scratch.noted_sorted.data();  // the copy's triangle p: its note
     return true;
 }
 

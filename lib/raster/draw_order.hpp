@@ -44,7 +44,7 @@ struct DrawOrderScratch {
     std::uint8_t class_of[kDrawOrderBuckets];
     std::vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
     std::vector<std::uint8_t> shared_edges;
-    std::vector<CellRecord> noted, noted_sorted;  // each triangle's cell record, in input order and in the sorted copy's
+    std::vector<CellRecord> noted;  // with the list of a clip-space soup: each triangle's cell record
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 
@@ -98,14 +98,13 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // w anyway, and its three outcodes decide without a branch per triangle where the setup's
 // loop mispredicted (castle view C0, one input, one thread: see docs/occlusion-buffer.md).
 //
-// Given `records` as well as `list`, when the input is a packed clip-space soup (the matrix is
-// the identity, no shared-edge flags), the first pass also notes each triangle for the
-// reference cells (bucket_packed_soup), and list->records holds the note of each triangle of
-// what is drawn: of the input's triangles (read through the list), or of the sorted copy's (the
-// notes sorted with the copy). 8 more bytes a triangle, or 16 with the copy, so that the render
-// can drop most hidden triangles without reading them (OcclusionBuffer::render_serial,
-// render_binned). Otherwise list->records is null. may_list false: no list of numbers (a job
-// system's render), `list` only for the notes.
+// Given `records` as well as `list`, an input that is a clip-space soup of 4 packed floats per
+// vertex (the identity matrix, no shared-edge flags) is listed whatever may_list says, and the
+// first pass also notes each of its triangles for the reference cells (bucket_packed_soup):
+// list->records[t] is triangle t's note, 8 bytes a triangle, so that the render can drop most
+// hidden triangles without reading them (OcclusionBuffer::render_serial, render_binned).
+// Otherwise list->records is null. may_list false (a render with a job system): no list
+// otherwise, the sorted copy.
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr,
                         const CellRecordSpec* records = nullptr, bool may_list = true);

@@ -365,7 +365,7 @@ private:
     void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
     void render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list);
     void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first,
-                       const detail::CellRecord* records);
+                       detail::DrawList list);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
     bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
