@@ -1,18 +1,20 @@
 #pragma once
 // A coarse lower bound of the reference layer while a render draws: the smallest d0 of each
 // cell of 8 x 8 subtiles (64 x 32 samples; 30 x 34 cells, 4 KB, at 1080p). With the notes the
-// draw order takes of a clip-space soup (CellRecord below), one thread drops most hidden
+// draw order takes of a clip-space soup (CellRecord below), the render drops most hidden
 // triangles from their note and a few cells in L1, without reading the triangle, setting it up
-// or reading some ten rows of d0 (OcclusionBuffer::render_serial): on S1 at 1080p about 80,000
-// of 100,000 triangles, 7.6 -> 6.0 ms.
+// or reading some ten rows of d0 (OcclusionBuffer::render_serial, and each wave's setup in
+// render_binned): on S1 at 1080p about 80,000 of 100,000 triangles; one thread 7.6 -> 6.0 ms,
+// two 5.1 -> 4.3 ms.
 //
 // Why a cell read long after it was computed is still safe: a subtile's d0 never decreases
 // while a render draws (it changes only when a full working layer is promoted, and the
 // working layer's depth always lies above d0), so a cell's minimum, taken at any earlier
 // point of the render, bounds every d0 of the cell from below. The render zeroes the cells
 // when it clears the buffer first, else computes them from d0, and refreshes those of the rows
-// it drew into every 4,096 triangles. The cells are the render's scratch: nothing reads them
-// outside a render, and they change no bit (see CellRecord).
+// it drew into every 4,096 triangles (with a job system: each band its own cells, after each
+// wave). The cells are the render's scratch: nothing reads them outside a render, and they
+// change no bit (see CellRecord).
 //
 // Greene, Kass and Miller's hierarchical Z-buffer (SIGGRAPH 1993) keeps such a pyramid exact
 // after every update; refreshing a stale but safe level in batches costs less here, where nine
