@@ -224,9 +224,9 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     // serves it too.
     if (!draw_order_) draw_order_ = std::make_unique<detail::DrawOrderScratch>();
     TriangleInput sorted;
-    detail::DrawList list;  // one thread: the order as a list of numbers, when the input allows
+    detail::DrawList list;  // the order as a list of numbers, when the input allows (one thread, or a clip-space soup)
     RasterStats skipped;    // the triangles the sort leaves out (with a vertex cache)
-    // One thread: cell records with the list, when the buffer keeps cells and they fit a byte.
+    // Cell records with the list of a clip-space soup, when the buffer keeps cells and they fit a byte.
     const detail::CellRecordSpec record_spec{sample_width_, sample_height_, reference_cells_width_,
                                              detail::reference_cells_height(subtiles_y_), config_.near_w, in.backface};
     const bool note = detail::hidden_skip_enabled() && detail::selected_refresh_cells() && record_spec.cells_width <= 256 &&
@@ -289,7 +289,9 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
 // nearest first, the first waves fill most of the buffer, and phase 1 of the later ones drops
 // the triangles already hidden in it before their edges are set up and they are binned
 // (hidden_in_target, as on one thread). Dropping them changes no bit, so the waves' sizes are
-// free; only the speed depends on them.
+// free; only the speed depends on them. A clip-space soup comes as a list with cell records:
+// phase 1 then first drops the noted triangles hidden behind the reference cells unread, and
+// phase 2 refreshes each band's own cells (as render_serial does every 4,096 triangles).
 void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first,
                                     detail::DrawList list) {
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;

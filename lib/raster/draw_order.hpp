@@ -33,7 +33,8 @@ constexpr std::size_t kDrawOrderTask = 8192;
 // render allocates nothing after the first: 2 bytes per triangle, 8 KB and a RasterStats per
 // task, 4 bytes per vertex of a vertex cache, and the sorted copy (the indices, 6 or 12 bytes
 // per triangle; without indices the positions, 36 or 48; and a byte of shared-edge flags) or,
-// on one thread for a soup of 4 floats per vertex, the list of numbers (4 bytes per triangle).
+// on one thread for a soup of 4 floats per vertex, the list of numbers (4 bytes per triangle),
+// with the cell notes of a clip-space soup (8 bytes per triangle, with or without a job system).
 struct DrawOrderScratch {
     std::vector<std::uint16_t> bucket;  // per triangle
     std::vector<std::uint32_t> count;   // per task and bucket

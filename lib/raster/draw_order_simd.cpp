@@ -2,7 +2,8 @@
 // clip w in float lanes, one triangle per lane, and its bucket, for inputs without indices whose
 // vertices are packed 3 or 4 floats (workload S1), and for indexed inputs (positions gathered). Every target makes the same float
 // operations in the same order (no fused multiply-add), so every target gives the same buckets;
-// the order does not depend on the instruction set.
+// the order does not depend on the instruction set. For a clip-space soup, the same pass also
+// notes each triangle for the reference cells (NoteTriangles, reference_cells.hpp).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/draw_order_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
