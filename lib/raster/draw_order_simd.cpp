@@ -16,8 +16,8 @@
 #include "raster/reference_cells.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 
@@ -83,12 +83,12 @@ HWY_INLINE void NoteTriangles(DF df, const CellRecordSpec& spec, const float (*c
         return hn::BitCast(du, hn::ConvertTo(di, hn::Min(hn::Max(c, hn::Zero(df)), hn::Set(df, float(cells - 1)))));
     };
     auto box = hn::Or(hn::Or(cell(hn::Sub(x_lo, margin), 64.0f, spec.cells_width),
-                                   hn::ShiftLeft<8>(cell(hn::Add(x_hi, margin), 64.0f, spec.cells_width))),
-                            hn::Or(hn::ShiftLeft<16>(cell(hn::Sub(y_lo, margin), 32.0f, spec.cells_height)),
-                                   hn::ShiftLeft<24>(cell(hn::Add(y_hi, margin), 32.0f, spec.cells_height))));
+                             hn::ShiftLeft<8>(cell(hn::Add(x_hi, margin), 64.0f, spec.cells_width))),
+                      hn::Or(hn::ShiftLeft<16>(cell(hn::Sub(y_lo, margin), 32.0f, spec.cells_height)),
+                             hn::ShiftLeft<24>(cell(hn::Add(y_hi, margin), 32.0f, spec.cells_height))));
     // 1/w_min to nearest, at most 2^-24 off; times 1 + 2^-20, above the double 1/w_min the
-    // setup computes (and at least 2^-64). NaN for a triangle not noted: no cell is at least that.
-    // The box of a triangle not noted may come from NaNs: cell 0 instead, within the cells.
+    // setup computes (and at least 2^-64). NaN for a triangle not noted: no cell is at least
+    // that. Its box may come from NaNs: cell 0 instead, within the cells.
     const std::uint8_t noted_bits[8] = {std::uint8_t(surely_drawn), std::uint8_t(surely_drawn >> 8)};
     const auto noted = hn::LoadMaskBits(df, noted_bits);
     const auto nearest = hn::IfThenElse(noted, hn::Mul(hn::Div(one, w_min), hn::Set(df, 1.0f + 0x1.0p-20f)),
