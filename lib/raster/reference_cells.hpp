@@ -42,8 +42,8 @@ inline int reference_cells_width(int subtiles_x) { return (subtiles_x + (1 << kR
 inline int reference_cells_height(int subtiles_y) { return (subtiles_y + (1 << kReferenceCellShift) - 1) >> kReferenceCellShift; }
 
 // What the draw order's first pass notes of a triangle for the cells (draw_order.hpp), so that
-// one thread can drop most hidden triangles of a clip-space soup without reading them again:
-// the cells that hold its box, and a depth no sample of it is drawn nearer than. cx0 > cx1:
+// the render can drop most hidden triangles of a clip-space soup without reading them again:
+// the cells that hold its box, and a depth no sample of it is drawn nearer than. A NaN depth:
 // no note (the triangle takes the setup's path).
 //
 // Why the depth is the nearest vertex's 1/w: every depth the row loop writes for a triangle is
@@ -74,7 +74,8 @@ struct CellRecordSpec {
 };
 
 // Whether a noted triangle is hidden behind the cells: every cell holding its box bounds d0
-// at or above its depth (positive, or NaN for no note). Most boxes span at most 2 x 2 cells: four loads, no loop.
+// at or above its depth (positive, or NaN for no note). Most boxes span at most 2 x 2 cells:
+// four loads, no loop.
 inline bool hidden_by_record(const ReferenceCells& cells, const CellRecord& r) {
     const float* row0 = cells.min_d0 + std::size_t(r.cy0) * std::size_t(cells.width);
     if (((r.cx1 - r.cx0) | (r.cy1 - r.cy0)) <= 1) {
