@@ -147,7 +147,6 @@ void OcclusionBuffer::read_pyramid(std::vector<float>& cells) const {
 }
 
 detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first) {
-    if (!detail::hidden_skip_enabled() || !detail::selected_refresh_cells()) return {};
     const detail::ReferenceCells cells{reference_cells_.data(), reference_cells_width_};
     if (clear_first) std::fill(reference_cells_.begin(), reference_cells_.end(), 0.0f);  // d0 >= 0 everywhere
     else refresh_reference_cells(cells, 0, subtiles_y_);
@@ -251,11 +250,11 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t updated = 0;
     RasterStats stats;
-    const detail::ReferenceCells cells = list.records && target.skip_hidden ? start_reference_cells(clear_first) : detail::ReferenceCells{};
-    if (!cells.min_d0) {
+    if (!list.records) {
         detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
                                      &target, stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); }, list);
     } else {
+        const detail::ReferenceCells cells = start_reference_cells(clear_first);
         int changed_begin = subtiles_y_, changed_end = 0;  // the subtile rows changed since the last refresh
         const auto draw = [&](const detail::RasterTriangle& tri) {
             const std::uint64_t n = target.kernel(target, tri);
@@ -268,12 +267,8 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
         if (undecided_.size() < kCellRefreshTriangles) undecided_.resize(kCellRefreshTriangles);
         for (std::size_t begin = 0; begin < in.triangle_count; begin += kCellRefreshTriangles) {
             const std::size_t end = std::min(in.triangle_count, begin + kCellRefreshTriangles);
-            // A dropped triangle counts as the setup counts a hidden one (rasterized).
-            const std::uint64_t hidden = detail::drop_hidden_noted(cells, list.records, list.order, begin, end, undecided_.data());
-            stats.triangles_in += hidden;
-            stats.rasterized += hidden;
-            detail::setup_triangle_range(in, cache, 0, end - begin - hidden, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
-                                         &target, stats, draw, detail::DrawList{undecided_.data(), nullptr});
+            detail::setup_noted_range(in, cells, list, begin, end, undecided_.data(), config_.near_w, config_.edge_margin, sample_width_,
+                                      sample_height_, &target, stats, draw);
             refresh_reference_cells(cells, changed_begin, changed_end);
             changed_begin = subtiles_y_, changed_end = 0;
         }
@@ -310,8 +305,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         const detail::ReferenceCells* cells;  // with records: refreshed by each band after each wave but the last
     };
     const detail::RasterTarget whole = raster_target(0, subtiles_y_);
-    const detail::ReferenceCells cells = list.records && whole.skip_hidden ? start_reference_cells(clear_first) : detail::ReferenceCells{};
-    if (!cells.min_d0) list.records = nullptr;
+    const detail::ReferenceCells cells = list.records ? start_reference_cells(clear_first) : detail::ReferenceCells{};
     std::size_t drawn_chunks = 0;  // the chunks of the waves drawn so far
     try {
         // At least one wave, so that render_frame clears and builds the pyramid whatever the count.
@@ -336,13 +330,8 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                 };
                 if (j.list.records && j.drawn_into) {  // as render_serial: noted triangles hidden behind the cells dropped unread
                     if (chunk.undecided.size() < kChunkTriangles) chunk.undecided.resize(kChunkTriangles);
-                    const std::uint64_t hidden = detail::drop_hidden_noted(*j.cells, j.list.records, j.list.order, c * kChunkTriangles,
-                                                                           end_triangle, chunk.undecided.data());
-                    chunk.stats.triangles_in += hidden;
-                    chunk.stats.rasterized += hidden;
-                    detail::setup_triangle_range(*j.in, j.cache, 0, end_triangle - c * kChunkTriangles - hidden, b.config_.near_w,
-                                                 b.config_.edge_margin, b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin,
-                                                 detail::DrawList{chunk.undecided.data(), nullptr});
+                    detail::setup_noted_range(*j.in, *j.cells, j.list, c * kChunkTriangles, end_triangle, chunk.undecided.data(), b.config_.near_w,
+                                              b.config_.edge_margin, b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin);
                 } else {
                     detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
                                                  b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin, j.list);

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
 namespace homcull::detail {
 
@@ -266,6 +267,22 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             }
         }
     }
+}
+
+// setup_triangle_range over positions [begin, end) of a list with cell records
+// (sort_nearest_first), the reference cells of the target drawn into at hand: the noted
+// triangles hidden behind the cells are counted as the setup counts a hidden triangle
+// (triangles_in and rasterized) and dropped unread (drop_hidden_noted); the others are set up
+// in order. `undecided`: room for end - begin triangle numbers. (A noted input has no cache.)
+template <typename Emit>
+void setup_noted_range(const TriangleInput& in, const ReferenceCells& cells, DrawList list, std::size_t begin, std::size_t end,
+                       std::uint32_t* undecided, double near_w, double edge_margin, int sample_width, int sample_height,
+                       const RasterTarget* drawn_into, RasterStats& stats, Emit&& emit) {
+    const std::uint64_t hidden = drop_hidden_noted(cells, list.records, list.order, begin, end, undecided);
+    stats.triangles_in += hidden;
+    stats.rasterized += hidden;
+    setup_triangle_range(in, nullptr, 0, (end - begin) - std::size_t(hidden), near_w, edge_margin, sample_width, sample_height, drawn_into,
+                         stats, std::forward<Emit>(emit), DrawList{undecided, nullptr});
 }
 
 }  // namespace homcull::detail

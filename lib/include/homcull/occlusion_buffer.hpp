@@ -386,9 +386,9 @@ private:
     std::vector<float> reference_cells_;
     int reference_cells_width_ = 0;
     std::vector<std::uint32_t> undecided_;  // one thread: the triangles of a slice the cells did not drop
-    // At the start of a render on one thread with cell records: the cells, zeroed when the
-    // render clears the buffer first, else refreshed from d0; none (null) when the selected
-    // instruction set sets triangles up one by one or hidden triangles are not skipped.
+    // At the start of a render with cell records (which render_rows asks the sort for only when
+    // hidden triangles are skipped and the instruction set has a refresh kernel): the cells,
+    // zeroed when the render clears the buffer first, else computed from d0.
     detail::ReferenceCells start_reference_cells(bool clear_first);
     // Refreshes the cells holding subtile rows [row_begin, row_end).
     void refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end);
