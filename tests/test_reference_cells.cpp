@@ -215,5 +215,70 @@ TEST(ReferenceCells, ANewFrameForgetsTheLastFramesCells) {
     }
 }
 
+// The vector drop decides every note as the scalar loop does (drop_hidden_noted, on
+// hidden_by_record): boxes of 1 x 1 to 6 x 9 cells, notes missing (NaN depth, box zeroed as the
+// notes kernel leaves it), depths equal to a cell's, counts that leave a partial vector.
+TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
+    const int width = 30, height = 34;  // 1080p's cells
+    std::mt19937_64 rng(41);
+    std::uniform_real_distribution<float> depth(0.0f, 1.0f);
+    std::vector<float> cells(std::size_t(width * height));
+    for (float& c : cells) c = depth(rng) < 0.3f ? std::numeric_limits<float>::infinity() : depth(rng);  // infinite: another part's rows
+    const std::size_t n = 5000 + 7;
+    std::vector<CellRecord> records(n);
+    std::vector<std::uint32_t> order(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        order[k] = std::uint32_t(rng());
+        CellRecord& r = records[k];
+        const int span_x = rng() % 4 == 0 ? int(rng() % 6) : int(rng() % 2), span_y = rng() % 4 == 0 ? int(rng() % 9) : int(rng() % 2);
+        r.cx0 = std::uint8_t(rng() % std::uint64_t(width - span_x)), r.cy0 = std::uint8_t(rng() % std::uint64_t(height - span_y));
+        r.cx1 = std::uint8_t(r.cx0 + span_x), r.cy1 = std::uint8_t(r.cy0 + span_y);
+        r.nearest = rng() % 3 == 0 ? cells[std::size_t(r.cy0 * width + r.cx0)] : depth(rng);
+        if (rng() % 10 == 0) r = CellRecord{0, 0, 0, 0, std::numeric_limits<float>::quiet_NaN()};
+    }
+    const ReferenceCells view{cells.data(), width};
+    std::vector<std::uint32_t> expected(n);
+    const std::size_t expected_kept = n - std::size_t(drop_hidden_noted(view, records.data(), order.data(), 0, n, expected.data()));
+    ASSERT_GT(expected_kept, n / 5);
+    ASSERT_LT(expected_kept, 4 * n / 5);
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        for (const std::size_t count : {n, std::size_t(5), std::size_t(0)}) {
+            std::vector<std::uint32_t> kept(n, 0);
+            const std::size_t got = selected_drop_hidden()(view, records.data(), order.data(), count, kept.data());
+            std::vector<std::uint32_t> want(count);
+            const std::size_t want_kept = count - std::size_t(drop_hidden_noted(view, records.data(), order.data(), 0, count, want.data()));
+            ASSERT_EQ(got, want_kept) << isa << ", " << count << " notes";
+            EXPECT_TRUE(std::equal(want.begin(), want.begin() + std::ptrdiff_t(want_kept), kept.begin())) << isa << ", " << count << " notes";
+        }
+    }
+    select_isa("best");
+}
+
+// A clip-space soup drawn with a job system goes in parts of rows (render_parts), as many as
+// ParallelFor::threads says, their bounds placed by the last render's load: whatever the parts,
+// frame after frame, the same bits and statistics as one thread.
+TEST(ReferenceCells, PartsOfRowsGiveTheBitsOfOneThread) {
+    const std::vector<float> frames[3] = {test::random_clip_triangles(51, 6000, 0.3f), test::random_clip_triangles(52, 6000, 0.3f),
+                                          test::random_clip_triangles(53, 9000, 0.2f)};
+    const BufferConfig config = test::buffer_config(333, 201, 2, 0.5f);  // 21 cell rows
+    std::vector<OcclusionBuffer> serial_frames;  // render_frame starts from a clear buffer: each frame alone
+    for (const std::vector<float>& frame : frames) {
+        serial_frames.emplace_back(config);
+        serial_frames.back().render_frame(test::clip_space_input(frame));
+    }
+    std::mt19937_64 order_rng(5);
+    for (const std::size_t threads : {std::size_t(0), std::size_t(1), std::size_t(3), std::size_t(8), std::size_t(1000)}) {
+        OcclusionBuffer parts(config);
+        for (std::size_t f = 0; f < 3; ++f) {
+            parts.render_frame(test::clip_space_input(frames[f]), ParallelFor{test::run_shuffled, &order_rng, threads});
+            const std::string where = std::to_string(threads) + " threads, frame " + std::to_string(f);
+            EXPECT_TRUE(test::same_subtiles(parts, serial_frames[f])) << where;
+            EXPECT_TRUE(test::same_pyramid(parts, serial_frames[f])) << where;
+            EXPECT_TRUE(parts.stats() == serial_frames[f].stats()) << where;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace homcull::detail

@@ -128,13 +128,16 @@ TEST(RenderThreads, RenderFrameThrowsBeforeClearing) {
 }
 
 // A job system that runs tasks in order on the calling thread and throws std::bad_alloc at
-// its throw_at-th call, as a bin growing out of memory would in the middle of a render.
+// its throw_at-th call, as a bin growing out of memory would in the middle of a render; with
+// run_some, that call first runs the first half of its tasks (a job system failing part-way).
 struct FailingJobs {
     int calls = 0, throw_at = 0;
+    bool run_some = false;
     static void run(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data) {
         auto& self = *static_cast<FailingJobs*>(user);
-        if (++self.calls == self.throw_at) throw std::bad_alloc();
-        for (std::size_t k = 0; k < count; ++k) task(data, k);
+        const bool fail = ++self.calls == self.throw_at;
+        for (std::size_t k = 0; k < (fail ? (self.run_some ? count / 2 : 0) : count); ++k) task(data, k);
+        if (fail) throw std::bad_alloc();
     }
 };
 
@@ -165,31 +168,57 @@ bool pyramid_matches_subtiles(const OcclusionBuffer& buffer) {
     return offset + 1 == cells.size();
 }
 
-// A render that fails part-way, after some of its waves were drawn, leaves a pyramid that
-// matches what the buffer holds (never the last frame's, which could hide what is now
-// visible), whichever call of the job system fails.
-TEST(RenderThreads, ARenderFailingBetweenWavesLeavesAMatchingPyramid) {
+// A render that fails part-way leaves a pyramid that matches what the buffer holds, and no
+// subtile farther than the whole frame puts it (nothing of the last frame may hide what is
+// now visible) once drawing began, whichever call of the job system fails and whether it ran
+// some tasks first.
+// A clip-space soup is drawn in parts of rows (one parallel run after the sort's two); with
+// shared-edge flags (all zero: the same triangles) the same soup goes in waves (two runs each).
+TEST(RenderThreads, ARenderFailingPartWayLeavesAMatchingConservativeBuffer) {
     const std::vector<float> last = test::random_clip_triangles(31, 3000, 0.4f, 0.5f), frame = test::random_clip_triangles(32, 30000, 0.3f);
+    const std::vector<std::uint8_t> no_shared_edges(frame.size() / 12, 0);
     BufferConfig config;
     config.width = 301;
     config.height = 277;
     config.samples = 2;
     config.near_w = 1.0f;
-    int failures = 0;
-    for (int throw_at = 1; throw_at <= 12; ++throw_at) {
-        OcclusionBuffer buffer(config);
-        buffer.render(test::clip_space_input(last));
-        FailingJobs jobs;
-        jobs.throw_at = throw_at;
-        try {
-            buffer.render_frame(test::clip_space_input(frame), ParallelFor{&FailingJobs::run, &jobs});
-        } catch (const std::bad_alloc&) {
-            ++failures;
+    for (const bool in_parts : {true, false}) {
+        TriangleInput in = test::clip_space_input(frame);
+        if (!in_parts) in.shared_edges = no_shared_edges.data();
+        OcclusionBuffer whole(config);
+        whole.render(test::clip_space_input(last));
+        whole.render_frame(in);
+        for (const bool run_some : {false, true}) {
+            int failures = 0;
+            for (int throw_at = 1; throw_at <= 12; ++throw_at) {
+                OcclusionBuffer buffer(config);
+                buffer.render(test::clip_space_input(last));
+                FailingJobs jobs;
+                jobs.throw_at = throw_at;
+                jobs.run_some = run_some;
+                try {
+                    buffer.render_frame(in, ParallelFor{&FailingJobs::run, &jobs, 2});
+                } catch (const std::bad_alloc&) {
+                    ++failures;
+                }
+                const std::string where = std::string(in_parts ? "parts" : "waves") + (run_some ? ", some tasks run" : "") + ", call " +
+                                          std::to_string(throw_at) + " failed";
+                EXPECT_TRUE(pyramid_matches_subtiles(buffer)) << where;
+                bool conservative = true;
+                for (int ty = 0; ty < buffer.subtiles_y(); ++ty)
+                    for (int tx = 0; tx < buffer.subtiles_x(); ++tx) conservative = conservative && buffer.subtile(tx, ty).d0 <= whole.subtile(tx, ty).d0;
+                // (A failure in the sort's two calls, before anything is drawn, leaves the last
+                // frame whole, as input render_frame refuses does.)
+                EXPECT_TRUE(throw_at <= 2 || conservative) << where;
+            }
+            if (in_parts) {
+                EXPECT_EQ(failures, 3);  // the sort's two calls and the parts'
+            } else {
+                EXPECT_GE(failures, 6);  // the sort's two calls, and at least two of the three waves' two each
+                EXPECT_LT(failures, 12);  // and a render that did not fail
+            }
         }
-        EXPECT_TRUE(pyramid_matches_subtiles(buffer)) << "the job system's call " << throw_at << " failed";
     }
-    EXPECT_GE(failures, 6);  // the sort's two calls, and at least two of the three waves' two each
-    EXPECT_LT(failures, 12);  // and a render that did not fail
 }
 
 TEST(RenderThreads, CityFromAboveSameBits) {

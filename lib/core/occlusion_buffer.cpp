@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace homcull {
 namespace {
@@ -48,7 +49,14 @@ void prefetch_triangle(const detail::RasterTriangle& tri) {
 struct OcclusionBuffer::Chunk {
     std::vector<std::vector<detail::RasterTriangle>> bins;
     RasterStats stats;
-    std::vector<std::uint32_t> undecided;  // with cell records: the triangles the cells did not drop
+};
+
+// A part of a noted render's rows (draw_noted_part), its scratch: room for a slice's undecided triangles, and its statistics.
+struct OcclusionBuffer::NotedPart {
+    std::vector<std::uint32_t> undecided;
+    RasterStats stats;
+    int row_begin = 0, row_end = 0;  // its subtile rows in the render under way
+    bool drawn = false;              // its task ran (render_parts)
 };
 
 OcclusionBuffer::~OcclusionBuffer() = default;
@@ -89,6 +97,7 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     pyramid_.assign(size + detail::kMaxSimdLanes, 0.0f);  // padded: RectScan loads whole vectors of a level's row
     reference_cells_width_ = detail::reference_cells_width(subtiles_x_);
     reference_cells_.assign(std::size_t(reference_cells_width_) * std::size_t(detail::reference_cells_height(subtiles_y_)), 0.0f);
+    cell_row_load_.assign(std::size_t(detail::reference_cells_height(subtiles_y_)), 0u);
     for (const detail::PyramidLevel& l : levels_) {
         level_offset_.push_back(std::int32_t(l.offset));
         level_width_.push_back(l.width);
@@ -146,10 +155,17 @@ void OcclusionBuffer::read_pyramid(std::vector<float>& cells) const {
     cells.assign(pyramid_.begin(), pyramid_.begin() + std::ptrdiff_t(top.offset + std::size_t(top.width) * std::size_t(top.height)));
 }
 
-detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first) {
-    const detail::ReferenceCells cells{reference_cells_.data(), reference_cells_width_};
-    if (clear_first) std::fill(reference_cells_.begin(), reference_cells_.end(), 0.0f);  // d0 >= 0 everywhere
-    else refresh_reference_cells(cells, 0, subtiles_y_);
+detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end) {
+    const std::size_t size = std::size_t(reference_cells_width_) * std::size_t(detail::reference_cells_height(subtiles_y_));
+    float* first = reference_cells_.data() + part * size;
+    const detail::ReferenceCells cells{first, reference_cells_width_};
+    const std::size_t width = std::size_t(reference_cells_width_);
+    const std::size_t own_begin = std::size_t(row_begin >> detail::kReferenceCellShift) * width;
+    const std::size_t own_end = std::min(size, std::size_t(((row_end - 1) >> detail::kReferenceCellShift) + 1) * width);
+    std::fill(first, first + own_begin, std::numeric_limits<float>::infinity());
+    std::fill(first + own_end, first + size, std::numeric_limits<float>::infinity());
+    if (clear_first) std::fill(first + own_begin, first + own_end, 0.0f);  // d0 >= 0 everywhere
+    else refresh_reference_cells(cells, row_begin, row_end);
     return cells;
 }
 
@@ -235,47 +251,141 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
                                      ? sorted
                                      : in;
     stats_ += skipped;
-    if (parallel.run) render_binned(drawn, parallel, cache, clear_first, list);
+    if (parallel.run && list.records) render_parts(drawn, parallel, clear_first, list);
+    else if (parallel.run) render_binned(drawn, parallel, cache, clear_first);
     else render_serial(drawn, cache, clear_first, list);
 }
 
 // One thread: each triangle is rasterized over the whole buffer as soon as it is set up, in
 // input order; nothing is binned. Every subtile sees the triangles in the same order as in
-// render_binned, so both give the same bits. With cell records (a clip-space soup drawn
-// nearest first, reference_cells.hpp), the list is taken in slices: a noted triangle hidden
-// behind the reference cells is dropped unread, the others go through the setup, and the cells
-// of the rows the slice changed are refreshed after it.
+// render_binned and render_parts, so all give the same bits. With cell records (a clip-space
+// soup drawn nearest first, reference_cells.hpp), the buffer is one part (draw_noted_part).
 void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list) {
+    if (list.records) {
+        if (noted_parts_.empty()) noted_parts_.resize(1);
+        if (noted_parts_[0].undecided.size() < kCellRefreshTriangles) noted_parts_[0].undecided.resize(kCellRefreshTriangles);
+        draw_noted_part(in, list, clear_first, 0, 0, subtiles_y_);
+        stats_ += noted_parts_[0].stats;
+        build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+        return;
+    }
     if (clear_first) clear_rows(0, subtiles_y_);
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t updated = 0;
     RasterStats stats;
-    if (!list.records) {
-        detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
-                                     &target, stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); }, list);
-    } else {
-        const detail::ReferenceCells cells = start_reference_cells(clear_first);
-        int changed_begin = subtiles_y_, changed_end = 0;  // the subtile rows changed since the last refresh
-        const auto draw = [&](const detail::RasterTriangle& tri) {
-            const std::uint64_t n = target.kernel(target, tri);
-            updated += n;
-            if (n != 0) {
-                changed_begin = std::min(changed_begin, tri.j0 / kH);
-                changed_end = std::max(changed_end, tri.j1 / kH + 1);
-            }
-        };
-        if (undecided_.size() < kCellRefreshTriangles) undecided_.resize(kCellRefreshTriangles);
-        for (std::size_t begin = 0; begin < in.triangle_count; begin += kCellRefreshTriangles) {
-            const std::size_t end = std::min(in.triangle_count, begin + kCellRefreshTriangles);
-            detail::setup_noted_range(in, cells, list, begin, end, undecided_.data(), config_.near_w, config_.edge_margin, sample_width_,
-                                      sample_height_, &target, stats, draw);
-            refresh_reference_cells(cells, changed_begin, changed_end);
-            changed_begin = subtiles_y_, changed_end = 0;
-        }
-    }
+    detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
+                                 stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); }, list);
     stats.subtiles_updated = updated;
     stats_ += stats;
     build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+}
+
+// The list is taken in slices of kCellRefreshTriangles: a noted triangle hidden behind the
+// part's cells (every noted triangle outside its rows, whose cells are infinite) is dropped
+// unread, the others go through the setup and are drawn into the part's rows, and the cells of
+// the rows the slice changed are refreshed after it. Every part counts the triangles it drops
+// as the setup counts a hidden one (triangles_in and rasterized), and the setup counts the
+// others as it would for the whole buffer (a triangle outside the target's rows is hidden
+// there): so each part's statistics are the whole render's, but for subtiles_updated.
+void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin,
+                                      int row_end) {
+    NotedPart& scratch = noted_parts_[part];
+    scratch.drawn = true;
+    if (clear_first) clear_rows(row_begin, row_end);
+    const detail::RasterTarget target = raster_target(row_begin, row_end);
+    const detail::ReferenceCells cells = start_reference_cells(clear_first, part, row_begin, row_end);
+    RasterStats stats;
+    int changed_begin = row_end, changed_end = row_begin;  // the subtile rows changed since the last refresh
+    const int first_cell_row = row_begin >> detail::kReferenceCellShift;
+    const auto draw = [&](const detail::RasterTriangle& tri) {
+        const std::uint64_t n = target.kernel(target, tri);
+        stats.subtiles_updated += n;
+        const int first_row = std::max(row_begin, tri.j0 / kH);
+        ++cell_row_load_[std::size_t(std::max(first_cell_row, first_row >> detail::kReferenceCellShift))];
+        if (n != 0) {
+            changed_begin = std::min(changed_begin, first_row);
+            changed_end = std::max(changed_end, std::min(row_end, tri.j1 / kH + 1));
+        }
+    };
+    for (std::size_t begin = 0; begin < in.triangle_count; begin += kCellRefreshTriangles) {
+        const std::size_t end = std::min(in.triangle_count, begin + kCellRefreshTriangles);
+        detail::setup_noted_range(in, cells, list, begin, end, scratch.undecided.data(), config_.near_w, config_.edge_margin, sample_width_,
+                                  sample_height_, &target, stats, draw);
+        refresh_reference_cells(cells, changed_begin, changed_end);
+        changed_begin = row_end, changed_end = row_begin;
+    }
+    scratch.stats = stats;
+}
+
+// With a job system and cell records: the rows split into parts, one task each, every part
+// drawing the whole list into its own rows with its own cells (draw_noted_part). Nothing is
+// binned and there is one parallel run: the noted triangles outside a part cost it a note
+// read, and a triangle reaching two parts is set up by both. The bounds lie on cell rows,
+// placed so that each part drew about as many triangles in the last noted render (equal rows
+// the first time); they change no bit, only the balance. Part 0's statistics are the render's.
+// S1 at 1080p, two threads: 4.44 -> ... ms (render_binned's waves before).
+void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list) {
+    const int cell_rows = detail::reference_cells_height(subtiles_y_);
+    const std::size_t parts = std::size_t(std::clamp<int>(int(std::min<std::size_t>(parallel.threads ? parallel.threads : 2, 256)), 1, cell_rows));
+    const std::size_t cells_size = std::size_t(reference_cells_width_) * std::size_t(cell_rows);
+    if (reference_cells_.size() < parts * cells_size) reference_cells_.resize(parts * cells_size);
+    if (noted_parts_.size() < parts) noted_parts_.resize(parts);
+    for (std::size_t p = 0; p < parts; ++p) {
+        NotedPart& part = noted_parts_[p];
+        if (part.undecided.size() < kCellRefreshTriangles) part.undecided.resize(kCellRefreshTriangles);
+        part.drawn = false;
+    }
+    // The bounds: part p ends at the first cell row where the load so far reaches (p + 1) / parts
+    // of the total, leaving each part at least one row.
+    std::uint64_t total = 0;
+    for (const std::uint32_t load : cell_row_load_) total += load;
+    int cell_row = 0;
+    std::uint64_t load_so_far = 0;
+    for (std::size_t p = 0; p < parts; ++p) {
+        NotedPart& part = noted_parts_[p];
+        part.row_begin = cell_row << detail::kReferenceCellShift;
+        const int rows_left_for_others = int(parts - p - 1);
+        if (p + 1 == parts) {
+            cell_row = cell_rows;
+        } else if (total == 0) {
+            cell_row = int((p + 1) * std::size_t(cell_rows) / parts);
+        } else {
+            do load_so_far += cell_row_load_[std::size_t(cell_row++)];
+            while (cell_row < cell_rows - rows_left_for_others && load_so_far * parts < (p + 1) * total);
+        }
+        part.row_end = std::min(subtiles_y_, cell_row << detail::kReferenceCellShift);
+    }
+    std::fill(cell_row_load_.begin(), cell_row_load_.end(), 0u);
+
+    struct Job {
+        OcclusionBuffer* self;
+        const TriangleInput* in;
+        detail::DrawList list;
+        bool clear_first;
+    } job{this, &in, list, clear_first};
+    try {
+        detail::run_tasks(parallel, parts, [](void* data, std::size_t p) {
+            const Job& j = *static_cast<Job*>(data);
+            OcclusionBuffer& b = *j.self;
+            const NotedPart& part = b.noted_parts_[p];
+            b.draw_noted_part(*j.in, j.list, j.clear_first, p, part.row_begin, part.row_end);
+            b.build_pyramid_rows(part.row_begin, part.row_end, std::min(detail::kReferenceCellShift, int(b.levels_.size()) - 1));
+        }, &job);
+    } catch (...) {
+        // The job system failed (the tasks themselves allocate nothing and do not throw): the
+        // parts it ran are drawn. The rows of the others still hold what was there before; in
+        // a render_frame that was the frame before, which must not hide anything of this one:
+        // they are cleared. The pyramid is rebuilt to match; the statistics count no part.
+        for (std::size_t p = 0; p < parts; ++p)
+            if (clear_first && !noted_parts_[p].drawn) clear_rows(noted_parts_[p].row_begin, noted_parts_[p].row_end);
+        build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+        throw;
+    }
+    // Above the parts' levels (their bounds are multiples of 2^kReferenceCellShift rows).
+    for (int level = detail::kReferenceCellShift + 1; level < int(levels_.size()); ++level)
+        reduce_pyramid_rows(level, 0, levels_[std::size_t(level)].height);
+    stats_ += noted_parts_[0].stats;
+    for (std::size_t p = 1; p < parts; ++p) stats_.subtiles_updated += noted_parts_[p].stats.subtiles_updated;
 }
 
 // With a job system, the triangles go in waves of chunks: in each, phase 1 sets up and bins
@@ -284,11 +394,9 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
 // nearest first, the first waves fill most of the buffer, and phase 1 of the later ones drops
 // the triangles already hidden in it before their edges are set up and they are binned
 // (hidden_in_target, as on one thread). Dropping them changes no bit, so the waves' sizes are
-// free; only the speed depends on them. A clip-space soup comes as a list with cell records:
-// phase 1 then first drops the noted triangles hidden behind the reference cells unread, and
-// phase 2 refreshes each band's own cells (as render_serial does every 4,096 triangles).
-void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first,
-                                    detail::DrawList list) {
+// free; only the speed depends on them. (A clip-space soup with cell records goes to
+// render_parts instead.)
+void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_updated_.size();
     if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
@@ -301,19 +409,15 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
         std::size_t first_chunk, end_chunk, bands;
         const detail::RasterTarget* drawn_into;  // phase 1's: the whole buffer, or null while nothing is drawn
         bool clear_first, last_wave;
-        detail::DrawList list;                // the order as a list, and the cell records, or null
-        const detail::ReferenceCells* cells;  // with records: refreshed by each band after each wave but the last
     };
     const detail::RasterTarget whole = raster_target(0, subtiles_y_);
-    const detail::ReferenceCells cells = list.records ? start_reference_cells(clear_first) : detail::ReferenceCells{};
     std::size_t drawn_chunks = 0;  // the chunks of the waves drawn so far
     try {
         // At least one wave, so that render_frame clears and builds the pyramid whatever the count.
         for (std::size_t first = 0, wave_chunks = kFirstWaveChunks; first == 0 || first < chunk_count; first += wave_chunks, wave_chunks *= 2) {
             const std::size_t end = std::min(chunk_count, first + wave_chunks);
             const bool nothing_drawn = first == 0 && clear_first;  // the buffer still holds the last frame
-            Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count,
-                    list, &cells};
+            Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count};
 
             detail::run_tasks(parallel, end - first, [](void* data, std::size_t k) {
                 const Job& j = *static_cast<Job*>(data);
@@ -328,14 +432,8 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                     for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
                         chunk.bins[std::size_t(band)].push_back(tri);
                 };
-                if (j.list.records && j.drawn_into) {  // as render_serial: noted triangles hidden behind the cells dropped unread
-                    if (chunk.undecided.size() < kChunkTriangles) chunk.undecided.resize(kChunkTriangles);
-                    detail::setup_noted_range(*j.in, *j.cells, j.list, c * kChunkTriangles, end_triangle, chunk.undecided.data(), b.config_.near_w,
-                                              b.config_.edge_margin, b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin);
-                } else {
-                    detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
-                                                 b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin, j.list);
-                }
+                detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
+                                             b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin);
             }, &job);
 
             detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
@@ -353,18 +451,23 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                     }
                 }
                 b.band_updated_[band] += updated;
-                if (j.list.records && updated != 0 && !j.last_wave) b.refresh_reference_cells(*j.cells, row_begin, row_end);  // its own cells
                 if (j.last_wave) b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
             }, &job);
             drawn_chunks = end;
         }
     } catch (...) {
-        // Out of memory growing a bin after earlier waves were drawn (input errors throw before
-        // any wave): the buffer keeps those waves' triangles, a partial but conservative render,
-        // with its statistics and a pyramid rebuilt to match, so that no test reads a pyramid
-        // of the frame before.
-        for (std::size_t c = 0; c < drawn_chunks; ++c) stats_ += chunks_[c].stats;
-        for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
+        // Out of memory growing a bin, or the job system failed (input errors throw before any
+        // wave). After the first wave, the buffer keeps the waves drawn, a partial but
+        // conservative render, with their statistics. Before that some bands may still hold
+        // the frame before, which must not hide anything of this one: a render_frame then
+        // leaves the buffer clear. Either way the pyramid is rebuilt to match, so that no test
+        // reads a pyramid of the frame before.
+        if (clear_first && drawn_chunks == 0) {
+            clear_rows(0, subtiles_y_);
+        } else {
+            for (std::size_t c = 0; c < drawn_chunks; ++c) stats_ += chunks_[c].stats;
+            for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
+        }
         build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
         throw;
     }

@@ -172,7 +172,15 @@ void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bu
 }
 
 void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
-                 const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges) {
+                 const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges,
+                 const CellRecord* noted, CellRecord* noted_in_order) {
+    if (listed && noted) {
+        place_triangles(begin, end, bucket, class_of, start, some_skipped, [&](std::size_t t, std::size_t p) {
+            data[p] = std::uint32_t(t);
+            noted_in_order[p] = noted[t];
+        });
+        return;
+    }
     if (listed) {  // the triangles' numbers only (DrawList): shared-edge flags stay the input's
         place_triangles(begin, end, bucket, class_of, start, some_skipped,
                         [&](std::size_t t, std::size_t p) { data[p] = std::uint32_t(t); });
@@ -258,6 +266,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
     if (scratch.skipped.size() < tasks) scratch.skipped.resize(tasks);
     if (noting && scratch.noted.size() < n) scratch.noted.resize(n);
+    if (noting && scratch.noted_in_order.size() < n) scratch.noted_in_order.resize(n);
     std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.excluded.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.skipped.begin(), tasks, RasterStats{});
@@ -329,7 +338,8 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         DrawOrderScratch& s = *j.scratch;
         place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
                     s.bucket.data(), s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
-                    j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr);
+                    j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr, j.records ? s.noted.data() : nullptr,
+                    s.noted_in_order.data());
     });
 
     sorted = in;
@@ -337,7 +347,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     sorted.triangle_count = n - left_out;
     if (listed) {
         list->order = scratch.data.data();
-        if (noting) list->records = scratch.noted.data();
+        if (noting) list->records = scratch.noted_in_order.data();
         return true;
     }
     sorted.shared_edges = in.shared_edges ? scratch.shared_edges.data() : nullptr;

@@ -46,6 +46,7 @@ struct DrawOrderScratch {
     std::vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
     std::vector<std::uint8_t> shared_edges;
     std::vector<CellRecord> noted;  // with the list of a clip-space soup: each triangle's cell record
+    std::vector<CellRecord> noted_in_order;  // the same in the list's order
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 

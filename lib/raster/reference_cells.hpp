@@ -97,9 +97,8 @@ inline std::uint64_t drop_hidden_noted(const ReferenceCells& cells, const CellRe
     std::size_t kept = 0;
     for (std::size_t k = begin; k < end; ++k) {
         const std::uint32_t t = order ? order[k] : std::uint32_t(k);
-        if (order && k + 16 < end) __builtin_prefetch(records + order[k + 16]);
         undecided[kept] = t;
-        kept += !hidden_by_record(cells, records[t]);
+        kept += !hidden_by_record(cells, records[k]);
     }
     return std::uint64_t((end - begin) - kept);
 }
@@ -110,5 +109,11 @@ inline std::uint64_t drop_hidden_noted(const ReferenceCells& cells, const CellRe
 using RefreshCellsKernel = void (*)(const SubtilePlanes& planes, int subtiles_x, int subtiles_y, int cell_row_begin, int cell_row_end,
                                     const ReferenceCells& cells);
 RefreshCellsKernel selected_refresh_cells();
+
+// drop_hidden_noted over positions [0, count) of records and order (both starting at the
+// slice's first position), in vectors: the kept count.
+using DropHiddenKernel = std::size_t (*)(const ReferenceCells& cells, const CellRecord* records, const std::uint32_t* order, std::size_t count,
+                                         std::uint32_t* undecided);
+DropHiddenKernel selected_drop_hidden();
 
 }  // namespace homcull::detail

@@ -278,7 +278,7 @@ template <typename Emit>
 void setup_noted_range(const TriangleInput& in, const ReferenceCells& cells, DrawList list, std::size_t begin, std::size_t end,
                        std::uint32_t* undecided, double near_w, double edge_margin, int sample_width, int sample_height,
                        const RasterTarget* drawn_into, RasterStats& stats, Emit&& emit) {
-    const std::uint64_t hidden = drop_hidden_noted(cells, list.records, list.order, begin, end, undecided);
+    const std::uint64_t hidden = std::uint64_t(end - begin) - selected_drop_hidden()(cells, list.records + begin, list.order + begin, end - begin, undecided);
     stats.triangles_in += hidden;
     stats.rasterized += hidden;
     setup_triangle_range(in, nullptr, 0, (end - begin) - std::size_t(hidden), near_w, edge_margin, sample_width, sample_height, drawn_into,

@@ -188,6 +188,9 @@ struct ClusteredInput {
 struct ParallelFor {
     void (*run)(void* user, std::size_t count, void (*task)(void* task_data, std::size_t index), void* task_data) = nullptr;
     void* user = nullptr;
+    // How many threads run the tasks (0: not said, taken as 2). Only a speed hint: a render of a
+    // clip-space soup splits the buffer's rows into this many parts, one task each.
+    std::size_t threads = 0;
 };
 
 // A screen rectangle to test: NDC (y up) bounds and the occludee's nearest clip w. The layout
@@ -364,8 +367,11 @@ private:
     // clear_first: render_frame, which clears the rows where it rasterizes them.
     void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
     void render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list);
-    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first,
-                       detail::DrawList list);
+    void render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list);
+    // Part `part` of a noted render: the list's triangles drawn into subtile rows [row_begin,
+    // row_end) with that part's cells; its statistics counted as for the whole buffer.
+    void draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin, int row_end);
+    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
     bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
@@ -382,14 +388,21 @@ private:
     void reduce_pyramid_above_bands();
 
     // The smallest d0 of each cell of 8 x 8 subtiles, valid only while a render draws
-    // (raster/reference_cells.hpp); sized with the buffer.
+    // (raster/reference_cells.hpp): a copy per part of the rows (render_parts; one thread: one
+    // part), the other parts' rows infinite in each. Sized with the buffer for one part.
     std::vector<float> reference_cells_;
     int reference_cells_width_ = 0;
-    std::vector<std::uint32_t> undecided_;  // one thread: the triangles of a slice the cells did not drop
+    struct NotedPart;
+    std::vector<NotedPart> noted_parts_;
+    // Per cell row: the triangles the last noted render drew there (each at its first row in its
+    // part), which places the next render's part bounds.
+    std::vector<std::uint32_t> cell_row_load_;
     // At the start of a render with cell records (which render_rows asks the sort for only when
-    // hidden triangles are skipped and the instruction set has a refresh kernel): the cells,
-    // zeroed when the render clears the buffer first, else computed from d0.
-    detail::ReferenceCells start_reference_cells(bool clear_first);
+    // hidden triangles are skipped and the instruction set has a refresh kernel): part `part`'s
+    // cells, those of subtile rows [row_begin, row_end) zeroed when the render clears the buffer
+    // first, else computed from d0, and the others infinite (every noted triangle is hidden
+    // there: another part draws them).
+    detail::ReferenceCells start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end);
     // Refreshes the cells holding subtile rows [row_begin, row_end).
     void refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end);
 

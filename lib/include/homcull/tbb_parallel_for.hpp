@@ -1,6 +1,7 @@
 #pragma once
 // A ParallelFor backed by oneTBB, for the tools and for engines without a job system of
-// their own (target homcull::tbb). Thread count: TBB's, which tbb::global_control limits.
+// their own (target homcull::tbb). Thread count: TBB's when it is called, within any
+// tbb::global_control limit then in force (ParallelFor::threads).
 #include <homcull/occlusion_buffer.hpp>
 
 namespace homcull {
