@@ -251,7 +251,7 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
                                      ? sorted
                                      : in;
     stats_ += skipped;
-    if (parallel.run && list.records) render_parts(drawn, parallel, clear_first, list);
+    if (parallel.run && list.notes) render_parts(drawn, parallel, clear_first, list);
     else if (parallel.run) render_binned(drawn, parallel, cache, clear_first);
     else render_serial(drawn, cache, clear_first, list);
 }
@@ -261,7 +261,7 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
 // render_binned and render_parts, so all give the same bits. With cell records (a clip-space
 // soup drawn nearest first, reference_cells.hpp), the buffer is one part (draw_noted_part).
 void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list) {
-    if (list.records) {
+    if (list.notes) {
         if (noted_parts_.empty()) noted_parts_.resize(1);
         if (noted_parts_[0].undecided.size() < kCellRefreshTriangles) noted_parts_[0].undecided.resize(kCellRefreshTriangles);
         draw_noted_part(in, list, clear_first, 0, 0, subtiles_y_);

@@ -173,12 +173,10 @@ void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bu
 
 void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
                  const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges,
-                 const CellRecord* noted, CellRecord* noted_in_order) {
-    if (listed && noted) {
-        place_triangles(begin, end, bucket, class_of, start, some_skipped, [&](std::size_t t, std::size_t p) {
-            data[p] = std::uint32_t(t);
-            noted_in_order[p] = noted[t];
-        });
+                 const CellRecord* noted, ListedNote* listed_notes) {
+    if (listed && noted) {  // the notes with the triangles' numbers: the list of a noted soup
+        place_triangles(begin, end, bucket, class_of, start, some_skipped,
+                        [&](std::size_t t, std::size_t p) { listed_notes[p] = {noted[t], std::uint32_t(t)}; });
         return;
     }
     if (listed) {  // the triangles' numbers only (DrawList): shared-edge flags stay the input's
@@ -255,7 +253,8 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     // (S1's render with 1,024 classes was slower than with none), and drawing S1 in 32 classes
     // of depth is within 2 % of drawing it fully sorted (docs/occlusion-buffer.md, "Draw order").
     const std::size_t tasks = (n + kDrawOrderTask - 1) / kDrawOrderTask;
-    const std::size_t words = listed        ? n
+    const std::size_t words = noting        ? 0
+                              : listed      ? n
                               : in.indices ? (in.indices_16bit ? (3 * n + 1) / 2 : 3 * n)
                                            : 3 * n * std::size_t(in.position_components);
     if (scratch.bucket.size() < n) scratch.bucket.resize(n);
@@ -266,7 +265,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
     if (scratch.skipped.size() < tasks) scratch.skipped.resize(tasks);
     if (noting && scratch.noted.size() < n) scratch.noted.resize(n);
-    if (noting && scratch.noted_in_order.size() < n) scratch.noted_in_order.resize(n);
+    if (noting && scratch.listed_notes.size() < n) scratch.listed_notes.resize(n);
     std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.excluded.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.skipped.begin(), tasks, RasterStats{});
@@ -339,15 +338,15 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
                     s.bucket.data(), s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
                     j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr, j.records ? s.noted.data() : nullptr,
-                    s.noted_in_order.data());
+                    s.listed_notes.data());
     });
 
     sorted = in;
     sorted.order = DrawOrder::as_given;
     sorted.triangle_count = n - left_out;
     if (listed) {
-        list->order = scratch.data.data();
-        if (noting) list->records = scratch.noted_in_order.data();
+        if (noting) list->notes = scratch.listed_notes.data();
+        else list->order = scratch.data.data();
         return true;
     }
     sorted.shared_edges = in.shared_edges ? scratch.shared_edges.data() : nullptr;

@@ -88,19 +88,23 @@ inline bool hidden_by_record(const ReferenceCells& cells, const CellRecord& r) {
     return true;
 }
 
-// Positions [begin, end) of what is drawn (triangle order[k], or k without a list): writes
-// the triangles not hidden behind the cells by their notes (hidden_by_record) to undecided[],
-// in order, and returns how many it dropped. The notes are read through the list, scattered:
-// they are prefetched 16 positions ahead.
-inline std::uint64_t drop_hidden_noted(const ReferenceCells& cells, const CellRecord* records, const std::uint32_t* order, std::size_t begin,
-                                       std::size_t end, std::uint32_t* undecided) {
+// A triangle's note in the draw order's list (sort_nearest_first): what the render reads of a
+// noted soup before it decides to read the triangle itself.
+struct ListedNote {
+    CellRecord note;
+    std::uint32_t triangle;  // its number in the input
+};
+static_assert(sizeof(ListedNote) == 12, "a listed note is 12 bytes");
+
+// Writes the triangles of notes [0, count) not hidden behind the cells (hidden_by_record) to
+// undecided[], in order, and returns how many it kept. The reference of the vector kernel below.
+inline std::size_t drop_hidden_noted(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided) {
     std::size_t kept = 0;
-    for (std::size_t k = begin; k < end; ++k) {
-        const std::uint32_t t = order ? order[k] : std::uint32_t(k);
-        undecided[kept] = t;
-        kept += !hidden_by_record(cells, records[k]);
+    for (std::size_t k = 0; k < count; ++k) {
+        undecided[kept] = notes[k].triangle;
+        kept += !hidden_by_record(cells, notes[k].note);
     }
-    return std::uint64_t((end - begin) - kept);
+    return kept;
 }
 
 // Sets the cells of cell rows [cell_row_begin, cell_row_end) to the smallest d0 of their
@@ -110,10 +114,8 @@ using RefreshCellsKernel = void (*)(const SubtilePlanes& planes, int subtiles_x,
                                     const ReferenceCells& cells);
 RefreshCellsKernel selected_refresh_cells();
 
-// drop_hidden_noted over positions [0, count) of records and order (both starting at the
-// slice's first position), in vectors: the kept count.
-using DropHiddenKernel = std::size_t (*)(const ReferenceCells& cells, const CellRecord* records, const std::uint32_t* order, std::size_t count,
-                                         std::uint32_t* undecided);
+// drop_hidden_noted in vectors: the same triangles kept, the same count.
+using DropHiddenKernel = std::size_t (*)(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided);
 DropHiddenKernel selected_drop_hidden();
 
 }  // namespace homcull::detail

@@ -48,8 +48,7 @@ void RefreshReferenceCells(const SubtilePlanes& planes, int subtiles_x, int subt
 // spans more cells is decided by hidden_by_record itself. Min and >= are exact: the same
 // answers as the scalar loop. (The scalar loop took about 17 cycles a note on S1: the fast
 // path's branch and the dependent loads.)
-std::size_t DropHiddenNoted(const ReferenceCells& cells, const CellRecord* records, const std::uint32_t* order, std::size_t count,
-                            std::uint32_t* undecided) {
+std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided) {
     const hn::ScalableTag<std::uint32_t> du;
     const hn::RebindToSigned<decltype(du)> di;
     const hn::RebindToFloat<decltype(du)> df;
@@ -58,8 +57,8 @@ std::size_t DropHiddenNoted(const ReferenceCells& cells, const CellRecord* recor
     const auto width = hn::Set(du, std::uint32_t(cells.width));
     std::size_t kept = 0, k = 0;
     for (; k + lanes <= count; k += lanes) {
-        hn::Vec<decltype(du)> box, nearest_bits;
-        hn::LoadInterleaved2(du, reinterpret_cast<const std::uint32_t*>(records + k), box, nearest_bits);
+        hn::Vec<decltype(du)> box, nearest_bits, triangle;
+        hn::LoadInterleaved3(du, reinterpret_cast<const std::uint32_t*>(notes + k), box, nearest_bits, triangle);
         const auto cx0 = hn::And(box, byte), cx1 = hn::And(hn::ShiftRight<8>(box), byte);
         const auto cy0 = hn::And(hn::ShiftRight<16>(box), byte), cy1 = hn::ShiftRight<24>(box);
         // The box's cells (cx0 + dx, cy0 + dy), dx and dy up to the vector's largest span, each
@@ -77,13 +76,9 @@ std::size_t DropHiddenNoted(const ReferenceCells& cells, const CellRecord* recor
         }
         // NaN (no note): never hidden.
         const auto hidden = hn::RebindMask(du, hn::AndNot(visible, hn::Eq(nearest, nearest)));
-        kept += hn::CompressStore(hn::LoadU(du, order + k), hn::Not(hidden), du, undecided + kept);
+        kept += hn::CompressStore(triangle, hn::Not(hidden), du, undecided + kept);
     }
-    for (; k < count; ++k) {
-        undecided[kept] = order[k];
-        kept += !hidden_by_record(cells, records[k]);
-    }
-    return kept;
+    return kept + drop_hidden_noted(cells, notes + k, count - k, undecided + kept);
 }
 
 }  // namespace homcull::detail::HWY_NAMESPACE

@@ -160,11 +160,14 @@ inline bool gather_listed_ready(const TriangleInput& in, std::size_t first, std:
 }
 
 // Triangles to draw in another order than the input's without copying them (the draw order
-// of a render on one thread, draw_order.hpp): position k of the sequence is input triangle
-// order[k]. The setup reads them through the list, prefetching the next batch's positions.
+// of a render on one thread, or of a clip-space soup, draw_order.hpp): position k of the
+// sequence is input triangle order[k], or notes[k].triangle. The setup reads them through a
+// list of numbers, prefetching the next batch's positions.
 struct DrawList {
     const std::uint32_t* order = nullptr;  // null: the input's own order
-    const CellRecord* records = nullptr;   // null, or records[t]: the cell record of triangle t of the input drawn (sort_nearest_first)
+    // A noted soup (sort_nearest_first): the list is its notes, each with its triangle's number
+    // (order is then null).
+    const ListedNote* notes = nullptr;
 };
 
 FrontEndKernels selected_front_end_kernels();
@@ -269,16 +272,15 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
     }
 }
 
-// setup_triangle_range over positions [begin, end) of a list with cell records
-// (sort_nearest_first), the reference cells of the target drawn into at hand: the noted
-// triangles hidden behind the cells are counted as the setup counts a hidden triangle
-// (triangles_in and rasterized) and dropped unread (drop_hidden_noted); the others are set up
-// in order. `undecided`: room for end - begin triangle numbers. (A noted input has no cache.)
+// setup_triangle_range over positions [begin, end) of a list of notes (sort_nearest_first),
+// the reference cells of the target drawn into at hand: the noted triangles hidden behind the
+// cells are counted as the setup counts a hidden triangle (triangles_in and rasterized) and
+// dropped unread (drop_hidden_noted, in vectors); the others are set up in order. `undecided`: room for end - begin triangle numbers. (A noted input has no cache.)
 template <typename Emit>
 void setup_noted_range(const TriangleInput& in, const ReferenceCells& cells, DrawList list, std::size_t begin, std::size_t end,
                        std::uint32_t* undecided, double near_w, double edge_margin, int sample_width, int sample_height,
                        const RasterTarget* drawn_into, RasterStats& stats, Emit&& emit) {
-    const std::uint64_t hidden = std::uint64_t(end - begin) - selected_drop_hidden()(cells, list.records + begin, list.order + begin, end - begin, undecided);
+    const std::uint64_t hidden = std::uint64_t(end - begin) - selected_drop_hidden()(cells, list.notes + begin, end - begin, undecided);
     stats.triangles_in += hidden;
     stats.rasterized += hidden;
     setup_triangle_range(in, nullptr, 0, (end - begin) - std::size_t(hidden), near_w, edge_margin, sample_width, sample_height, drawn_into,
