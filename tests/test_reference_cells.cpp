@@ -215,15 +215,18 @@ TEST(ReferenceCells, ANewFrameForgetsTheLastFramesCells) {
     }
 }
 
-// The vector drop decides every note as the scalar loop does (drop_hidden_noted, on
-// hidden_by_record): boxes of 1 x 1 to 6 x 9 cells, notes missing (NaN depth, box zeroed as the
-// notes kernel leaves it), depths equal to a cell's, counts that leave a partial vector.
+// The vector drop (block tables) decides every note as the scalar loop over the cells does
+// (drop_hidden_noted, on hidden_by_record): boxes of 1 x 1 to 6 x 9 cells (more than 8: the
+// kernel's own fallback), notes missing (NaN depth, box zeroed as the notes kernel leaves it),
+// depths equal to a cell's, counts that leave a partial vector. Then the tables follow changed
+// rows (update_cell_blocks on those rows only).
 TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
     const int width = 30, height = 34;  // 1080p's cells
     std::mt19937_64 rng(41);
     std::uniform_real_distribution<float> depth(0.0f, 1.0f);
-    std::vector<float> cells(std::size_t(width * height));
-    for (float& c : cells) c = depth(rng) < 0.3f ? std::numeric_limits<float>::infinity() : depth(rng);  // infinite: another part's rows
+    std::vector<float> cells(std::size_t(kCellTables * width * height));
+    for (std::size_t c = 0; c < std::size_t(width * height); ++c)
+        cells[c] = depth(rng) < 0.3f ? std::numeric_limits<float>::infinity() : depth(rng);  // infinite: another part's rows
     const std::size_t n = 5000 + 7;
     std::vector<ListedNote> notes(n);
     for (std::size_t k = 0; k < n; ++k) {
@@ -235,7 +238,8 @@ TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
         r.nearest = rng() % 3 == 0 ? cells[std::size_t(r.cy0 * width + r.cx0)] : depth(rng);
         if (rng() % 10 == 0) r = CellRecord{0, 0, 0, 0, std::numeric_limits<float>::quiet_NaN()};
     }
-    const ReferenceCells view{cells.data(), width};
+    const ReferenceCells view{cells.data(), width, height};
+    update_cell_blocks(view, 0, height);
     std::vector<std::uint32_t> all_kept(n);
     const std::size_t kept_of_all = drop_hidden_noted(view, notes.data(), n, all_kept.data());
     ASSERT_GT(kept_of_all, n / 5);
@@ -250,6 +254,16 @@ TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
             EXPECT_TRUE(std::equal(want.begin(), want.begin() + std::ptrdiff_t(want_kept), got.begin())) << isa << ", " << count << " notes";
         }
     }
+    // Rows 10 to 14 change (some cells nearer, some farther); the tables updated for those rows
+    // alone must answer as tables built from scratch.
+    for (int cy = 10; cy < 15; ++cy)
+        for (int cx = 0; cx < width; ++cx) cells[std::size_t(cy * width + cx)] = depth(rng);
+    update_cell_blocks(view, 10, 15);
+    std::vector<float> rebuilt(cells.begin(), cells.begin() + width * height);
+    rebuilt.resize(cells.size());
+    const ReferenceCells rebuilt_view{rebuilt.data(), width, height};
+    update_cell_blocks(rebuilt_view, 0, height);
+    EXPECT_TRUE(rebuilt == cells);
     select_isa("best");
 }
 

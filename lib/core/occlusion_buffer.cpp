@@ -96,7 +96,9 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     }
     pyramid_.assign(size + detail::kMaxSimdLanes, 0.0f);  // padded: RectScan loads whole vectors of a level's row
     reference_cells_width_ = detail::reference_cells_width(subtiles_x_);
-    reference_cells_.assign(std::size_t(reference_cells_width_) * std::size_t(detail::reference_cells_height(subtiles_y_)), 0.0f);
+    reference_cells_.assign(std::size_t(detail::kCellTables) * std::size_t(reference_cells_width_) *
+                                std::size_t(detail::reference_cells_height(subtiles_y_)),
+                            0.0f);
     cell_row_load_.assign(std::size_t(detail::reference_cells_height(subtiles_y_)), 0u);
     for (const detail::PyramidLevel& l : levels_) {
         level_offset_.push_back(std::int32_t(l.offset));
@@ -156,9 +158,10 @@ void OcclusionBuffer::read_pyramid(std::vector<float>& cells) const {
 }
 
 detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end) {
-    const std::size_t size = std::size_t(reference_cells_width_) * std::size_t(detail::reference_cells_height(subtiles_y_));
-    float* first = reference_cells_.data() + part * size;
-    const detail::ReferenceCells cells{first, reference_cells_width_};
+    const int height = detail::reference_cells_height(subtiles_y_);
+    const std::size_t size = std::size_t(reference_cells_width_) * std::size_t(height);  // of the cells (table (0, 0))
+    float* first = reference_cells_.data() + part * std::size_t(detail::kCellTables) * size;
+    const detail::ReferenceCells cells{first, reference_cells_width_, height};
     const std::size_t width = std::size_t(reference_cells_width_);
     const std::size_t own_begin = std::size_t(row_begin >> detail::kReferenceCellShift) * width;
     const std::size_t own_end = std::min(size, std::size_t(((row_end - 1) >> detail::kReferenceCellShift) + 1) * width);
@@ -166,14 +169,16 @@ detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, 
     std::fill(first + own_end, first + size, std::numeric_limits<float>::infinity());
     if (clear_first) std::fill(first + own_begin, first + own_end, 0.0f);  // d0 >= 0 everywhere
     else refresh_reference_cells(cells, row_begin, row_end);
+    detail::update_cell_blocks(cells, 0, height);
     return cells;
 }
 
 void OcclusionBuffer::refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end) {
     if (!cells.min_d0 || row_begin >= row_end) return;
     const detail::SubtilePlanes planes{d0_.data(), d1_.data(), mask_.data(), covered_.data(), stride_, nullptr, 0};
-    detail::selected_refresh_cells()(planes, subtiles_x_, subtiles_y_, row_begin >> detail::kReferenceCellShift,
-                                     ((row_end - 1) >> detail::kReferenceCellShift) + 1, cells);
+    const int cell_row_begin = row_begin >> detail::kReferenceCellShift, cell_row_end = ((row_end - 1) >> detail::kReferenceCellShift) + 1;
+    detail::selected_refresh_cells()(planes, subtiles_x_, subtiles_y_, cell_row_begin, cell_row_end, cells);
+    detail::update_cell_blocks(cells, cell_row_begin, cell_row_end);
 }
 
 detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) {
@@ -327,7 +332,7 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
 void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list) {
     const int cell_rows = detail::reference_cells_height(subtiles_y_);
     const std::size_t parts = std::size_t(std::clamp<int>(int(std::min<std::size_t>(parallel.threads ? parallel.threads : 2, 256)), 1, cell_rows));
-    const std::size_t cells_size = std::size_t(reference_cells_width_) * std::size_t(cell_rows);
+    const std::size_t cells_size = std::size_t(detail::kCellTables) * std::size_t(reference_cells_width_) * std::size_t(cell_rows);
     if (reference_cells_.size() < parts * cells_size) reference_cells_.resize(parts * cells_size);
     if (noted_parts_.size() < parts) noted_parts_.resize(parts);
     for (std::size_t p = 0; p < parts; ++p) {

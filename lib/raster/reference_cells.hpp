@@ -35,7 +35,23 @@ constexpr int kReferenceCellShift = 3;  // a cell spans 2^3 x 2^3 subtiles
 struct ReferenceCells {
     float* min_d0 = nullptr;  // null: no cells
     int width = 0;            // cells per row; rows follow each other
+    int height = 0;           // rows; min_d0 is the first of kCellTables tables of width x height (cell_table)
 };
+
+// Block minima for the drop (DropHiddenKernel): table (kx, ky) holds at each cell the smallest
+// of the 2^kx x 2^ky cells from it rightwards and downwards (those within the grid), so that
+// four reads answer any box of up to 8 x 8 cells, two blocks a side, as a sparse
+// table answers range minima (Bender and Farach-Colton, "The LCA Problem Revisited", LATIN
+// 2000). Table (0, 0) is the cells themselves. S1's boxes span up to 6 x 9 cells; the drop
+// gathered every cell of the vector's largest box before, about nine reads a note.
+constexpr int kCellBlockLevels = 3;  // blocks of 1, 2 and 4 cells a side
+constexpr int kCellTables = kCellBlockLevels * kCellBlockLevels;
+inline std::size_t cell_table_offset(const ReferenceCells& cells, int kx, int ky) {
+    return std::size_t(ky * kCellBlockLevels + kx) * std::size_t(cells.width) * std::size_t(cells.height);
+}
+// Recomputes the tables above (0, 0) where cell rows [cell_row_begin, cell_row_end) changed
+// (and the three rows above, whose blocks reach into them).
+void update_cell_blocks(const ReferenceCells& cells, int cell_row_begin, int cell_row_end);
 
 // The cells needed for subtiles_x x subtiles_y subtiles.
 inline int reference_cells_width(int subtiles_x) { return (subtiles_x + (1 << kReferenceCellShift) - 1) >> kReferenceCellShift; }

@@ -42,12 +42,13 @@ void RefreshReferenceCells(const SubtilePlanes& planes, int subtiles_x, int subt
     }
 }
 
-// drop_hidden_noted over `count` positions, a vector of notes at a time: the four corner
-// cells of each note's box gathered (hidden_by_record's 2 x 2 path, the boxes of nearly every
-// S1 triangle), the kept triangles' numbers compressed into undecided[]; a lane whose box
-// spans more cells is decided by hidden_by_record itself. Min and >= are exact: the same
-// answers as the scalar loop. (The scalar loop took about 17 cycles a note on S1: the fast
-// path's branch and the dependent loads.)
+// drop_hidden_noted over `count` notes, a vector at a time: the smallest cell of each note's
+// box from four reads of a block table (kCellTables: blocks of 2^kx x 2^ky cells at the box's
+// corners, overlapping), the kept triangles' numbers compressed into undecided[]; a lane whose
+// box spans more than 8 cells a side is decided by hidden_by_record itself. Min and >= are
+// exact: the same answers as the scalar loop. (The scalar loop took about 17 cycles a note on
+// S1, its branch on the box's size mispredicted; gathering every cell of the vector's largest
+// box about 12.)
 std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided) {
     const hn::ScalableTag<std::uint32_t> du;
     const hn::RebindToSigned<decltype(du)> di;
@@ -61,21 +62,31 @@ std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes
         hn::LoadInterleaved3(du, reinterpret_cast<const std::uint32_t*>(notes + k), box, nearest_bits, triangle);
         const auto cx0 = hn::And(box, byte), cx1 = hn::And(hn::ShiftRight<8>(box), byte);
         const auto cy0 = hn::And(hn::ShiftRight<16>(box), byte), cy1 = hn::ShiftRight<24>(box);
-        // The box's cells (cx0 + dx, cy0 + dy), dx and dy up to the vector's largest span, each
-        // clamped to the lane's own box (a cell read twice changes no minimum).
-        const auto span_x = hn::Sub(cx1, cx0), span_y = hn::Sub(cy1, cy0);
-        const int max_dx = int(hn::GetLane(hn::MaxOfLanes(du, span_x))), max_dy = int(hn::GetLane(hn::MaxOfLanes(du, span_y)));
-        auto visible = hn::Lt(hn::Zero(df), hn::Zero(df));  // no lane yet
-        const auto nearest = hn::BitCast(df, nearest_bits);
-        for (int dy = 0; dy <= max_dy; ++dy) {
-            const auto row = hn::Mul(hn::Min(hn::Add(cy0, hn::Set(du, std::uint32_t(dy))), cy1), width);
-            for (int dx = 0; dx <= max_dx; ++dx) {
-                const auto cell = hn::Add(row, hn::Min(hn::Add(cx0, hn::Set(du, std::uint32_t(dx))), cx1));
-                visible = hn::Or(visible, hn::Lt(hn::GatherIndex(df, cells.min_d0, hn::BitCast(di, cell)), nearest));
-            }
+        // Blocks of 2^k cells a side, k = 0 for one cell, 1 for 2 or 3, 2 for 4 to 8 (two blocks
+        // overlapping or meeting cover the side). Wider boxes are decided below.
+        const auto span_x = hn::BitCast(di, hn::Sub(cx1, cx0)), span_y = hn::BitCast(di, hn::Sub(cy1, cy0));
+        const auto one = hn::Set(di, 1), two = hn::Set(di, 2);
+        const auto level = [&](auto span) { return hn::Neg(hn::Add(hn::VecFromMask(di, hn::Gt(span, hn::Zero(di))), hn::VecFromMask(di, hn::Gt(span, two)))); };
+        const auto kx = level(span_x), ky = level(span_y);
+        const auto wide = hn::Or(hn::Gt(span_x, hn::Set(di, 7)), hn::Gt(span_y, hn::Set(di, 7)));
+        // The far blocks start 2^k - 1 cells before the box's far edge.
+        const auto x0 = hn::BitCast(di, cx0), y0 = hn::BitCast(di, cy0);
+        const auto x1 = hn::Add(hn::Sub(hn::BitCast(di, cx1), hn::Shl(one, kx)), one);
+        const auto y1 = hn::Add(hn::Sub(hn::BitCast(di, cy1), hn::Shl(one, ky)), one);
+        const auto table = hn::Mul(hn::Add(hn::Mul(ky, hn::Set(di, kCellBlockLevels)), kx), hn::Set(di, cells.width * cells.height));
+        const auto w = hn::BitCast(di, width);
+        const auto read = [&](auto x, auto y) { return hn::GatherIndex(df, cells.min_d0, hn::Add(table, hn::Add(hn::Mul(y, w), x))); };
+        const auto smallest = hn::Min(hn::Min(read(x0, y0), read(x1, y0)), hn::Min(read(x0, y1), read(x1, y1)));
+        auto hidden = hn::RebindMask(du, hn::Ge(smallest, hn::BitCast(df, nearest_bits)));  // NaN (no note): never hidden
+        if (!hn::AllFalse(di, wide)) {
+            HWY_ALIGN std::uint32_t hidden_lanes[hn::MaxLanes(du)];
+            hn::Store(hn::VecFromMask(du, hidden), du, hidden_lanes);
+            HWY_ALIGN std::int32_t wide_lanes[hn::MaxLanes(di)];
+            hn::Store(hn::VecFromMask(di, wide), di, wide_lanes);
+            for (std::size_t l = 0; l < lanes; ++l)
+                if (wide_lanes[l]) hidden_lanes[l] = hidden_by_record(cells, notes[k + l].note) ? ~0u : 0u;
+            hidden = hn::MaskFromVec(hn::Load(du, hidden_lanes));
         }
-        // NaN (no note): never hidden.
-        const auto hidden = hn::RebindMask(du, hn::AndNot(visible, hn::Eq(nearest, nearest)));
         kept += hn::CompressStore(triangle, hn::Not(hidden), du, undecided + kept);
     }
     return kept + drop_hidden_noted(cells, notes + k, count - k, undecided + kept);
@@ -99,6 +110,30 @@ RefreshCellsKernel selected_refresh_cells() {
 }
 
 DropHiddenKernel selected_drop_hidden() { return HOMCULL_RESOLVED_KERNEL(DropHiddenNoted); }
+
+void update_cell_blocks(const ReferenceCells& cells, int cell_row_begin, int cell_row_end) {
+    const int width = cells.width, height = cells.height;
+    const auto row = [&](int kx, int ky, int cy) { return cells.min_d0 + cell_table_offset(cells, kx, ky) + std::size_t(cy) * std::size_t(width); };
+    // Rows of each level from the level before: wider blocks from two of half the width in the
+    // same row, taller ones from two of half the height, the second clamped to the grid.
+    for (int cy = cell_row_begin; cy < cell_row_end; ++cy)
+        for (int kx = 1; kx < kCellBlockLevels; ++kx) {
+            const float* half = row(kx - 1, 0, cy);
+            float* out = row(kx, 0, cy);
+            const int step = 1 << (kx - 1);
+            for (int cx = 0; cx < width; ++cx) out[cx] = std::min(half[cx], half[std::min(cx + step, width - 1)]);
+        }
+    for (int ky = 1; ky < kCellBlockLevels; ++ky) {
+        const int step = 1 << (ky - 1);
+        for (int cy = std::max(0, cell_row_begin - ((1 << ky) - 1)); cy < cell_row_end; ++cy)
+            for (int kx = 0; kx < kCellBlockLevels; ++kx) {
+                const float* top = row(kx, ky - 1, cy);
+                const float* bottom = row(kx, ky - 1, std::min(cy + step, height - 1));
+                float* out = row(kx, ky, cy);
+                for (int cx = 0; cx < width; ++cx) out[cx] = std::min(top[cx], bottom[cx]);
+            }
+    }
+}
 
 }  // namespace homcull::detail
 #endif  // HWY_ONCE
