@@ -214,15 +214,19 @@ public:
 
     void clear();
     // Rasterizes occluders in draw order (TriangleInput::order, nearest first by default).
-    // Without a job system each triangle is set up and drawn in turn; with one, in waves of
-    // chunks of triangles (4, 8, 16, ... chunks), each set up and binned into bands of subtile
-    // rows in parallel, then each band rasterized in draw order (so every subtile sees the
-    // same sequence of triangles whatever the threads). Triangles already hidden in the buffer
-    // are dropped before their edges are set up, which changes no bit. Scratch memory (the
+    // Without a job system each triangle is set up and drawn in turn; with one, a clip-space
+    // soup drawn nearest first (the identity matrix, 4 packed floats per vertex, no shared-edge
+    // flags, as S1 and MOC's API give triangles) is drawn in ParallelFor::threads parts of rows,
+    // one task each; other input in waves of chunks of triangles (4, 8, 16, ... chunks), each
+    // set up and binned into bands of subtile rows in parallel, then each band rasterized in
+    // draw order. Every subtile sees the same sequence of triangles whatever the threads.
+    // Triangles already hidden in the buffer are dropped before their edges are set up (most
+    // of a noted soup's before they are read), which changes no bit. Scratch memory (the
     // per-chunk band bins) is reused and only grows, so a frame allocates only when a bin
     // outgrows every earlier frame's: after a few frames of a walkthrough, rarely. Should that
-    // allocation fail (std::bad_alloc) after some waves were drawn, the buffer keeps them, with
-    // a pyramid and statistics to match. Indexed input with at most two vertices per
+    // allocation, or the job system, fail (std::bad_alloc) after drawing began, the buffer keeps
+    // what was drawn, with a pyramid to match; a render_frame leaves no row of the frame
+    // before. Indexed input with at most two vertices per
     // triangle has every one of its vertex_count positions read and transformed once (so
     // vertex_count must not overstate the positions), into scratch of 33 bytes a vertex (up to
     // 4M vertices) that also only grows and stays allocated with the buffer. Statistics
@@ -361,8 +365,8 @@ private:
     Visibility test_prepared_rect(const detail::RectQuery& q) const;
     detail::SubtileView subtile_view() const;
 
-    // Rendering (occlusion_buffer.cpp): without a job system straight through, with one
-    // binned by bands of subtile rows; the same bits either way.
+    // Rendering (occlusion_buffer.cpp): without a job system straight through, with one in
+    // parts of rows (a noted soup) or binned by bands of subtile rows; the same bits either way.
     detail::RasterTarget raster_target(int row_begin, int row_end);
     // clear_first: render_frame, which clears the rows where it rasterizes them.
     void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
