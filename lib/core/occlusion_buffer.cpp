@@ -51,7 +51,8 @@ struct OcclusionBuffer::Chunk {
     RasterStats stats;
 };
 
-// A part of a noted render's rows (draw_noted_part), its scratch: room for a slice's undecided triangles, and its statistics.
+// A part of a noted render's rows (draw_noted_part) and its scratch: room for a slice's
+// undecided triangles, and its statistics.
 struct OcclusionBuffer::NotedPart {
     std::vector<std::uint32_t> undecided;
     RasterStats stats;
@@ -301,12 +302,15 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
     const detail::ReferenceCells cells = start_reference_cells(clear_first, part, row_begin, row_end);
     RasterStats stats;
     int changed_begin = row_end, changed_end = row_begin;  // the subtile rows changed since the last refresh
-    const int first_cell_row = row_begin >> detail::kReferenceCellShift;
+    // The triangles drawn per cell row of the part, counted here and copied out at the end: the
+    // parts' counts share cache lines of cell_row_load_.
+    const int first_cell_row = row_begin >> detail::kReferenceCellShift, cell_row_end = ((row_end - 1) >> detail::kReferenceCellShift) + 1;
+    std::uint32_t load[256] = {};  // a noted buffer has at most 256 cell rows (CellRecord's bytes)
     const auto draw = [&](const detail::RasterTriangle& tri) {
         const std::uint64_t n = target.kernel(target, tri);
         stats.subtiles_updated += n;
         const int first_row = std::max(row_begin, tri.j0 / kH);
-        ++cell_row_load_[std::size_t(std::max(first_cell_row, first_row >> detail::kReferenceCellShift))];
+        ++load[(first_row >> detail::kReferenceCellShift) - first_cell_row];
         if (n != 0) {
             changed_begin = std::min(changed_begin, first_row);
             changed_end = std::max(changed_end, std::min(row_end, tri.j1 / kH + 1));
@@ -319,6 +323,7 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
         refresh_reference_cells(cells, changed_begin, changed_end);
         changed_begin = row_end, changed_end = row_begin;
     }
+    std::copy(load, load + (cell_row_end - first_cell_row), cell_row_load_.begin() + first_cell_row);
     scratch.stats = stats;
 }
 
@@ -328,10 +333,11 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
 // read, and a triangle reaching two parts is set up by both. The bounds lie on cell rows,
 // placed so that each part drew about as many triangles in the last noted render (equal rows
 // the first time); they change no bit, only the balance. Part 0's statistics are the render's.
-// S1 at 1080p, two threads: 4.44 -> ... ms (render_binned's waves before).
+// S1 at 1080p, two threads: 4.30 -> 3.02 ms against render_binned's waves (see
+// docs/occlusion-buffer.md, "Threads").
 void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list) {
     const int cell_rows = detail::reference_cells_height(subtiles_y_);
-    const std::size_t parts = std::size_t(std::clamp<int>(int(std::min<std::size_t>(parallel.threads ? parallel.threads : 2, 256)), 1, cell_rows));
+    const std::size_t parts = std::min(parallel.threads ? parallel.threads : 2, std::size_t(cell_rows));  // cell_rows >= 1
     const std::size_t cells_size = std::size_t(detail::kCellTables) * std::size_t(reference_cells_width_) * std::size_t(cell_rows);
     if (reference_cells_.size() < parts * cells_size) reference_cells_.resize(parts * cells_size);
     if (noted_parts_.size() < parts) noted_parts_.resize(parts);
