@@ -3,18 +3,18 @@
 // cell of 8 x 8 subtiles (64 x 32 samples; 30 x 34 cells, 4 KB, at 1080p). With the notes the
 // draw order takes of a clip-space soup (CellRecord below), the render drops most hidden
 // triangles from their note and a few cells in L1, without reading the triangle, setting it up
-// or reading some ten rows of d0 (OcclusionBuffer::render_serial, and each wave's setup in
-// render_binned): on S1 at 1080p about 80,000 of 100,000 triangles; one thread 7.6 -> 6.0 ms,
-// two 5.1 -> 4.3 ms.
+// or reading some ten rows of d0 (OcclusionBuffer::draw_noted_part, on one thread for the whole
+// buffer, with a job system for each part of its rows): on S1 at 1080p about 80,000 of 100,000
+// triangles.
 //
 // Why a cell read long after it was computed is still safe: a subtile's d0 never decreases
 // while a render draws (it changes only when a full working layer is promoted, and the
 // working layer's depth always lies above d0), so a cell's minimum, taken at any earlier
 // point of the render, bounds every d0 of the cell from below. The render zeroes the cells
 // when it clears the buffer first, else computes them from d0, and refreshes those of the rows
-// it drew into every 4,096 triangles (with a job system: each band its own cells, after each
-// wave). The cells are the render's scratch: nothing reads them outside a render, and they
-// change no bit (see CellRecord).
+// it drew into every 4,096 triangles (each part of the rows its own copy of the cells). The cells
+// are the render's scratch: nothing reads them outside a render, and they change no bit (see
+// CellRecord).
 //
 // Greene, Kass and Miller's hierarchical Z-buffer (SIGGRAPH 1993) keeps such a pyramid exact
 // after every update; refreshing a stale but safe level in batches costs less here, where nine
@@ -35,7 +35,7 @@ constexpr int kReferenceCellShift = 3;  // a cell spans 2^3 x 2^3 subtiles
 struct ReferenceCells {
     float* min_d0 = nullptr;  // null: no cells
     int width = 0;            // cells per row; rows follow each other
-    int height = 0;           // rows; min_d0 is the first of kCellTables tables of width x height (cell_table)
+    int height = 0;           // rows; min_d0 is the first of kCellTables tables of width x height (cell_table_offset)
 };
 
 // Block minima for the drop (DropHiddenKernel): table (kx, ky) holds at each cell the smallest

@@ -1,6 +1,7 @@
-// The refresh of the reference cells (reference_cells.hpp): a cell's 8 subtiles of a row in
-// one vector of 8 floats (two of 4 on SSE4 and NEON), the minimum over its 8 rows, then over
-// the lanes.
+// The reference cells' kernels (reference_cells.hpp): the refresh, a cell's 8 subtiles of a row
+// in one vector of 8 floats (two of 4 on SSE4 and NEON), the minimum over its 8 rows, then over
+// the lanes; and the drop of noted triangles hidden behind the cells, a note per lane. The block
+// tables' update is plain C++ (a few thousand minima per refresh).
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/reference_cells_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -66,7 +67,9 @@ std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes
         // overlapping or meeting cover the side). Wider boxes are decided below.
         const auto span_x = hn::BitCast(di, hn::Sub(cx1, cx0)), span_y = hn::BitCast(di, hn::Sub(cy1, cy0));
         const auto one = hn::Set(di, 1), two = hn::Set(di, 2);
-        const auto level = [&](auto span) { return hn::Neg(hn::Add(hn::VecFromMask(di, hn::Gt(span, hn::Zero(di))), hn::VecFromMask(di, hn::Gt(span, two)))); };
+        const auto level = [&](auto span) {  // (span > 0) + (span > 2): masks are -1
+            return hn::Neg(hn::Add(hn::VecFromMask(di, hn::Gt(span, hn::Zero(di))), hn::VecFromMask(di, hn::Gt(span, two))));
+        };
         const auto kx = level(span_x), ky = level(span_y);
         const auto wide = hn::Or(hn::Gt(span_x, hn::Set(di, 7)), hn::Gt(span_y, hn::Set(di, 7)));
         // The far blocks start 2^k - 1 cells before the box's far edge.
@@ -113,7 +116,9 @@ DropHiddenKernel selected_drop_hidden() { return HOMCULL_RESOLVED_KERNEL(DropHid
 
 void update_cell_blocks(const ReferenceCells& cells, int cell_row_begin, int cell_row_end) {
     const int width = cells.width, height = cells.height;
-    const auto row = [&](int kx, int ky, int cy) { return cells.min_d0 + cell_table_offset(cells, kx, ky) + std::size_t(cy) * std::size_t(width); };
+    const auto row = [&](int kx, int ky, int cy) {
+        return cells.min_d0 + cell_table_offset(cells, kx, ky) + std::size_t(cy) * std::size_t(width);
+    };
     // Rows of each level from the level before: wider blocks from two of half the width in the
     // same row, taller ones from two of half the height, the second clamped to the grid.
     for (int cy = cell_row_begin; cy < cell_row_end; ++cy)
