@@ -108,9 +108,9 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // bytes a triangle (list->order null), so that the render reads the notes in order and drops
 // most hidden triangles without reading them (OcclusionBuffer::draw_noted_part). Read through
 // a list of numbers, the notes took about 1.0 ms of S1's 5.9 on one thread; in order, in
-// vectors (DropHiddenKernel), about 0.45, and every part of the rows reads all of them
-// (render_parts). Otherwise list->notes is null. may_list false (a
-// render with a job system): no list otherwise, the sorted copy.
+// vectors (DropHiddenKernel), about 0.3, and every part of the rows reads all of them
+// (render_parts). Otherwise list->notes is null. may_list false (a render with a job system):
+// no list otherwise, the sorted copy.
 bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr,
                         const CellRecordSpec* records = nullptr, bool may_list = true);

@@ -275,7 +275,8 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
 // setup_triangle_range over positions [begin, end) of a list of notes (sort_nearest_first),
 // the reference cells of the target drawn into at hand: the noted triangles hidden behind the
 // cells are counted as the setup counts a hidden triangle (triangles_in and rasterized) and
-// dropped unread (drop_hidden_noted, in vectors); the others are set up in order. `undecided`: room for end - begin triangle numbers. (A noted input has no cache.)
+// dropped unread (drop_hidden_noted, in vectors); the others are set up in order.
+// `undecided`: room for end - begin triangle numbers. (A noted input has no cache.)
 template <typename Emit>
 void setup_noted_range(const TriangleInput& in, const ReferenceCells& cells, DrawList list, std::size_t begin, std::size_t end,
                        std::uint32_t* undecided, double near_w, double edge_margin, int sample_width, int sample_height,
