@@ -206,7 +206,8 @@ TEST(RenderThreads, ARenderFailingPartWayLeavesAMatchingConservativeBuffer) {
                 EXPECT_TRUE(pyramid_matches_subtiles(buffer)) << where;
                 bool conservative = true;
                 for (int ty = 0; ty < buffer.subtiles_y(); ++ty)
-                    for (int tx = 0; tx < buffer.subtiles_x(); ++tx) conservative = conservative && buffer.subtile(tx, ty).d0 <= whole.subtile(tx, ty).d0;
+                    for (int tx = 0; tx < buffer.subtiles_x(); ++tx)
+                        conservative = conservative && buffer.subtile(tx, ty).d0 <= whole.subtile(tx, ty).d0;
                 // (A failure in the sort's two calls, before anything is drawn, leaves the last
                 // frame whole, as input render_frame refuses does.)
                 EXPECT_TRUE(throw_at <= 2 || conservative) << where;
