@@ -269,10 +269,21 @@ TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
 
 // A clip-space soup drawn with a job system goes in parts of rows (render_parts), as many as
 // ParallelFor::threads says, their bounds placed by the last render's load: whatever the parts,
-// frame after frame, the same bits and statistics as one thread.
+// frame after frame, and with bad input, the same bits and statistics as one thread.
 TEST(ReferenceCells, PartsOfRowsGiveTheBitsOfOneThread) {
-    const std::vector<float> frames[3] = {test::random_clip_triangles(51, 6000, 0.3f), test::random_clip_triangles(52, 6000, 0.3f),
-                                          test::random_clip_triangles(53, 9000, 0.2f)};
+    std::vector<float> frames[4] = {test::random_clip_triangles(51, 6000, 0.3f), test::random_clip_triangles(52, 6000, 0.3f),
+                                    test::random_clip_triangles(53, 9000, 0.2f), test::random_clip_triangles(54, 6000, 0.3f)};
+    // The last frame with bad input among the good: vertices behind the eye, not numbers,
+    // infinite, and far outside the guard band.
+    std::vector<float>& bad = frames[3];
+    for (std::size_t v = 0; 4 * v < bad.size(); ++v) {
+        float* p = &bad[4 * v];
+        if (v % 97 == 0) p[3] = -p[3];
+        if (v % 211 == 0) p[v % 2] = std::numeric_limits<float>::quiet_NaN();
+        if (v % 223 == 0) p[3] = std::numeric_limits<float>::infinity();
+        if (v % 227 == 0) p[2] = std::numeric_limits<float>::infinity();
+        if (v % 13 == 0) p[0] *= 1e9f;
+    }
     const BufferConfig config = test::buffer_config(333, 201, 2, 0.5f);  // 21 cell rows
     std::vector<OcclusionBuffer> serial_frames;  // render_frame starts from a clear buffer: each frame alone
     for (const std::vector<float>& frame : frames) {
@@ -282,7 +293,7 @@ TEST(ReferenceCells, PartsOfRowsGiveTheBitsOfOneThread) {
     std::mt19937_64 order_rng(5);
     for (const std::size_t threads : {std::size_t(0), std::size_t(1), std::size_t(3), std::size_t(8), std::size_t(1000)}) {
         OcclusionBuffer parts(config);
-        for (std::size_t f = 0; f < 3; ++f) {
+        for (std::size_t f = 0; f < 4; ++f) {
             parts.render_frame(test::clip_space_input(frames[f]), ParallelFor{test::run_shuffled, &order_rng, threads});
             const std::string where = std::to_string(threads) + " threads, frame " + std::to_string(f);
             EXPECT_TRUE(test::same_subtiles(parts, serial_frames[f])) << where;
@@ -290,6 +301,10 @@ TEST(ReferenceCells, PartsOfRowsGiveTheBitsOfOneThread) {
             EXPECT_TRUE(parts.stats() == serial_frames[f].stats()) << where;
         }
     }
+    const RasterStats& bad_stats = serial_frames[3].stats();
+    EXPECT_GT(bad_stats.invalid, 0u);
+    EXPECT_GT(bad_stats.near_clipped, 0u);
+    EXPECT_GT(bad_stats.too_large + bad_stats.outside, 0u);
 }
 
 }  // namespace
