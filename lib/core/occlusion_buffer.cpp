@@ -168,9 +168,13 @@ detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, 
     const std::size_t own_end = std::min(size, std::size_t(((row_end - 1) >> detail::kReferenceCellShift) + 1) * width);
     std::fill(first, first + own_begin, std::numeric_limits<float>::infinity());
     std::fill(first + own_end, first + size, std::numeric_limits<float>::infinity());
-    if (clear_first) std::fill(first + own_begin, first + own_end, 0.0f);  // d0 >= 0 everywhere
-    else refresh_reference_cells(cells, row_begin, row_end);
-    detail::update_cell_blocks(cells, 0, height);
+    if (clear_first) {
+        std::fill(first + own_begin, first + own_end, 0.0f);  // d0 >= 0 everywhere
+    } else {
+        const detail::SubtilePlanes planes{d0_.data(), d1_.data(), mask_.data(), covered_.data(), stride_, nullptr, 0};
+        detail::selected_refresh_cells()(planes, subtiles_x_, subtiles_y_, int(own_begin / width), int(own_end / width), cells);
+    }
+    detail::update_cell_blocks(cells, 0, height);  // every row: the infinite ones too
     return cells;
 }
 
