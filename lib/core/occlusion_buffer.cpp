@@ -254,8 +254,8 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     // Cell records with the list of a clip-space soup, when the buffer keeps cells and they fit a byte.
     const detail::CellRecordSpec record_spec{sample_width_, sample_height_, reference_cells_width_,
                                              detail::reference_cells_height(subtiles_y_), config_.near_w, in.backface};
-    const bool note = detail::hidden_skip_enabled() && detail::selected_refresh_cells() && record_spec.cells_width <= 256 &&
-                      record_spec.cells_height <= 256;
+    const bool note = detail::hidden_skip_enabled() && detail::selected_refresh_cells() &&
+                      record_spec.cells_width <= detail::kMaxNotedCellsPerSide && record_spec.cells_height <= detail::kMaxNotedCellsPerSide;
     const TriangleInput& drawn = detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted, &list, &skipped,
                                                             note ? &record_spec : nullptr, !parallel.run)
                                      ? sorted
@@ -309,7 +309,7 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
     // The triangles drawn per cell row of the part, counted here and copied out at the end: the
     // parts' counts share cache lines of cell_row_load_.
     const int first_cell_row = row_begin >> detail::kReferenceCellShift, cell_row_end = ((row_end - 1) >> detail::kReferenceCellShift) + 1;
-    std::uint32_t load[256] = {};  // a noted buffer has at most 256 cell rows (CellRecord's bytes)
+    std::uint32_t load[detail::kMaxNotedCellsPerSide] = {};  // a noted render's buffer has at most that many cell rows
     const auto draw = [&](const detail::RasterTriangle& tri) {
         const std::uint64_t n = target.kernel(target, tri);
         stats.subtiles_updated += n;

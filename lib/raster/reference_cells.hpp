@@ -78,8 +78,11 @@ struct CellRecord {
 };
 static_assert(sizeof(CellRecord) == 8, "a record is 8 bytes");
 
-// What the first pass needs to note a triangle: the buffer's samples and cells (at most 256 a
-// side: the record's bytes), and the setup's near plane and backface mode, to note only the
+// A buffer with more cells than this a side takes no notes: a record holds cell numbers in bytes.
+constexpr int kMaxNotedCellsPerSide = 256;
+
+// What the first pass needs to note a triangle: the buffer's samples and cells (at most
+// kMaxNotedCellsPerSide a side), and the setup's near plane and backface mode, to note only the
 // triangles whose setup would surely count them as rasterized (not invalid, outside, clipped,
 // degenerate or backfacing), so that dropping them keeps the statistics.
 struct CellRecordSpec {
@@ -90,14 +93,10 @@ struct CellRecordSpec {
 };
 
 // Whether a noted triangle is hidden behind the cells: every cell holding its box bounds d0
-// at or above its depth (positive, or NaN for no note). Most boxes span at most 2 x 2 cells:
-// four loads, no loop.
+// at or above its depth (positive, or NaN for no note). Cell by cell: the reference of the drop
+// kernel (which reads block minima), and its answer for boxes wider than 8 cells.
 inline bool hidden_by_record(const ReferenceCells& cells, const CellRecord& r) {
     const float* row0 = cells.min_d0 + std::size_t(r.cy0) * std::size_t(cells.width);
-    if (((r.cx1 - r.cx0) | (r.cy1 - r.cy0)) <= 1) {
-        const float* row1 = cells.min_d0 + std::size_t(r.cy1) * std::size_t(cells.width);
-        return std::min(std::min(row0[r.cx0], row0[r.cx1]), std::min(row1[r.cx0], row1[r.cx1])) >= r.nearest;
-    }
     for (int cy = r.cy0; cy <= r.cy1; ++cy, row0 += cells.width)
         for (int cx = r.cx0; cx <= r.cx1; ++cx)
             if (!(row0[cx] >= r.nearest)) return false;
