@@ -1,6 +1,7 @@
 // Occludee tests on every instruction set: single rectangle tests, batches of rectangles and
 // batches of boxes all give the answers of the exhaustive scalar definition, including for
 // invalid, huge, inverted and off-screen input.
+#include "core/min_pyramid.hpp"
 #include "support.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -107,6 +108,23 @@ TEST(OccludeeBatches, EmptyBatchesAndBlockBoundaries) {
         buffer.test_rects(rects.data(), count, answers.data());
         EXPECT_EQ(std::count(answers.begin(), answers.end(), Visibility::visible), std::ptrdiff_t(count));
     }
+}
+
+// coarse_level computes what the search over the levels finds: every range of up to 300 cells
+// from every start up to 70 (sides alike and not), every level count up to 12.
+TEST(OccludeeBatches, CoarseLevelIsTheLevelTheSearchFinds) {
+    int checked = 0;
+    for (int levels = 1; levels <= 12; ++levels)
+        for (int x0 = 0; x0 <= 70; ++x0)
+            for (int width : {0, 1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 63, 64, 65, 127, 128, 129, 255, 256, 300})
+                for (int height : {0, 1, 2, 3, 6, 8, 13, 64, 200}) {
+                    const int y0 = (x0 * 7) % 41;
+                    ASSERT_EQ(detail::coarse_level(x0, x0 + width, y0, y0 + height, levels),
+                              detail::coarse_level_by_search(x0, x0 + width, y0, y0 + height, levels))
+                        << x0 << " + " << width << ", " << y0 << " + " << height << ", " << levels << " levels";
+                    ++checked;
+                }
+    EXPECT_EQ(checked, 12 * 71 * 23 * 9);
 }
 
 }  // namespace

@@ -78,10 +78,11 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
 
     // Coarse check: the level where the subtile range spans at most 2 x 2 cells. Their minimum
     // d0 is at most any covered subtile's bound, so d_near below it hides the rectangle.
+    // The four corner cells, read without a branch (one to four distinct cells; a repeated one
+    // changes no minimum), as the batches' SIMD coarse stage reads them.
     const int level = detail::coarse_level(tx0, tx1, ty0, ty1, int(levels_.size()));
-    float coarse = INFINITY;
-    for (int y = ty0 >> level; y <= ty1 >> level; ++y)
-        for (int x = tx0 >> level; x <= tx1 >> level; ++x) coarse = std::min(coarse, min_d0(level, x, y));
+    const int x0 = tx0 >> level, x1 = tx1 >> level, y0 = ty0 >> level, y1 = ty1 >> level;
+    const float coarse = std::min(std::min(min_d0(level, x0, y0), min_d0(level, x1, y0)), std::min(min_d0(level, x0, y1), min_d0(level, x1, y1)));
     if (q.d_near < coarse) return Visibility::occluded;
     if (const detail::RectScanKernel scan = detail::selected_rect_scan_kernel()) return scan(subtile_view(), q);
     // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound

@@ -305,8 +305,14 @@ inline std::uint32_t subtile_rect_bits(int tx, int ty, int i0, int i1, int j0, i
 inline void sample_span(double lo, double hi, int count, int& first, int& last) {
     lo = std::min(std::max(lo, -1.0), double(count) + 1.0);
     hi = std::min(std::max(hi, -1.0), double(count) + 1.0);
-    first = std::max(0, int(std::ceil(lo - 0.5)));
-    last = std::min(count - 1, int(std::floor(hi - 0.5)));
+    // ceil and floor of numbers in [-1.5, count + 0.5] by truncation: exact for any int count,
+    // and cheaper than std::ceil and std::floor, which the baseline x86-64 target (no SSE4.1
+    // round) computes with a range check and two conversions (single test_rect calls on S1:
+    // 18.6 -> 19.2 M/s).
+    const double first_edge = lo - 0.5, last_edge = hi - 0.5;
+    const int first_truncated = int(first_edge), last_truncated = int(last_edge);
+    first = std::max(0, first_truncated + int(double(first_truncated) < first_edge));
+    last = std::min(count - 1, last_truncated - int(double(last_truncated) > last_edge));
 }
 
 // The subtile columns [tx_begin, tx_end] that a subtile row's sample-row intervals
