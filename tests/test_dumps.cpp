@@ -73,14 +73,27 @@ std::vector<std::pair<std::string, std::vector<float>>> expected_parts(const Occ
     std::vector<float> depth;
     buffer.read_depth(depth);
     out.emplace_back("buffer.depth", depth);
+    // Both depth pyramids, as maps making both give them (the culler's maps make only the one
+    // their depth test reads, OcclusionMapsConfig::depth_pyramids; the dump has both). Where
+    // the maps make one, it is that one.
+    OcclusionMapsConfig with_both = maps.config();
+    with_both.depth_pyramids = DepthPyramids::both;
+    OcclusionMaps both(buffer, with_both);
+    both.build(buffer);
     for (int k = 0; k < maps.levels(); ++k) {
         const std::size_t n = std::size_t(maps.level_width(k)) * std::size_t(maps.level_height(k));
         std::vector<float> opacity;
         for (int y = 0; y < maps.level_height(k); ++y)
             for (int x = 0; x < maps.level_width(k); ++x) opacity.push_back(maps.opacity(k, x, y));
         out.emplace_back("opacity.L" + std::to_string(k), opacity);
-        out.emplace_back("maxz.L" + std::to_string(k), std::vector<float>(maps.farthest_depth(k), maps.farthest_depth(k) + n));
-        out.emplace_back("nbz.L" + std::to_string(k), std::vector<float>(maps.nearest_depth(k), maps.nearest_depth(k) + n));
+        out.emplace_back("maxz.L" + std::to_string(k), std::vector<float>(both.farthest_depth(k), both.farthest_depth(k) + n));
+        out.emplace_back("nbz.L" + std::to_string(k), std::vector<float>(both.nearest_depth(k), both.nearest_depth(k) + n));
+        if (maps.farthest_depth(k)) {
+            EXPECT_TRUE(std::equal(maps.farthest_depth(k), maps.farthest_depth(k) + n, both.farthest_depth(k)));
+        }
+        if (maps.nearest_depth(k)) {
+            EXPECT_TRUE(std::equal(maps.nearest_depth(k), maps.nearest_depth(k) + n, both.nearest_depth(k)));
+        }
     }
     if (maps.config().depth == DepthTest::deb) out.emplace_back("deb", maps.depth_estimation());
     return out;
@@ -110,6 +123,10 @@ void expect_exr_matches(const std::string& path, const OcclusionBuffer& buffer, 
 
 TEST(Dumps, ExrHasEveryPartBitForBitWithTwoSamples) {
     const CityFrame frame(city_config(2));
+    // The masked depth test reads neither depth pyramid: the culler's maps make none, the dump
+    // still holds both.
+    ASSERT_EQ(frame.culler.maps().farthest_depth(0), nullptr);
+    ASSERT_EQ(frame.culler.maps().nearest_depth(0), nullptr);
     const std::string dir = test::temp_dir("dumps_exr_samples");
     write_maps_exr(frame.culler.buffer(), frame.culler.maps(), dir + "/maps.exr");
     expect_exr_matches(dir + "/maps.exr", frame.culler.buffer(), frame.culler.maps());

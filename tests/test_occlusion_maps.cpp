@@ -109,7 +109,9 @@ TEST(OcclusionMaps, EveryIsaBuildsTheSamePyramids) {
             c.near_w = 0.5f;
             OcclusionBuffer buffer(c);
             buffer.render(test::clip_space_input(tris));
-            OcclusionMaps maps(buffer, maps_config(buffer));
+            OcclusionMapsConfig config = maps_config(buffer);
+            config.depth_pyramids = DepthPyramids::both;
+            OcclusionMaps maps(buffer, config);
             maps.build(buffer);
             std::vector<std::uint32_t> covered;
             std::vector<float> far, near;
@@ -129,6 +131,64 @@ TEST(OcclusionMaps, EveryIsaBuildsTheSamePyramids) {
         }
         select_isa("best");
     }
+}
+
+// By default the maps make only the depth pyramid their depth test reads: the same opacity
+// pyramid, the same bits in the pyramid made, null for the others, and the same answers as
+// maps making both, for every depth test, with and without holes, on every instruction set.
+TEST(OcclusionMaps, MakeOnlyTheDepthPyramidTheirTestReads) {
+    const std::vector<float> tris = test::random_clip_triangles(9, 400, 0.3f);
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> ndc(-1.1f, 1.0f), size(0.0f, 0.5f), w(0.5f, 30.0f);
+    std::vector<ScreenRect> rects;
+    for (int k = 0; k < 400; ++k) {
+        const float x = ndc(rng), y = ndc(rng);
+        rects.push_back({x, y, x + size(rng), y + size(rng), w(rng)});
+    }
+    for (const std::string isa : {"scalar", "best"}) {
+        select_isa(isa);
+        for (int s : {1, 4}) {
+            OcclusionBuffer buffer(test::buffer_config(101, 67, s, 0.5f));
+            buffer.render(test::clip_space_input(tris));
+            for (DepthTest depth : {DepthTest::masked, DepthTest::hzb, DepthTest::deb, DepthTest::nbz, DepthTest::plane})
+                for (double hole : {0.0, 6.0}) {
+                    OcclusionMapsConfig config = maps_config(buffer, depth, hole);
+                    OcclusionMaps needed(buffer, config);
+                    config.depth_pyramids = DepthPyramids::both;
+                    OcclusionMaps both(buffer, config);
+                    for (OcclusionMaps* maps : {&needed, &both}) {
+                        maps->add_occluder_box({{-0.5f, -0.5f, 4.0f}, {0.3f, 0.4f, 6.0f}}, kXyw);
+                        maps->build(buffer);
+                    }
+                    const std::string what = isa + " S " + std::to_string(s) + " depth " + std::to_string(int(depth)) + " hole " +
+                                             std::to_string(hole);
+                    const bool far_made = depth == DepthTest::hzb || depth == DepthTest::plane, near_made = depth == DepthTest::nbz;
+                    for (int k = 0; k < both.levels(); ++k) {
+                        const std::size_t n = std::size_t(both.level_width(k)) * std::size_t(both.level_height(k));
+                        ASSERT_TRUE(std::equal(both.covered_samples(k), both.covered_samples(k) + n, needed.covered_samples(k))) << what;
+                        ASSERT_EQ(needed.farthest_depth(k) != nullptr, far_made) << what;
+                        ASSERT_EQ(needed.nearest_depth(k) != nullptr, near_made) << what;
+                        if (far_made) {
+                            ASSERT_TRUE(std::equal(both.farthest_depth(k), both.farthest_depth(k) + n, needed.farthest_depth(k))) << what;
+                        }
+                        if (near_made) {
+                            ASSERT_TRUE(std::equal(both.nearest_depth(k), both.nearest_depth(k) + n, needed.nearest_depth(k))) << what;
+                        }
+                    }
+                    EXPECT_EQ(needed.plane_depth(), far_made ? both.plane_depth() : INFINITY) << what;
+                    int occluded = 0;
+                    for (const ScreenRect& r : rects) {
+                        const OccludeeAnswer a = needed.test_rect(r), b = both.test_rect(r);
+                        ASSERT_EQ(a.visibility, b.visibility) << what;
+                        ASSERT_EQ(a.level_of_visibility, b.level_of_visibility) << what;
+                        ASSERT_EQ(a.overlap_exit, b.overlap_exit) << what;
+                        occluded += a.visibility == Visibility::occluded;
+                    }
+                    EXPECT_GT(occluded, 0) << what;  // the answers compared include hidden ones
+                }
+        }
+    }
+    select_isa("best");
 }
 
 TEST(OcclusionMaps, ThresholdsFollowZhang) {
@@ -369,6 +429,7 @@ TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.finest_level = 40; }), Error);
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.coarsest_level = 40; }), Error);
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.deb_width = 0; }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.depth_pyramids = DepthPyramids(7); }), Error);
     EXPECT_NO_THROW(make([](OcclusionMapsConfig&) {}));
     // Tests need a built map.
     {

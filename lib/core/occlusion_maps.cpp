@@ -42,6 +42,8 @@ OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsC
     if (!(config.transparency >= 0.0 && config.transparency < 1.0))
         throw Error("occlusion maps: the transparency threshold must be in [0, 1)");
     if (config.min_size < 1) throw Error("occlusion maps: the minimum pyramid size must be at least 1");
+    if (config.depth_pyramids != DepthPyramids::needed && config.depth_pyramids != DepthPyramids::both)
+        throw Error("occlusion maps: depth_pyramids must be DepthPyramids::needed or ::both");
     if (config.deb_width < 1 || config.deb_height < 1 || config.deb_width > 4096 || config.deb_height > 4096)
         throw Error("occlusion maps: the depth estimation buffer must have 1 to 4096 cells per axis");
 
@@ -62,8 +64,9 @@ OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsC
     if (start_max_level_ < config.finest_level || start_max_level_ > last)
         throw Error("occlusion maps: coarsest level must be -1 or in [finest level, " + std::to_string(last) + "]");
     covered_.assign(size, 0u);
-    hzb_.assign(size, 0.0f);
-    nbz_.assign(size, 0.0f);
+    const bool both = config.depth_pyramids == DepthPyramids::both;
+    if (both || config.depth == DepthTest::hzb || config.depth == DepthTest::plane) hzb_.assign(size, 0.0f);
+    if (both || config.depth == DepthTest::nbz) nbz_.assign(size, 0.0f);
     deb_.assign(std::size_t(config.deb_width) * std::size_t(config.deb_height), INFINITY);
 
     // Display pixels per buffer pixel (m0 x m0) and samples per display pixel (area).
@@ -107,10 +110,13 @@ void OcclusionMaps::build(const OcclusionBuffer& buffer) {
     // those samples (a sample in a subtile's working mask is bounded by max(d0, d1), any
     // other by d0; see OcclusionBuffer). Pixels without covered samples get +inf ("no
     // occluder"): the depth maps ignore the background, the overlap test decides coverage.
+    // Depth pyramids not made (depth_pyramids) are null here: the kernels skip them.
+    float* const hzb = hzb_.empty() ? nullptr : hzb_.data();
+    float* const nbz = nbz_.empty() ? nullptr : nbz_.data();
     const detail::Level0Maps level0{buffer.covered_.data(), buffer.mask_.data(), buffer.d0_.data(), buffer.d1_.data(),
                                     buffer.stride_,         buffer.subtiles_x(), buffer.subtiles_y(), width_,
-                                    height_,                samples_,            covered_.data(),      hzb_.data(),
-                                    nbz_.data()};
+                                    height_,                samples_,            covered_.data(),      hzb,
+                                    nbz};
     const detail::Level0Kernel level0_kernel = detail::selected_level0_kernel();
     detail::level0_reference(level0, level0_kernel ? level0_kernel(level0) : 0);
     // Levels 1..: sums of covered samples, minimum (farthest) of the depth maps.
@@ -125,16 +131,17 @@ void OcclusionMaps::build(const OcclusionBuffer& buffer) {
             const std::size_t r0 = below.offset + std::size_t(y0) * std::size_t(below.width);
             const std::size_t r1 = below.offset + std::size_t(y1) * std::size_t(below.width);
             const std::size_t out = here.offset + std::size_t(y) * std::size_t(here.width);
-            const detail::PyramidRows rows{covered_.data() + r0, covered_.data() + r1, hzb_.data() + r0, hzb_.data() + r1,
-                                           nbz_.data() + r0,     nbz_.data() + r1,     y1 != y0,          covered_.data() + out,
-                                           hzb_.data() + out,    nbz_.data() + out};
+            const auto at = [](float* pyramid, std::size_t i) { return pyramid ? pyramid + i : nullptr; };
+            const detail::PyramidRows rows{covered_.data() + r0, covered_.data() + r1, at(hzb, r0), at(hzb, r1),
+                                           at(nbz, r0),          at(nbz, r1),          y1 != y0,    covered_.data() + out,
+                                           at(hzb, out),         at(nbz, out)};
             const int pairs = below.width / 2;  // output cells with both children columns
             const int done = reduce ? reduce(rows, pairs) : 0;
             detail::reduce_pyramid_row_reference(rows, done, here.width, below.width);
         }
     }
     const Level& top = levels_.back();
-    plane_ = *std::min_element(hzb_.begin() + std::ptrdiff_t(top.offset), hzb_.end());
+    plane_ = hzb ? *std::min_element(hzb_.begin() + std::ptrdiff_t(top.offset), hzb_.end()) : INFINITY;
     built_ = &buffer;
 }
 

@@ -31,8 +31,8 @@ void level0_reference(const Level0Maps& m, int tx_begin) {
                     const std::uint32_t c = cov & pixel_bits[py * pixels_x + px];
                     const bool outside_mask = (c & ~mask) != 0, inside_mask = (c & mask) != 0;
                     m.covered_out[row + std::size_t(px)] = bit_count(c);
-                    m.far_out[row + std::size_t(px)] = outside_mask ? d0 : inside_mask ? layered : INFINITY;  // d0 <= layered
-                    m.near_out[row + std::size_t(px)] = inside_mask ? layered : outside_mask ? d0 : INFINITY;
+                    if (m.far_out) m.far_out[row + std::size_t(px)] = outside_mask ? d0 : inside_mask ? layered : INFINITY;  // d0 <= layered
+                    if (m.near_out) m.near_out[row + std::size_t(px)] = inside_mask ? layered : outside_mask ? d0 : INFINITY;
                 }
             }
         }
@@ -47,8 +47,8 @@ void reduce_pyramid_row_reference(const PyramidRows& r, int begin, int end, int 
         std::uint32_t covered = r.covered0[a] + second_column * r.covered0[b];
         if (r.second_row) covered += r.covered1[a] + second_column * r.covered1[b];
         r.covered_out[x] = covered;
-        r.far_out[x] = std::min(std::min(r.far0[a], r.far0[b]), std::min(r.far1[a], r.far1[b]));
-        r.near_out[x] = std::min(std::min(r.near0[a], r.near0[b]), std::min(r.near1[a], r.near1[b]));
+        if (r.far_out) r.far_out[x] = std::min(std::min(r.far0[a], r.far0[b]), std::min(r.far1[a], r.far1[b]));
+        if (r.near_out) r.near_out[x] = std::min(std::min(r.near0[a], r.near0[b]), std::min(r.near1[a], r.near1[b]));
     }
 }
 

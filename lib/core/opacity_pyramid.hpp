@@ -20,7 +20,7 @@ struct Level0Maps {
     int subtiles_x, subtiles_y;
     int width, height, samples;  // buffer pixels and samples per axis (1, 2 or 4)
     std::uint32_t* covered_out;  // width x height, row-major
-    float *far_out, *near_out;
+    float *far_out, *near_out;   // either may be null: not made (OcclusionMapsConfig::depth_pyramids)
 };
 
 // Level 0 for the subtile columns [tx_begin, subtiles_x) of every subtile row: a pixel's
@@ -38,10 +38,10 @@ Level0Kernel selected_level0_kernel();
 // children columns both exist.
 struct PyramidRows {
     const std::uint32_t *covered0, *covered1;
-    const float *far0, *far1, *near0, *near1;
+    const float *far0, *far1, *near0, *near1;  // null with far_out / near_out
     bool second_row;
     std::uint32_t* covered_out;
-    float *far_out, *near_out;
+    float *far_out, *near_out;  // either may be null: that pyramid is not made
 };
 
 // Output cells [begin, end) of a row; below_width is the row length of the level below.

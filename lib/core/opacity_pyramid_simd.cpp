@@ -40,8 +40,8 @@ int ReducePyramidRow(const PyramidRows& r, int pairs) {
         auto covered = sum_row(r.covered0);
         if (r.second_row) covered = hn::Add(covered, sum_row(r.covered1));
         hn::StoreU(covered, du, r.covered_out + x);
-        hn::StoreU(hn::Min(min_row(r.far0), min_row(r.far1)), df, r.far_out + x);
-        hn::StoreU(hn::Min(min_row(r.near0), min_row(r.near1)), df, r.near_out + x);
+        if (r.far_out) hn::StoreU(hn::Min(min_row(r.far0), min_row(r.far1)), df, r.far_out + x);
+        if (r.near_out) hn::StoreU(hn::Min(min_row(r.near0), min_row(r.near1)), df, r.near_out + x);
     }
     return x;
 #endif
@@ -74,8 +74,10 @@ int Level0SingleSample(const Level0Maps& m) {
                     const auto outside = hn::RebindMask(df, hn::Ne(hn::AndNot(in_mask, bit), hn::Zero(du)));
                     const auto inside = hn::RebindMask(df, hn::Ne(hn::And(in_mask, bit), hn::Zero(du)));
                     hn::StoreU(bit, du, m.covered_out + out + std::size_t(h));
-                    hn::StoreU(hn::IfThenElse(outside, d0, hn::IfThenElse(inside, layered, infinity)), df, m.far_out + out + std::size_t(h));
-                    hn::StoreU(hn::IfThenElse(inside, layered, hn::IfThenElse(outside, d0, infinity)), df, m.near_out + out + std::size_t(h));
+                    if (m.far_out)
+                        hn::StoreU(hn::IfThenElse(outside, d0, hn::IfThenElse(inside, layered, infinity)), df, m.far_out + out + std::size_t(h));
+                    if (m.near_out)
+                        hn::StoreU(hn::IfThenElse(inside, layered, hn::IfThenElse(outside, d0, infinity)), df, m.near_out + out + std::size_t(h));
                 }
             }
         }

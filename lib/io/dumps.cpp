@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 namespace homcull {
 namespace {
@@ -72,6 +73,16 @@ std::string number(double v) {
 std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionMaps& maps) {
     if (maps.levels() < 1 || maps.level_width(0) != buffer.config().width || maps.level_height(0) != buffer.config().height)
         throw Error("dumps: the occlusion maps were not made for this buffer");
+    // Maps that make only the depth pyramid their test reads (OcclusionMapsConfig::
+    // depth_pyramids): both are built here from the same buffer, for the dump alone.
+    std::optional<OcclusionMaps> with_both;
+    const OcclusionMaps* depth_maps = &maps;
+    if (!maps.farthest_depth(0) || !maps.nearest_depth(0)) {
+        OcclusionMapsConfig config = maps.config();
+        config.depth_pyramids = DepthPyramids::both;
+        depth_maps = &with_both.emplace(buffer, config);
+        with_both->build(buffer);
+    }
     std::vector<DumpPart> parts;
     const int sw = buffer.sample_width(), sh = buffer.sample_height();
     {
@@ -106,8 +117,8 @@ std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionM
             part.values.assign(cells, cells + n);
             parts.push_back(std::move(part));
         };
-        depth_part("maxz", "max-Z (hzb), the farthest depth of the covered samples:", maps.farthest_depth(k));
-        depth_part("nbz", "no-background Z-buffer, the nearest depth of the covered samples:", maps.nearest_depth(k));
+        depth_part("maxz", "max-Z (hzb), the farthest depth of the covered samples:", depth_maps->farthest_depth(k));
+        depth_part("nbz", "no-background Z-buffer, the nearest depth of the covered samples:", depth_maps->nearest_depth(k));
     }
     // Only filled (add_occluder_box) when the maps answer with it: otherwise all +inf, noise.
     if (maps.config().depth == DepthTest::deb) {

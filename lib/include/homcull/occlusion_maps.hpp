@@ -31,6 +31,16 @@ enum class DepthTest : std::uint8_t {
     plane,   // one plane at the farthest covered depth (Zhang's single depth; conservative)
 };
 
+// Which of the two depth pyramids (farthest_depth, nearest_depth) build() makes. Each is a
+// float per buffer pixel and its levels above: at 1280 x 720 the two took about two thirds of
+// build()'s time (it is bound by writing its arrays) while the default depth test reads
+// neither.
+enum class DepthPyramids : std::uint8_t {
+    needed,  // the one the depth test reads: hzb for DepthTest::hzb and ::plane, nbz for ::nbz, none
+             // for ::masked and ::deb
+    both,    // both, whatever the depth test (debug dumps, inspection)
+};
+
 struct OcclusionMapsConfig {
     // The display the answers must be right for, in pixels. A display pixel is
     // (buffer samples per axis) / (display pixels per axis) samples wide: the hole size and
@@ -54,6 +64,7 @@ struct OcclusionMapsConfig {
     // Depth estimation buffer cells (Zhang 6.2; 64 x 64 by default).
     int deb_width = 64, deb_height = 64;
     DepthTest depth = DepthTest::masked;
+    DepthPyramids depth_pyramids = DepthPyramids::needed;
 };
 
 // What an occludee test answers. level_of_visibility estimates the share of the occludee's
@@ -119,9 +130,12 @@ public:
     // Depth maps as 1/w per cell (larger is nearer; +inf where no occluder covers anything):
     // the farthest (hzb) and nearest (nbz) depth of the covered samples of each pixel, with
     // their min pyramids on the opacity pyramid's levels, and the depth estimation buffer.
-    const float* farthest_depth(int k) const { return hzb_.data() + levels_[std::size_t(k)].offset; }
-    const float* nearest_depth(int k) const { return nbz_.data() + levels_[std::size_t(k)].offset; }
+    // A pyramid the maps do not make (OcclusionMapsConfig::depth_pyramids) is null.
+    const float* farthest_depth(int k) const { return hzb_.empty() ? nullptr : hzb_.data() + levels_[std::size_t(k)].offset; }
+    const float* nearest_depth(int k) const { return nbz_.empty() ? nullptr : nbz_.data() + levels_[std::size_t(k)].offset; }
     const std::vector<float>& depth_estimation() const { return deb_; }
+    // The farthest covered depth of the whole buffer (the plane test's): +inf when nothing is
+    // covered, and when the maps make no hzb pyramid.
     float plane_depth() const { return plane_; }
 
 private:
