@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <string>
 #include <utility>
 
 namespace homcull {
@@ -282,6 +283,59 @@ TEST(OccludeeTriangles, NeverHidesATriangleSeenAtASample) {
                 hidden_by_buffer, hidden_by_test);
     ASSERT_GT(hidden_by_buffer, 50);
     EXPECT_EQ(hidden_by_test, hidden_by_buffer);
+}
+
+// Every instruction set gives the scalar reference's answers and counts: the row intervals of
+// occludee triangles come from the row loop's SIMD kernel (tall triangles span several of its
+// chunks of 64 sample rows), the rest is shared code. Occluders near and far, occludees
+// behind, in front, straddling and beyond the near plane, some taller than the buffer; per-sample
+// depth on and off; tolerated samples 0 and 7.
+TEST(OccludeeTriangles, EveryIsaGivesTheReferenceAnswersAndCounts) {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<float> pos(-1.4f, 1.4f), size(0.01f, 1.5f), depth(0.3f, 40.0f), tilt(0.8f, 1.25f);
+    std::vector<Soup> occludees;
+    for (int k = 0; k < 150; ++k) {
+        Soup o;
+        const float cx = pos(rng), cy = pos(rng), r = size(rng), w = depth(rng);
+        for (int t = 0; t < 1 + k % 20; ++t)
+            o.add(cx + r * pos(rng), cy + r * pos(rng), w * tilt(rng), cx + r * pos(rng), cy + r * pos(rng), w * tilt(rng), cx + r * pos(rng),
+                  cy + r * pos(rng), w * tilt(rng));
+        occludees.push_back(o);
+    }
+    Soup occluders;
+    for (int k = 0; k < 16; ++k) {
+        const float cx = pos(rng), cy = pos(rng), r = size(rng), w = depth(rng) * 0.5f;
+        occluders.add(cx - r, cy - r, w, cx + r, cy - r * 0.5f, w * tilt(rng), cx, cy + r, w * tilt(rng));
+    }
+    for (const auto& [samples, sample_depth] : {std::pair{1, false}, {4, false}, {1, true}}) {
+        std::vector<OcclusionBuffer::TriangleTest> reference;
+        for (const std::string& isa : available_isas()) {
+            select_isa(isa);
+            OcclusionBuffer buffer = make_buffer(149, 301, samples, sample_depth);  // more rows than a chunk of the row loop
+            buffer.render(occluders.input());
+            std::vector<OcclusionBuffer::TriangleTest> answers;
+            for (const Soup& o : occludees)
+                for (std::uint64_t tolerated : {0u, 7u}) answers.push_back(buffer.test_triangles(o.input(), tolerated));
+            if (isa == "scalar") {
+                reference = answers;
+                int occluded = 0, visible = 0;
+                for (const auto& a : answers) occluded += a.visibility == Visibility::occluded, visible += a.visibility == Visibility::visible;
+                EXPECT_GT(occluded, 20) << "S " << samples;  // both answers are compared
+                EXPECT_GT(visible, 20) << "S " << samples;
+                continue;
+            }
+            ASSERT_EQ(answers.size(), reference.size());
+            for (std::size_t k = 0; k < answers.size(); ++k) {
+                SCOPED_TRACE(isa + ", S " + std::to_string(samples) + ", sample depth " + std::to_string(sample_depth) + ", occludee " +
+                             std::to_string(k / 2));
+                ASSERT_EQ(answers[k].visibility, reference[k].visibility);
+                ASSERT_EQ(answers[k].samples, reference[k].samples);
+                ASSERT_EQ(answers[k].visible_samples, reference[k].visible_samples);
+                ASSERT_EQ(answers[k].deciding_triangle, reference[k].deciding_triangle);
+            }
+        }
+        select_isa("best");
+    }
 }
 
 // Past its first 16 triangles an occludee is fetched and transformed 16 at a time: the

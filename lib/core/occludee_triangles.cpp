@@ -191,9 +191,22 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
     }
 
     bool raised_ready = false;
-    for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
-        std::int32_t first[kH], last[kH];
-        detail::subtile_row_intervals(has_area ? &edges : nullptr, ty, i0, i1, j0, j1, first, last);
+    // The rows' intervals a chunk of subtile rows at a time: in SIMD lanes where the instruction
+    // set has them (the row loop's kernel, the same intervals), else row by row. They were about
+    // a fifth of the castle's occludee tests.
+    const detail::RowIntervalsKernel row_intervals = has_area ? detail::selected_row_intervals_kernel() : nullptr;
+    constexpr int kChunkRows = detail::kChunkSubtileRows * kH;
+    std::int32_t chunk_first[kChunkRows + detail::kMaxSimdLanes], chunk_last[kChunkRows + detail::kMaxSimdLanes];
+    for (int ty = j0 / kH, chunk_ty = ty; ty <= j1 / kH; ++ty) {
+        if (row_intervals && (ty == j0 / kH || ty - chunk_ty == detail::kChunkSubtileRows)) {
+            chunk_ty = ty;
+            const int chunk_rows = std::min(detail::kChunkSubtileRows, j1 / kH - ty + 1) * kH;
+            row_intervals(edges, i0, i1, j0, j1, ty * kH, chunk_rows, chunk_first, chunk_last);
+        }
+        std::int32_t row_first[kH], row_last[kH];
+        const std::int32_t *first = row_first, *last = row_last;
+        if (row_intervals) first = chunk_first + (ty - chunk_ty) * kH, last = chunk_last + (ty - chunk_ty) * kH;
+        else detail::subtile_row_intervals(has_area ? &edges : nullptr, ty, i0, i1, j0, j1, row_first, row_last);
         int tx_begin, tx_end;
         if (!detail::reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
         for (int tx = tx_begin; tx <= tx_end; ++tx) {

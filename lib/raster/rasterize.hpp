@@ -361,6 +361,13 @@ TriangleRowsKernel selected_rows_kernel();
 // (a vector of subtiles per step, the same comparisons, so the same answer), or the scalar one.
 using HiddenTestKernel = bool (*)(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
 HiddenTestKernel selected_hidden_test();
+// subtile_row_intervals for the sample rows [row0, row0 + rows) at once (rows a multiple of
+// 4), the rows as SIMD lanes: the row loop's double intervals, with the same operations, so
+// the same intervals on every row in [j0, j1] (first > last elsewhere, with other values).
+// Writes up to kMaxSimdLanes entries past `rows`. Null when the scalar reference is selected.
+using RowIntervalsKernel = void (*)(const TriangleEdges& edges, int i0, int i1, int j0, int j1, int row0, int rows,
+                                    std::int32_t* first, std::int32_t* last);
+RowIntervalsKernel selected_row_intervals_kernel();
 // Whether select_isa chose the plain scalar reference paths.
 bool scalar_reference_selected();
 

@@ -282,19 +282,19 @@ HWY_INLINE void UpdateSampleDepth(const SubtilePlanes& planes, int ty, const std
 // The coverage intervals [first[r], last[r]] of sample rows row0 + r, r in [0, rows), by the
 // double rule (sample_row_interval), the rows as lanes: 8 on AVX-512, 4 on AVX2, 2 on SSE4.
 // Writes up to a vector past `rows`.
-HWY_INLINE void DoubleRowIntervals(const RasterTriangle& triangle, int row0, int rows, std::int32_t* first, std::int32_t* last) {
-    const TriangleEdges& e = triangle.edges;
+HWY_INLINE void DoubleRowIntervals(const TriangleEdges& e, int i0, int i1, int j0, int j1, int row0, int rows, std::int32_t* first,
+                                   std::int32_t* last) {
     const hn::CappedTag<double, 8> d;
     const hn::Rebind<std::int32_t, decltype(d)> di;
     const int lanes = int(hn::Lanes(d));
-    const auto lo_clamp = hn::Set(d, double(triangle.i0) - 2.0), hi_clamp = hn::Set(d, double(triangle.i1) + 2.0);
+    const auto lo_clamp = hn::Set(d, double(i0) - 2.0), hi_clamp = hn::Set(d, double(i1) + 2.0);
     const auto half = hn::Set(d, 0.5), one = hn::Set(d, 1.0), zero = hn::Zero(d);
-    const auto row_min = hn::Set(d, double(triangle.j0)), row_max = hn::Set(d, double(triangle.j1));
+    const auto row_min = hn::Set(d, double(j0)), row_max = hn::Set(d, double(j1));
     const auto lane = hn::Iota(d, 0.0);  // once: Highway's Iota goes through memory
     for (int r = 0; r < rows; r += lanes) {
         const auto sy = hn::Add(lane, hn::Set(d, double(row0 + r)));  // exact: small integers
         const auto py = hn::Add(sy, half);
-        auto lo = hn::Set(d, double(triangle.i0)), hi = hn::Set(d, double(triangle.i1));
+        auto lo = hn::Set(d, double(i0)), hi = hn::Set(d, double(i1));
         auto empty = hn::Or(hn::Lt(sy, row_min), hn::Gt(sy, row_max));
         for (int k = 0; k < 3; ++k) {
             const auto c = hn::Sub(hn::Set(d, e.threshold[k]), hn::Mul(hn::Set(d, e.sb[k]), hn::Sub(py, hn::Set(d, e.oy[k]))));
@@ -392,6 +392,11 @@ HWY_INLINE bool HiddenBehindReferenceLayer(const SubtilePlanes& planes, int tx0,
     return true;
 }
 
+// DoubleRowIntervals as a kernel of its own, for the occludee triangle tests.
+void RowIntervals(const TriangleEdges& edges, int i0, int i1, int j0, int j1, int row0, int rows, std::int32_t* first, std::int32_t* last) {
+    DoubleRowIntervals(edges, i0, i1, j0, j1, row0, rows, first, last);
+}
+
 // HiddenBehindReferenceLayer as a kernel of its own, for the clustered render's box tests.
 bool HiddenBehindReferenceLayerKernel(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest) {
     return HiddenBehindReferenceLayer(planes, tx0, tx1, ty0, ty1, nearest);
@@ -432,7 +437,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             HiddenBehindReferenceLayer(t.planes, i0 / kW, i1 / kW, ty0, ty1, chunk_nearest_depth(tri, i0, i1, triangle.j0, j1, ty0, ty1)))
             continue;
         if (triangle.plane.float_rows) FloatRowIntervals(triangle, row0, rows, first, last);
-        else DoubleRowIntervals(triangle, row0, rows, first, last);
+        else DoubleRowIntervals(triangle.edges, i0, i1, triangle.j0, j1, row0, rows, first, last);
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
@@ -474,6 +479,7 @@ namespace detail {
 
 HWY_EXPORT(RasterizeRows);
 HWY_EXPORT(HiddenBehindReferenceLayerKernel);
+HWY_EXPORT(RowIntervals);
 
 namespace {
 
@@ -494,6 +500,7 @@ TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_ro
 HiddenTestKernel selected_hidden_test() {
     return use_reference ? &hidden_behind_reference_layer : HOMCULL_RESOLVED_KERNEL(HiddenBehindReferenceLayerKernel);
 }
+RowIntervalsKernel selected_row_intervals_kernel() { return use_reference ? nullptr : HOMCULL_RESOLVED_KERNEL(RowIntervals); }
 bool scalar_reference_selected() { return use_reference; }
 void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
 bool hidden_skip_enabled() { return skip_hidden; }
