@@ -289,7 +289,12 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         const std::size_t count = std::min({kBatch, in.triangle_count - t, in.triangle_count - n});  // up to the wrap
         detail::gather_triangle_batch(in, t, int(count), batch);
         kernels.transform_batch(in, batch);
+        // Lanes beyond a side plane (valid and finite) cannot show the occludee: shows() would
+        // pass over them first thing. Decided for the whole batch in SIMD lanes: most lanes on
+        // a walk (the castle's: 88 %). The others are taken in order, as before.
+        const std::uint32_t passed_over = kernels.beyond_side_plane(batch, int(count));
         for (std::size_t k = 0; k < count; ++k) {
+            if ((passed_over >> k) & 1u) continue;
             result.deciding_triangle = t + k;
             if (!((batch.indices_valid >> k) & 1u)) return visible();  // as fetch_clip_triangle
             glm::dvec4 model[3], clip[3];
@@ -302,6 +307,7 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
             if (!finite) return visible();
             if (shows(model, clip)) return visible();
         }
+        result.deciding_triangle = t + count - 1;  // the batch's last triangle, passed over or not
         n += count;
         t = t + count == in.triangle_count ? 0 : t + count;
     }

@@ -120,6 +120,17 @@ void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch) {
         }
 }
 
+std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count) {
+    std::uint32_t bits = 0;
+    for (int t = 0; t < count; ++t) {
+        const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
+        if (((batch.indices_valid >> t) & 1u) && finite_clip(clip[0]) && finite_clip(clip[1]) && finite_clip(clip[2]) &&
+            outside_side_plane(clip))
+            bits |= 1u << t;
+    }
+    return bits;
+}
+
 bool assemble_raster_triangle(const BatchSetup& s, int t, std::uint8_t shared_bits, double edge_margin, RasterTriangle& out) {
     if (s.area2[t] == 0.0) return false;  // orient_triangle
     out.i0 = s.i0[t], out.i1 = s.i1[t], out.j0 = s.j0[t], out.j1 = s.j1[t];

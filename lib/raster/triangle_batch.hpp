@@ -141,7 +141,12 @@ struct FrontEndKernels {
     // (order null), or of the listed triangles of one that gather_listed_ready accepts; null for
     // the scalar reference.
     void (*gather_direct)(const TriangleInput& in, std::size_t first, const std::uint32_t* order, TriangleBatch& batch);
+    // The lanes [0, count) of a transformed batch with valid indices, finite clip x, y and w at
+    // every vertex (finite_clip) and all three vertices beyond one side plane
+    // (outside_side_plane), as bits (lane t: bit t).
+    std::uint32_t (*beyond_side_plane)(const TriangleBatch& batch, int count);
 };
+std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count);
 
 // Whether triangles [first, first + TriangleBatch::kSize) of the input are consecutive
 // vertices of 4 floats each (aligned as floats), all within vertex_count:

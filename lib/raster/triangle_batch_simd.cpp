@@ -196,6 +196,27 @@ void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, Raste
     }
 }
 
+// beyond_side_plane_reference, lane by lane: the same comparisons.
+std::uint32_t BeyondSidePlane(const TriangleBatch& batch, int count) {
+    const D d;
+    const int lanes = int(hn::Lanes(d));
+    const V infinity = hn::Set(d, HUGE_VAL);
+    std::uint32_t bits = 0;
+    for (int g = 0; g < count; g += lanes) {
+        const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};
+        M keep = hn::And(hn::FirstN(d, std::size_t(count - g)), hn::LoadMaskBits(d, index_bits));
+        M right = keep, left = keep, top = keep, bottom = keep;
+        for (int k = 0; k < 3; ++k) {
+            const V x = hn::Load(d, batch.cx[k] + g), y = hn::Load(d, batch.cy[k] + g), w = hn::Load(d, batch.cw[k] + g);
+            keep = hn::And(keep, hn::And(hn::And(hn::Lt(hn::Abs(x), infinity), hn::Lt(hn::Abs(y), infinity)), hn::Lt(hn::Abs(w), infinity)));
+            right = hn::And(right, hn::Gt(x, w)), left = hn::And(left, hn::Lt(x, hn::Neg(w)));
+            top = hn::And(top, hn::Gt(y, w)), bottom = hn::And(bottom, hn::Lt(y, hn::Neg(w)));
+        }
+        bits |= LaneBits(d, hn::And(keep, hn::Or(hn::Or(right, left), hn::Or(top, bottom)))) << g;
+    }
+    return bits;
+}
+
 // A mask of double lanes as a mask of the float lanes they demote to.
 HWY_INLINE hn::Mask<hn::Rebind<float, D>> FloatLaneMask(M m) {
     const D d;
@@ -395,13 +416,15 @@ HWY_EXPORT(GatherDirectBatch);
 HWY_EXPORT(ClassifyBatch);
 HWY_EXPORT(SetupPlanes);
 HWY_EXPORT(SetupEdges);
+HWY_EXPORT(BeyondSidePlane);
 
 FrontEndKernels selected_front_end_kernels() {
     if (scalar_reference_selected())
-        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr, nullptr};
+        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr, nullptr,
+                &beyond_side_plane_reference};
     return {HOMCULL_RESOLVED_KERNEL(TransformVertices), HOMCULL_RESOLVED_KERNEL(TransformBatch), HOMCULL_RESOLVED_KERNEL(ClassifyBatch),
             HOMCULL_RESOLVED_KERNEL(SetupPlanes), HOMCULL_RESOLVED_KERNEL(SetupEdges),
-            HOMCULL_RESOLVED_KERNEL(GatherDirectBatch)};
+            HOMCULL_RESOLVED_KERNEL(GatherDirectBatch), HOMCULL_RESOLVED_KERNEL(BeyondSidePlane)};
 }
 
 }  // namespace homcull::detail
