@@ -310,6 +310,21 @@ TEST(OccludeeTriangles, EveryIsaGivesTheReferenceAnswersAndCounts) {
         const float cx = pos(rng), cy = pos(rng), r = size(rng), w = depth(rng) * 0.5f;
         occluders.add(cx - r, cy - r, w, cx + r, cy - r * 0.5f, w * tilt(rng), cx, cy + r, w * tilt(rng));
     }
+    // Triangles beyond the right plane, taken one at a time and then in batches, all passed
+    // over; but one of them (in a batch) with an infinite or NaN coordinate makes the occludee
+    // visible, as it does one triangle at a time: the pass-over needs finite vertices.
+    for (int bad = -1; bad < 3; ++bad) {
+        Soup o;
+        for (int t = 0; t < 30; ++t) o.add_flat(1.5f, 0.0f, 2.0f, 0.1f, 1.7f, -0.2f, 8.0f);
+        if (bad >= 0) o.xyw[9 * 20 + 3 + std::size_t(bad)] = bad == 1 ? NAN : INFINITY;  // x, y or w of triangle 20's vertex 1
+        for (const std::string& isa : available_isas()) {
+            select_isa(isa);
+            const OcclusionBuffer empty = make_buffer(64, 36);
+            EXPECT_EQ(empty.test_triangles(o.input()).visibility, bad < 0 ? Visibility::view_culled : Visibility::visible)
+                << isa << ", bad coordinate " << bad;
+        }
+        select_isa("best");
+    }
     for (const auto& [samples, sample_depth] : {std::pair{1, false}, {4, false}, {1, true}}) {
         std::vector<OcclusionBuffer::TriangleTest> reference;
         for (const std::string& isa : available_isas()) {
