@@ -10,6 +10,7 @@
 #include <hwy/highway.h>
 
 #include "raster/clip_fates-inl.h"
+#include "raster/float_outward-inl.h"
 #include "raster/lane_bits-inl.h"
 #include "raster/triangle_batch.hpp"
 
@@ -217,34 +218,6 @@ std::uint32_t BeyondSidePlane(const TriangleBatch& batch, int count) {
     return bits;
 }
 
-// A mask of double lanes as a mask of the float lanes they demote to.
-HWY_INLINE hn::Mask<hn::Rebind<float, D>> FloatLaneMask(M m) {
-    const D d;
-    const hn::Rebind<std::int32_t, D> di;
-    return hn::RebindMask(hn::Rebind<float, D>(), hn::Lt(hn::DemoteTo(di, hn::IfThenElseZero(m, hn::Set(d, -1.0))), hn::Zero(di)));
-}
-
-// float_up (kUp) or float_down of finite doubles, lane by lane: the nearest float, then one step
-// of its bits towards the safe side when it lies on the other. Beyond the float range the
-// nearest float is the largest one or infinity, and that step gives float_up's and
-// float_down's answers there too (the largest float or infinity on the safe side).
-template <bool kUp>
-HWY_INLINE hn::Vec<hn::Rebind<float, D>> FloatOutward(V v) {
-    const D d;
-    const hn::Rebind<float, D> df;
-    const hn::Rebind<std::int32_t, D> di;
-    const auto f = hn::DemoteTo(df, v);
-    const auto wrong_side = FloatLaneMask(kUp ? hn::Lt(hn::PromoteTo(d, f), v) : hn::Gt(hn::PromoteTo(d, f), v));
-    // float_step: away from zero when the step and the sign agree, else towards it; from zero
-    // to the smallest denormal of the step's sign.
-    const auto bits = hn::BitCast(di, f);
-    const auto zero = hn::Zero(df);
-    const auto away = hn::RebindMask(di, kUp ? hn::Gt(f, zero) : hn::Lt(f, zero));
-    auto stepped = hn::IfThenElse(away, hn::Add(bits, hn::Set(di, 1)), hn::Sub(bits, hn::Set(di, 1)));
-    stepped = hn::IfThenElse(hn::RebindMask(di, hn::Eq(f, zero)), hn::Set(di, kUp ? 1 : std::int32_t(0x80000001u)), stepped);
-    return hn::IfThenElse(wrong_side, hn::BitCast(df, stepped), f);
-}
-
 // prepare_float_row_edges for edge k of lanes [g, g + lanes), as a silhouette edge (threshold
 // edge_threshold(false, ...)): the same double operations lane by lane. Returns the lanes it
 // accepts.
@@ -335,12 +308,12 @@ void SetupPlanes(const TriangleBatch& batch, int sample_width, int sample_height
         const V error = hn::Add(hn::Mul(hn::Set(d, 0x1.0p-20), magnitude), hn::Mul(hn::Set(d, 0x1.0p-40), terms));
         // finish_depth_plane: the plane in float where it is usable, else none.
         const M usable = hn::And(hn::Lt(hn::Abs(error), hn::Set(d, HUGE_VAL)), hn::Lt(magnitude, hn::Set(d, 0x1.0p100)));
-        const auto usable_f = FloatLaneMask(usable);
+        const auto usable_f = FloatLaneMask(D(), usable);
         const auto a_f = hn::IfThenElseZero(usable_f, hn::DemoteTo(df, a));
         const auto dzdx_f = hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdx));
         const auto dzdy_f = hn::IfThenElseZero(usable_f, hn::DemoteTo(df, dzdy));
-        const auto error_f = hn::IfThenElseZero(usable_f, FloatOutward<true>(hn::IfThenElseZero(usable, error)));
-        const auto z_vertex_min = FloatOutward<false>(hn::Min(hn::Min(d0, d1), d2));
+        const auto error_f = hn::IfThenElseZero(usable_f, FloatOutward<true>(D(), hn::IfThenElseZero(usable, error)));
+        const auto z_vertex_min = FloatOutward<false>(D(), hn::Min(hn::Min(d0, d1), d2));
         hn::Store(a_f, df, out.plane_a + g);
         hn::Store(dzdx_f, df, out.plane_dzdx + g);
         hn::Store(dzdy_f, df, out.plane_dzdy + g);

@@ -1,0 +1,70 @@
+#pragma once
+// An occludee triangle's depth bound over a subtile's covered samples, and the test of one
+// subtile row of an occludee triangle against the buffer's layers (OcclusionBuffer::
+// test_triangles, occludee_triangles.cpp): a scalar reference and a SIMD kernel, a subtile per
+// lane (occludee_rows_simd.cpp), which give the same masks and the same answers.
+#include "core/raised_vertex_plane.hpp"
+#include "core/rect_tests.hpp"
+#include "raster/rasterize.hpp"
+
+#include <algorithm>
+#include <cstdint>
+
+namespace homcull::detail {
+
+// An upper bound of the triangle's 1/w at a sample, or over a rectangle of samples: the
+// smaller of two bounds, each evaluated at the rectangle's corner where it is largest.
+struct OccludeeDepth {
+    static constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    PreparedTriangle plane{};   // usable when plane.has_plane
+    float error = 0.0f;         // plane.error plus plane_error's absolute part, rounded up
+    float z_vertex_max = 0.0f;  // the nearest vertex, rounded up
+    float plane_raise = 1.0f;   // 1 + plane_error's relative part, rounded up
+    float raise = 1.0f;         // final relative raise, rounded up: 1 + 2^-20 + the w rounding
+    RaisedVertexPlane raised{};  // usable when raised.usable; evaluated in double
+
+    // The plane-error bound at one sample.
+    float plane_bound(int column, int row) const {
+        float bound = z_vertex_max;
+        if (plane.has_plane) {
+            const float x = float(column) + 0.5f, y = float(row) + 0.5f;
+            bound = std::min(bound, (((plane.a + plane.dzdy * y) + plane.dzdx * x) + error) * plane_raise);
+        }
+        return bound * raise;
+    }
+    // The raised-vertex bound at one sample, with the relative 2^-20 of `raise` for the ray's
+    // rounding, rounded up to float.
+    float raised_bound(int column, int row) const {
+        return raised.usable ? float_up(raised.at(column, row) * (1.0 + 0x1.0p-20)) : HUGE_VALF;
+    }
+    float at(int column, int row) const { return std::min(plane_bound(column, row), raised_bound(column, row)); }
+    // Over the samples of subtile (tx, ty) within the columns and rows of `c`.
+    float over(int tx, int ty, const SubtileCoverage& c) const {
+        const bool far_is_left = plane.has_plane && plane.far_is_left, far_is_top = plane.has_plane && plane.far_is_top;
+        const float by_plane = plane_bound(tx * kW + (far_is_left ? c.column_hi : c.column_lo), ty * kH + (far_is_top ? c.row_hi : c.row_lo));
+        const float by_vertices = raised_bound(tx * kW + (raised.dzdx > 0.0 ? c.column_hi : c.column_lo),
+                                               ty * kH + (raised.dzdy > 0.0 ? c.row_hi : c.row_lo));
+        return std::min(by_plane, by_vertices);
+    }
+};
+
+// For the subtiles tx_begin + k, k in [0, count), of subtile row ty, whose sample rows hold the
+// intervals [first[j], last[j]]: masks[k], the triangle's samples there (subtile_coverage), and
+// unhidden[k], those of them the layers do not hide at depth.over (subtile_unhidden_samples).
+// The kernels write up to kMaxSimdLanes entries past count.
+// What the kernel computes, subtile by subtile (count_triangle runs the same steps inline for
+// narrow rows; Highway's one-lane target runs this).
+inline void occludee_row_reference(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,
+                                   int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden) {
+    for (int k = 0; k < count; ++k) {
+        const SubtileCoverage c = subtile_coverage(first, last, tx_begin + k);
+        masks[k] = c.mask;
+        unhidden[k] = c.mask ? subtile_unhidden_samples(view, tx_begin + k, ty, c.mask, depth.over(tx_begin + k, ty, c)) : 0u;
+    }
+}
+using OccludeeRowKernel = void (*)(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,
+                                   int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden);
+// The SIMD kernel for the selected instruction set; null when the scalar reference is selected.
+OccludeeRowKernel selected_occludee_row_kernel();
+
+}  // namespace homcull::detail

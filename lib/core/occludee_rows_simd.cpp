@@ -1,0 +1,121 @@
+// The occludee triangle test of one subtile row, a subtile per SIMD lane (occludee_depth.hpp):
+// the coverage mask from the row intervals, the corner of the covered samples where each depth
+// bound is largest, the two bounds (the plane's in float, the raised vertices' in double, both
+// with occludee_depth.hpp's operations in its order, no fused multiply-add) and the layers'
+// test. Every lane computes what occludee_row_reference computes for its subtile.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "core/occludee_rows_simd.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/highway.h>
+
+#include "core/occludee_depth.hpp"
+#include "raster/float_outward-inl.h"
+
+#include <cmath>
+
+HWY_BEFORE_NAMESPACE();
+namespace homcull::detail::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin, int count,
+                 const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden) {
+#if HWY_TARGET == HWY_SCALAR
+    occludee_row_reference(view, ty, first, last, tx_begin, count, depth, masks, unhidden);
+#else
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    static_assert(kW == 8 && kH == 4, "a subtile's mask is 4 bytes of 8 columns");
+    const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::RebindToUnsigned<decltype(df)> du;
+    const hn::Half<decltype(df)> dfh;
+    const hn::Rebind<double, decltype(dfh)> dd;  // half the float lanes, for the raised bound
+    const hn::Half<decltype(di)> dih;
+    const int lanes = int(hn::Lanes(df));
+    using VI = hn::Vec<decltype(di)>;
+    using VF = hn::Vec<decltype(df)>;
+    using VD = hn::Vec<decltype(dd)>;
+
+    const PreparedTriangle& p = depth.plane;
+    const bool far_is_left = p.has_plane && p.far_is_left, far_is_top = p.has_plane && p.far_is_top;
+    const RaisedVertexPlane& r = depth.raised;
+    const VI lane = hn::Iota(di, 0), zero = hn::Zero(di), seven = hn::Set(di, kW - 1);
+    const hn::Vec<decltype(du)> byte = hn::Set(du, 0xFFu);
+    const VF half = hn::Set(df, 0.5f);
+    const std::size_t row = std::size_t(ty) * view.stride;
+    for (int base = 0; base < count; base += lanes) {
+        const auto live = hn::FirstN(di, std::size_t(count - base));
+        const VI x0 = hn::ShiftLeft<3>(hn::Add(lane, hn::Set(di, tx_begin + base)));  // tx * 8
+        // subtile_coverage, lane by lane.
+        hn::Vec<decltype(du)> mask = hn::Zero(du);
+        VI column_lo = hn::Set(di, kW), column_hi = hn::Set(di, -1), row_lo = hn::Set(di, kH), row_hi = hn::Set(di, -1);
+        for (int j = 0; j < kH; ++j) {
+            const VI lo = hn::Max(hn::Sub(hn::Set(di, first[j]), x0), zero), hi = hn::Min(hn::Sub(hn::Set(di, last[j]), x0), seven);
+            const auto filled = hn::And(live, hn::Not(hn::Gt(lo, hi)));
+            // (0xFF >> (7 - hi)) & (0xFF << lo), shift counts kept within [0, 7] whatever the
+            // interval (empty lanes get no bits), placed at byte j.
+            const auto bits = hn::And(hn::Shr(byte, hn::BitCast(du, hn::Sub(seven, hn::Max(hi, zero)))),
+                                      hn::Shl(byte, hn::BitCast(du, hn::Min(lo, seven))));
+            mask = hn::Or(mask, hn::IfThenElseZero(hn::RebindMask(du, filled), hn::Shl(bits, hn::Set(du, std::uint32_t(j * kW)))));
+            column_lo = hn::IfThenElse(filled, hn::Min(column_lo, lo), column_lo);
+            column_hi = hn::IfThenElse(filled, hn::Max(column_hi, hi), column_hi);
+            row_lo = hn::IfThenElse(hn::And(filled, hn::Eq(row_lo, hn::Set(di, kH))), hn::Set(di, j), row_lo);
+            row_hi = hn::IfThenElse(filled, hn::Set(di, j), row_hi);
+        }
+        const VI y0 = hn::Set(di, ty * kH);
+        // OccludeeDepth::over: the plane's bound at its corner, in float.
+        const VI plane_column = hn::Add(x0, far_is_left ? column_hi : column_lo), plane_row = hn::Add(y0, far_is_top ? row_hi : row_lo);
+        VF bound = hn::Set(df, depth.z_vertex_max);
+        if (p.has_plane) {
+            const VF x = hn::Add(hn::ConvertTo(df, plane_column), half), y = hn::Add(hn::ConvertTo(df, plane_row), half);
+            const VF on_plane = hn::Mul(hn::Add(hn::Add(hn::Add(hn::Set(df, p.a), hn::Mul(hn::Set(df, p.dzdy), y)), hn::Mul(hn::Set(df, p.dzdx), x)),
+                                                hn::Set(df, depth.error)),
+                                        hn::Set(df, depth.plane_raise));
+            bound = hn::IfThenElse(hn::Lt(on_plane, bound), on_plane, bound);  // std::min(bound, on_plane)
+        }
+        const VF by_plane = hn::Mul(bound, hn::Set(df, depth.raise));
+        // ... and the raised vertices' bound at theirs, in double, rounded up to float.
+        VF by_vertices = hn::Set(df, HUGE_VALF);
+        if (r.usable) {
+            const VI column = hn::Add(x0, r.dzdx > 0.0 ? column_hi : column_lo), row_of = hn::Add(y0, r.dzdy > 0.0 ? row_hi : row_lo);
+            const auto bound_of = [&](auto c, auto rr) {
+                const VD cd = hn::PromoteTo(dd, c), rd = hn::PromoteTo(dd, rr), h = hn::Set(dd, 0.5);
+                const VD at = hn::Add(hn::Add(hn::Add(hn::Set(dd, r.d0), hn::Mul(hn::Set(dd, r.dzdx), hn::Sub(hn::Add(cd, h), hn::Set(dd, r.x0)))),
+                                              hn::Mul(hn::Set(dd, r.dzdy), hn::Sub(hn::Add(rd, h), hn::Set(dd, r.y0)))),
+                                      hn::Set(dd, r.outside));
+                return FloatOutward<true>(dd, hn::Mul(at, hn::Set(dd, 1.0 + 0x1.0p-20)));
+            };
+            by_vertices = hn::Combine(df, bound_of(hn::UpperHalf(dih, column), hn::UpperHalf(dih, row_of)),
+                                      bound_of(hn::LowerHalf(dih, column), hn::LowerHalf(dih, row_of)));
+        }
+        const VF d_near = hn::IfThenElse(hn::Lt(by_vertices, by_plane), by_vertices, by_plane);  // std::min(by_plane, by_vertices)
+        // subtile_unhidden_samples, lane by lane.
+        const std::size_t at = row + std::size_t(tx_begin + base);
+        const VF d0 = hn::LoadU(df, view.d0 + at), d1 = hn::LoadU(df, view.d1 + at);
+        const auto layer = hn::LoadU(du, view.mask + at);
+        const VF layered = hn::IfThenElse(hn::Lt(d0, d1), d1, d0);  // std::max(d0, d1)
+        auto shown = hn::AndNot(layer, mask);
+        shown = hn::Or(shown, hn::IfThenElseZero(hn::RebindMask(du, hn::Not(hn::Lt(d_near, layered))), hn::And(mask, layer)));
+        shown = hn::IfThenZeroElse(hn::RebindMask(du, hn::Lt(d_near, d0)), shown);
+        hn::StoreU(mask, du, masks + base);
+        hn::StoreU(shown, du, unhidden + base);
+    }
+#endif
+}
+
+}  // namespace homcull::detail::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+#include "raster/resolved_kernel.hpp"
+
+namespace homcull::detail {
+
+HWY_EXPORT(OccludeeRow);
+
+OccludeeRowKernel selected_occludee_row_kernel() {
+    return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(OccludeeRow);
+}
+
+}  // namespace homcull::detail
+#endif  // HWY_ONCE
