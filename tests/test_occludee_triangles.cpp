@@ -421,6 +421,21 @@ TEST(OccludeeTriangles, ThinTriangleJustBehindAGrazingFloorIsHidden) {
     EXPECT_EQ(sliver(0.0), Visibility::visible);  // flush: a tie, never hidden
     EXPECT_EQ(sliver(-1e-5), Visibility::visible);
     EXPECT_EQ(sliver(-1e-4), Visibility::visible);
+    // A wide sliver across the floor: its rows reach many subtiles (tested a subtile per SIMD
+    // lane), and it needs the raised-vertex bound from its first subtile on, on every ISA.
+    auto wide_sliver = [&](double gap) {
+        const float k = float(1.0 + gap);
+        Soup s;
+        s.add(-0.9f, -0.5f, floor_w(-0.5f) * k, 0.9f, -0.5f, floor_w(-0.5f) * k, 0.9f, -0.45f, floor_w(-0.45f) * k);
+        return answer(buffer, s);
+    };
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        EXPECT_EQ(wide_sliver(1e-4), Visibility::occluded) << isa;
+        EXPECT_EQ(wide_sliver(0.0), Visibility::visible) << isa;
+        EXPECT_EQ(wide_sliver(-1e-5), Visibility::visible) << isa;
+    }
+    select_isa("best");
 }
 
 // The occludee's input rounding, as test_triangles models it (ClipError in
