@@ -421,12 +421,13 @@ TEST(OccludeeTriangles, ThinTriangleJustBehindAGrazingFloorIsHidden) {
     EXPECT_EQ(sliver(0.0), Visibility::visible);  // flush: a tie, never hidden
     EXPECT_EQ(sliver(-1e-5), Visibility::visible);
     EXPECT_EQ(sliver(-1e-4), Visibility::visible);
-    // A wide sliver across the floor: its rows reach many subtiles (tested a subtile per SIMD
-    // lane), and it needs the raised-vertex bound from its first subtile on, on every ISA.
+    // A wide sliver across the floor, wide side up: its rows, the first included, reach many
+    // subtiles (tested a subtile per SIMD lane), and it needs the raised-vertex bound from its
+    // first subtile on (the rest of that row is then taken again with it), on every ISA.
     auto wide_sliver = [&](double gap) {
         const float k = float(1.0 + gap);
         Soup s;
-        s.add(-0.9f, -0.5f, floor_w(-0.5f) * k, 0.9f, -0.5f, floor_w(-0.5f) * k, 0.9f, -0.45f, floor_w(-0.45f) * k);
+        s.add(-0.9f, -0.45f, floor_w(-0.45f) * k, 0.9f, -0.45f, floor_w(-0.45f) * k, 0.9f, -0.5f, floor_w(-0.5f) * k);
         return answer(buffer, s);
     };
     for (const std::string& isa : available_isas()) {
