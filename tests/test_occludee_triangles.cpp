@@ -1,6 +1,7 @@
 // OcclusionBuffer::test_triangles: occludee triangles tested sample by sample. Hand-built
 // cases for each answer, a hole counted sample by sample, bad input, and a brute-force check on
 // random triangles that the test never hides a triangle seen at a sample of the buffer.
+#include "core/occludee_depth.hpp"
 #include "support.hpp"
 
 #include <homcull/error.hpp>
@@ -362,6 +363,69 @@ TEST(OccludeeTriangles, EveryIsaGivesTheReferenceAnswersAndCounts) {
         }
         select_isa("best");
     }
+}
+
+// The row kernel against its reference, on depths placed where a rounding decides: each
+// subtile's d0 (or the larger of d0 and d1) is the reference's own bound at that subtile, one
+// float step above or below it. Random intervals (empty rows and rows past the subtiles
+// included), planes of every corner, raised-vertex planes usable or not.
+TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kColumns = 70, kStride = 96;
+    std::vector<float> d0(kStride), d1(kStride);
+    std::vector<std::uint32_t> layer(kStride);
+    int checked = 0, unhidden_seen = 0;
+    for (const std::string& isa : available_isas()) {
+        if (isa == "scalar") continue;
+        select_isa(isa);
+        const detail::OccludeeRowKernel kernel = detail::selected_occludee_row_kernel();
+        ASSERT_NE(kernel, nullptr);
+        for (int trial = 0; trial < 400; ++trial) {
+            detail::OccludeeDepth depth;
+            depth.z_vertex_max = float(0.05 + unit(rng));
+            depth.raise = 1.0f + 0x1.0p-20f;
+            depth.plane.has_plane = trial % 5 != 0;
+            depth.plane.a = float(0.2 * unit(rng)), depth.plane.dzdx = float((unit(rng) - 0.5) * 1e-3);
+            depth.plane.dzdy = float((unit(rng) - 0.5) * 1e-2);
+            depth.plane.far_is_left = depth.plane.dzdx > 0.0f, depth.plane.far_is_top = depth.plane.dzdy > 0.0f;
+            depth.error = float(1e-6 * unit(rng)), depth.plane_raise = float(1.0 + 1e-5 * unit(rng));
+            depth.raised.usable = trial % 3 != 0;
+            depth.raised.d0 = 0.3 * unit(rng), depth.raised.x0 = 300 * unit(rng), depth.raised.y0 = 50 * unit(rng);
+            depth.raised.dzdx = (unit(rng) - 0.5) * 1e-3, depth.raised.dzdy = (unit(rng) - 0.5) * 1e-2, depth.raised.outside = 1e-6 * unit(rng);
+            const int ty = int(20 * unit(rng));
+            std::int32_t first[4], last[4];
+            for (int j = 0; j < 4; ++j) {
+                first[j] = int(kColumns * kW * unit(rng)) - 20;
+                last[j] = trial % 7 == 0 && j == 2 ? first[j] - 1 : first[j] + int(300 * unit(rng));
+            }
+            const int tx_begin = int(20 * unit(rng)), count = 1 + int((kColumns - tx_begin - 1) * unit(rng));
+            // The reference's bound per subtile, and the planes placed about it.
+            for (int k = 0; k < count; ++k) {
+                const detail::SubtileCoverage c = detail::subtile_coverage(first, last, tx_begin + k);
+                const float bound = c.mask ? depth.over(tx_begin + k, ty, c) : 0.5f;
+                const int place = int(6 * unit(rng));
+                const float near_it = place % 3 == 0 ? bound : place % 3 == 1 ? std::nextafter(bound, 2.0f) : std::nextafter(bound, 0.0f);
+                d0[std::size_t(tx_begin + k)] = place < 3 ? near_it : float(0.5 * unit(rng)) * bound;
+                d1[std::size_t(tx_begin + k)] = place < 3 ? float(unit(rng)) : near_it;
+                layer[std::size_t(tx_begin + k)] = std::uint32_t(rng());
+            }
+            // Rows ty of a view whose row stride is 0: every row is these arrays.
+            const detail::SubtileView view{d0.data(), d1.data(), layer.data(), 0, nullptr, 0, nullptr, nullptr, 0};
+            std::uint32_t masks[kColumns + 16], unhidden[kColumns + 16], want_masks[kColumns], want_unhidden[kColumns];
+            kernel(view, ty, first, last, tx_begin, count, depth, masks, unhidden);
+            detail::occludee_row_reference(view, ty, first, last, tx_begin, count, depth, want_masks, want_unhidden);
+            for (int k = 0; k < count; ++k) {
+                ASSERT_EQ(masks[k], want_masks[k]) << isa << " trial " << trial << " subtile " << k;
+                ASSERT_EQ(unhidden[k], want_unhidden[k]) << isa << " trial " << trial << " subtile " << k;
+                unhidden_seen += want_unhidden[k] != 0;
+                ++checked;
+            }
+        }
+    }
+    select_isa("best");
+    EXPECT_GT(checked, 1000);
+    EXPECT_GT(unhidden_seen, checked / 10);  // both answers compared
 }
 
 // Past its first 16 triangles an occludee is fetched and transformed 16 at a time: the
