@@ -121,8 +121,6 @@ struct SampleCounts {
     std::uint64_t samples = 0, visible = 0;
 };
 
-// Counts one screen triangle's outer-covered samples and those not certainly hidden; stops
-// once more than `tolerated` are visible.
 // The SIMD kernels count_triangle uses (null for the scalar reference), looked up once per
 // occludee rather than once per triangle.
 struct OccludeeKernels {
@@ -130,6 +128,8 @@ struct OccludeeKernels {
     detail::OccludeeRowKernel row = detail::selected_occludee_row_kernel();
 };
 
+// Counts one screen triangle's outer-covered samples and those not certainly hidden; stops
+// once more than `tolerated` are visible.
 void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error, const PlaneError& depth_error, double margin,
                     const detail::SubtileView& view, int sample_width, int sample_height, std::uint64_t tolerated,
                     const OccludeeKernels& kernels, SampleCounts& counts) {
@@ -204,8 +204,8 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
             depth.raised = detail::raised_vertex_plane(tri, slack.x, slack.y, slack.depth, pad_x, pad_y);
         };
         if (!row_kernel || tx_end - tx_begin + 1 < kLaneRun) {
-            // Subtile by subtile: most occludee triangles reach one or two subtiles of a row,
-            // where a vector's set-up costs more than it saves.
+            // Subtile by subtile (the scalar reference, and rows of one subtile: there a
+            // vector's set-up costs more than it saves).
             for (int tx = tx_begin; tx <= tx_end; ++tx) {
                 const detail::SubtileCoverage c = detail::subtile_coverage(first, last, tx);
                 if (c.mask == 0) continue;
