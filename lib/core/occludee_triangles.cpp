@@ -205,7 +205,9 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
         };
         if (!row_kernel || tx_end - tx_begin + 1 < kLaneRun) {
             // Subtile by subtile (the scalar reference, and rows of one subtile: there a
-            // vector's set-up costs more than it saves).
+            // vector's set-up costs more than it saves). The same steps as the runs below,
+            // written out: one loop over runs for both, the reference through the kernel
+            // pointer, made castle C0's occludee tests 2 % slower (3.04 -> 3.10 ms).
             for (int tx = tx_begin; tx <= tx_end; ++tx) {
                 const detail::SubtileCoverage c = detail::subtile_coverage(first, last, tx);
                 if (c.mask == 0) continue;

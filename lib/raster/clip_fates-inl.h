@@ -18,6 +18,23 @@
 HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 
+// finite_clip and outside_side_plane, corner by corner: each corner (x, y, w) keeps, of the
+// lanes set in `finite` and in the four planes' masks, those where it is finite and beyond that
+// plane (start them all true). Shared by ClipFates and the occludee tests' pass-over
+// (BeyondSidePlane). (Masks as arguments: SVE masks cannot be members of a struct.)
+template <class D>
+HWY_INLINE void AddSidePlaneCorner(D d, hwy::HWY_NAMESPACE::Vec<D> x, hwy::HWY_NAMESPACE::Vec<D> y, hwy::HWY_NAMESPACE::Vec<D> w,
+                                   hwy::HWY_NAMESPACE::Mask<D>& finite, hwy::HWY_NAMESPACE::Mask<D>& right, hwy::HWY_NAMESPACE::Mask<D>& left,
+                                   hwy::HWY_NAMESPACE::Mask<D>& above, hwy::HWY_NAMESPACE::Mask<D>& below) {
+    namespace hn = hwy::HWY_NAMESPACE;
+    const auto infinity = hn::Set(d, HUGE_VAL);
+    finite = hn::And(finite, hn::And(hn::And(hn::Lt(hn::Abs(x), infinity), hn::Lt(hn::Abs(y), infinity)), hn::Lt(hn::Abs(w), infinity)));
+    right = hn::And(right, hn::Gt(x, w));
+    left = hn::And(left, hn::Lt(x, hn::Neg(w)));
+    above = hn::And(above, hn::Gt(y, w));
+    below = hn::And(below, hn::Lt(y, hn::Neg(w)));
+}
+
 // For corners (x_k, y_k, w_k): finite (x, y and w of every corner), outside_frustum (behind
 // near_w or beyond one side plane), too_large_to_clip or needs_clipping (`unsettled`: the
 // one-triangle setup's), homogeneous_det plus 0.0 as setup_clip_triangle sums it, and
@@ -40,12 +57,8 @@ HWY_INLINE void ClipFates(D d, Backface backface, double near_w, hwy::HWY_NAMESP
     V extent = zero, min_w = infinity;
     const auto corner = [&](V x, V y, V w) {
         const V ax = hn::Abs(x), ay = hn::Abs(y);
-        finite = hn::And(finite, hn::And(hn::And(hn::Lt(ax, infinity), hn::Lt(ay, infinity)), hn::Lt(hn::Abs(w), infinity)));
-        behind = hn::And(behind, hn::Lt(w, near));  // outside_frustum
-        right = hn::And(right, hn::Gt(x, w));       // outside_side_plane
-        left = hn::And(left, hn::Lt(x, hn::Neg(w)));
-        above = hn::And(above, hn::Gt(y, w));
-        below = hn::And(below, hn::Lt(y, hn::Neg(w)));
+        AddSidePlaneCorner(d, x, y, w, finite, right, left, above, below);  // finite_clip, outside_side_plane
+        behind = hn::And(behind, hn::Lt(w, near));                          // outside_frustum
         extent = hn::Max(extent, hn::Max(ax, ay));  // too_large_to_clip (max and min are exact)
         min_w = hn::Min(min_w, w);
         const V band = hn::Mul(guard, w);  // needs_clipping

@@ -24,10 +24,12 @@ HWY_INLINE hwy::HWY_NAMESPACE::Mask<hwy::HWY_NAMESPACE::Rebind<float, D>> FloatL
     return hn::RebindMask(hn::Rebind<float, D>(), hn::Lt(hn::DemoteTo(di, hn::IfThenElseZero(m, hn::Set(d, -1.0))), hn::Zero(di)));
 }
 
-// float_up (kUp) or float_down of doubles, lane by lane: the nearest float, then one step of its
-// bits towards the safe side when it lies on the other. Beyond the float range the nearest
-// float is the largest one or infinity, and that step gives float_up's and float_down's answers
-// there too (the largest float or infinity on the safe side); NaN stays NaN.
+// float_up (kUp) or float_down of finite doubles, lane by lane: the nearest float, then one step
+// of its bits towards the safe side when it lies on the other. Beyond the float range the
+// nearest float is the largest one or infinity, and that step gives float_up's and float_down's
+// answers there too (the largest float or infinity on the safe side); NaN stays NaN. An infinite
+// input on the safe side's opposite differs: FloatOutward<true>(-inf) is -inf where float_up
+// gives the lowest float (and FloatOutward<false>(+inf) +inf): both callers pass finite values.
 template <bool kUp, class D>
 HWY_INLINE hwy::HWY_NAMESPACE::Vec<hwy::HWY_NAMESPACE::Rebind<float, D>> FloatOutward(D d, hwy::HWY_NAMESPACE::Vec<D> v) {
     namespace hn = hwy::HWY_NAMESPACE;

@@ -201,19 +201,15 @@ void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, Raste
 std::uint32_t BeyondSidePlane(const TriangleBatch& batch, int count) {
     const D d;
     const int lanes = int(hn::Lanes(d));
-    const V infinity = hn::Set(d, HUGE_VAL);
     std::uint32_t bits = 0;
     for (int g = 0; g < count; g += lanes) {
         const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};
-        M keep = hn::And(hn::FirstN(d, std::size_t(count - g)), hn::LoadMaskBits(d, index_bits));
-        M right = keep, left = keep, top = keep, bottom = keep;
-        for (int k = 0; k < 3; ++k) {
-            const V x = hn::Load(d, batch.cx[k] + g), y = hn::Load(d, batch.cy[k] + g), w = hn::Load(d, batch.cw[k] + g);
-            keep = hn::And(keep, hn::And(hn::And(hn::Lt(hn::Abs(x), infinity), hn::Lt(hn::Abs(y), infinity)), hn::Lt(hn::Abs(w), infinity)));
-            right = hn::And(right, hn::Gt(x, w)), left = hn::And(left, hn::Lt(x, hn::Neg(w)));
-            top = hn::And(top, hn::Gt(y, w)), bottom = hn::And(bottom, hn::Lt(y, hn::Neg(w)));
-        }
-        bits |= LaneBits(d, hn::And(keep, hn::Or(hn::Or(right, left), hn::Or(top, bottom)))) << g;
+        const M valid = hn::And(hn::FirstN(d, std::size_t(count - g)), hn::LoadMaskBits(d, index_bits));
+        M finite = valid, right = valid, left = valid, above = valid, below = valid;
+        for (int k = 0; k < 3; ++k)  // ClassifyBatch's comparisons (clip_fates-inl.h)
+            AddSidePlaneCorner(d, hn::Load(d, batch.cx[k] + g), hn::Load(d, batch.cy[k] + g), hn::Load(d, batch.cw[k] + g), finite, right, left,
+                               above, below);
+        bits |= LaneBits(d, hn::And(finite, hn::Or(hn::Or(right, left), hn::Or(above, below)))) << g;
     }
     return bits;
 }

@@ -96,7 +96,8 @@ public:
 
     // Per frame: clear() forgets the occluder boxes of the depth estimation buffer;
     // add_occluder_box() enters one (its far rectangle, Zhang 6.2.1); build() derives the
-    // opacity pyramid and the depth maps from a rendered buffer. No allocation.
+    // opacity pyramid and the depth pyramids it makes (OcclusionMapsConfig::depth_pyramids)
+    // from a rendered buffer. No allocation.
     void clear();
     void add_occluder_box(const Aabb& box, const std::array<float, 16>& model_to_clip);
     void build(const OcclusionBuffer& buffer);

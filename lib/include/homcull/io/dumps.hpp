@@ -43,7 +43,9 @@ struct DumpPart {
     bool larger_is_nearer = false;  // depth parts: 1/w (true) or w (false); drawn near = bright
 };
 
-// The parts of a dump, in file order (see above). The maps must have been built from `buffer`.
+// The parts of a dump, in file order (see above). The maps must have been built from `buffer`,
+// unchanged since: a depth pyramid the maps do not make (OcclusionMapsConfig::depth_pyramids)
+// is built here from `buffer`.
 std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionMaps& maps);
 
 // Writes every part into one multi-part OpenEXR file (FLOAT channel "Y", zip compression). The
