@@ -52,14 +52,19 @@ struct OccludeeDepth {
 // intervals [first[j], last[j]]: masks[k], the triangle's samples there (subtile_coverage), and
 // unhidden[k], those of them the layers do not hide at depth.over (subtile_unhidden_samples).
 // The kernels write up to kMaxSimdLanes entries past count.
-// What the kernel computes, subtile by subtile (count_triangle runs the same steps inline for
-// narrow rows; Highway's one-lane target runs this).
+// The samples of coverage `c` of subtile (tx, ty) that the layers do not hide at depth.over:
+// what the row kernel computes per lane, and count_triangle per subtile of a narrow row.
+inline std::uint32_t occludee_unhidden(const SubtileView& view, int tx, int ty, const SubtileCoverage& c, const OccludeeDepth& depth) {
+    return c.mask ? subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c)) : 0u;
+}
+
+// What the kernel computes, subtile by subtile (Highway's one-lane target runs this).
 inline void occludee_row_reference(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,
                                    int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden) {
     for (int k = 0; k < count; ++k) {
         const SubtileCoverage c = subtile_coverage(first, last, tx_begin + k);
         masks[k] = c.mask;
-        unhidden[k] = c.mask ? subtile_unhidden_samples(view, tx_begin + k, ty, c.mask, depth.over(tx_begin + k, ty, c)) : 0u;
+        unhidden[k] = occludee_unhidden(view, tx_begin + k, ty, c, depth);
     }
 }
 using OccludeeRowKernel = void (*)(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,

@@ -211,10 +211,10 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
             for (int tx = tx_begin; tx <= tx_end; ++tx) {
                 const detail::SubtileCoverage c = detail::subtile_coverage(first, last, tx);
                 if (c.mask == 0) continue;
-                std::uint32_t unhidden_samples = detail::subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c));
+                std::uint32_t unhidden_samples = detail::occludee_unhidden(view, tx, ty, c, depth);
                 if (unhidden_samples && has_area && !raised_ready) {
                     raise_vertices();
-                    unhidden_samples = detail::subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c));
+                    unhidden_samples = detail::occludee_unhidden(view, tx, ty, c, depth);
                 }
                 if (count_subtile(tx, c.mask, unhidden_samples)) return;
             }
