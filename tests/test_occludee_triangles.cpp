@@ -503,6 +503,32 @@ TEST(OccludeeTriangles, ThinTriangleJustBehindAGrazingFloorIsHidden) {
     select_isa("best");
 }
 
+// A wide sliver behind a wall, without per-sample depth (the layers alone decide): two of its
+// vertices just behind the wall, the third 300 times farther. The plane's error bound cannot
+// hide any of its subtiles; the raised-vertex bound hides them all. It is made when the first
+// subtile needs it, and the SIMD lanes' answers for the rest of that row, computed before it
+// existed, must be computed again with it (without that, the sliver shows in the next subtile).
+TEST(OccludeeTriangles, RaisedBoundRetestsTheRestOfItsRow) {
+    const OcclusionBuffer buffer = wall_at(4.0f);
+    auto sliver = [&](double gap) {
+        const float near_w = float(4.0 * (1.0 + gap));
+        Soup s;
+        s.add(-0.9f, -0.45f, 300.0f * near_w, 0.9f, -0.45f, near_w, -0.9f, -0.5f, near_w);
+        return buffer.test_triangles(s.input());
+    };
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        const OcclusionBuffer::TriangleTest hidden = sliver(1e-5);
+        EXPECT_EQ(hidden.visibility, Visibility::occluded) << isa;
+        EXPECT_GT(hidden.samples, 8u) << isa;  // rows across several subtiles
+        // Its samples lie inside, where it is already farther than at its near edge: flush with
+        // the wall it is still behind at every sample. Brought to half the distance, it shows.
+        EXPECT_EQ(sliver(0.0).visibility, Visibility::occluded) << isa;
+        EXPECT_EQ(sliver(-0.5).visibility, Visibility::visible) << isa;
+    }
+    select_isa("best");
+}
+
 // The occludee's input rounding, as test_triangles models it (ClipError in
 // occludee_triangles.cpp): with a float matrix within 2^-24 per entry of an exact one, each
 // clip coordinate of each vertex may be off by 2^-23 sum_i |m_ri p_i|, independently. Random
