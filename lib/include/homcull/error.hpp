@@ -1,7 +1,8 @@
 #pragma once
 // The one exception type homcull's C++ libraries throw. Messages name the thing that is wrong
 // (a file, an option, an object) and the problem, ready to show a user as they are.
-// Nothing throws across the C ABI; the command-line program turns an Error into exit code 1.
+// (There is no C ABI yet: a C wrapper would catch it at its boundary.) The command-line
+// program turns an Error into exit code 1.
 #include <stdexcept>
 #include <string>
 
