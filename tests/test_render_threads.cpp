@@ -279,6 +279,28 @@ TEST(RectTest, PyramidAnswersEqualExhaustiveOnes) {
 namespace homcull {
 namespace {
 
+// A name select_isa cannot take throws and changes nothing: the selection stays, and the list of
+// available instruction sets is the CPU's whatever is selected.
+TEST(Isa, ANameThatCannotBeSelectedLeavesTheSelectionAsItWas) {
+    const std::vector<std::string> isas = available_isas();
+    ASSERT_EQ(isas.front(), "scalar");
+    for (const std::string& selected : isas) {
+        select_isa(selected);
+        EXPECT_THROW(select_isa("bogus"), Error) << selected;
+        EXPECT_EQ(selected_isa(), selected);
+        for (const char* name : {"avx512", "avx2", "sse4", "sve2", "sve", "neon"})
+            if (std::find(isas.begin(), isas.end(), name) == isas.end()) {  // not on this machine or in this build
+                EXPECT_THROW(select_isa(name), Error) << selected << " then " << name;
+                EXPECT_EQ(selected_isa(), selected) << name;
+            }
+        EXPECT_EQ(available_isas(), isas) << selected;
+    }
+    select_isa("best");
+    if (isas.size() > 1) {
+        EXPECT_EQ(selected_isa(), isas[1]);  // the widest: listed first after scalar
+    }
+}
+
 // Every instruction set gives the scalar reference's bits: S1-like random triangles at every
 // sample count, and a city seen from the street (shared edges, near clipping); with and
 // without per-sample depth.

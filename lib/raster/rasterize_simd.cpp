@@ -471,7 +471,9 @@ HWY_AFTER_NAMESPACE();
 
 #include "raster/resolved_kernel.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <iterator>
 #include <string>
 
 namespace homcull {
@@ -507,35 +509,49 @@ bool hidden_skip_enabled() { return skip_hidden; }
 
 }  // namespace detail
 
+namespace {
+
+// select_isa's target (0: every one the CPU supports). Highway's SupportedTargets() returns
+// only this one while it is set, so the CPU's own are read with it lifted for a moment.
+std::int64_t forced_targets = 0;
+std::int64_t cpu_targets() {
+    hwy::SetSupportedTargetsForTest(0);
+    const std::int64_t cpu = hwy::SupportedTargets();
+    hwy::SetSupportedTargetsForTest(forced_targets);
+    return cpu;
+}
+
+}  // namespace
+
 std::vector<std::string> available_isas() {
     std::vector<std::string> names = {"scalar"};
-    const std::int64_t supported = hwy::SupportedTargets();
+    const std::int64_t supported = cpu_targets();
     for (const auto& t : detail::kTargets)
         if ((HWY_TARGETS & t.bits) && (supported & t.bits)) names.push_back(t.name);
     return names;
 }
 
+// Checks the name first: a name that cannot be selected throws and leaves the selection as it was.
 void select_isa(const std::string& name) {
+    bool scalar = false;
+    std::int64_t bits = 0;  // best
     if (name == "scalar") {
-        detail::use_reference = true;
-        return;
-    }
-    detail::use_reference = false;
-    if (name == "best") {
-        hwy::SetSupportedTargetsForTest(0);  // back to what the CPU supports
-        return;
-    }
-    for (const auto& t : detail::kTargets)
-        if (name == t.name) {
-            hwy::SetSupportedTargetsForTest(0);
-            if (!(HWY_TARGETS & t.bits) || !(hwy::SupportedTargets() & t.bits))
-                throw Error("instruction set '" + name + "' is not available on this machine or in this build");
-            hwy::SetSupportedTargetsForTest(t.bits);
-            return;
+        scalar = true;
+    } else if (name != "best") {
+        const auto t = std::find_if(std::begin(detail::kTargets), std::end(detail::kTargets), [&](const auto& k) { return name == k.name; });
+        if (t == std::end(detail::kTargets)) {
+            std::string known;
+            for (const std::string& n : available_isas()) known += (known.empty() ? "" : ", ") + n;
+            throw Error("unknown instruction set '" + name + "' (available: best, " + known + ")");
         }
-    std::string known;
-    for (const std::string& n : available_isas()) known += (known.empty() ? "" : ", ") + n;
-    throw Error("unknown instruction set '" + name + "' (available: best, " + known + ")");
+        if (!(HWY_TARGETS & t->bits) || !(cpu_targets() & t->bits))
+            throw Error("instruction set '" + name + "' is not available on this machine or in this build");
+        bits = t->bits;
+    }
+    detail::use_reference = scalar;
+    if (scalar) return;  // the SIMD targets stay as they were: the scalar paths do not dispatch
+    forced_targets = bits;
+    hwy::SetSupportedTargetsForTest(bits);
 }
 
 std::string selected_isa() {
