@@ -119,9 +119,24 @@ TEST(Cli, CullRejectsInconsistentOptions) {
     r = run_cli("accuracy --mode approximate --hole 4");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_MENTIONS(r.err, "--mode needs --scene");
-    // Approximate mode takes any buffer.
-    r = run_cli("cull " + kCityCamera + " --buffer 40x20 --samples 4 --mode approximate --hole 2 --json");
+    // Approximate mode takes any buffer: 4 x 4 samples unless told otherwise (a low-resolution one).
+    r = run_cli("cull " + kCityCamera + " --buffer 40x20 --samples 2 --mode approximate --hole 2 --json");
     EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 2);
+    r = run_cli("cull " + kCityCamera + " --buffer 40x20 --mode approximate --hole 2 --json");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 4);
+    // A buffer whose samples can lie on the display's pixel centres gets those samples.
+    r = run_cli("cull " + kCityCamera + " --buffer 48x27 --json");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 2);
+    // A bad size names the option it came from.
+    r = run_cli("cull " + kCityCamera + " --buffer 0x0");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--buffer: expected WxH between 1x1 and 65536x65536");
+    r = run_cli("cull " + kCityCamera + " --deb 64x-3");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "--deb: expected WxH");
 }
 
 TEST(Cli, PathFileFramesDriveTheCamera) {

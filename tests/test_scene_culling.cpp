@@ -211,6 +211,40 @@ std::vector<WalkTotals> walk_every_strategy(const Scene& scene, const std::vecto
     return totals;
 }
 
+// SceneCullerConfig::samples = 0: the samples that put a buffer on the display's pixel centres,
+// else 4 x 4 for a low-resolution buffer; and what the buffer is then made with.
+TEST(SceneCulling, AutomaticSamplesPutTheBufferOnTheDisplayOrGiveLowResolutionOnes4x4) {
+    const Resolution display{1280, 720};
+    EXPECT_EQ(automatic_samples(display, {0, 0}), 1);
+    EXPECT_EQ(automatic_samples(display, {1280, 720}), 1);
+    EXPECT_EQ(automatic_samples(display, {640, 360}), 2);
+    EXPECT_EQ(automatic_samples(display, {320, 180}), 4);
+    EXPECT_EQ(automatic_samples({1920, 1080}, {256, 128}), 4);  // low resolution, not on the display's grid
+    EXPECT_EQ(automatic_samples(display, {1280, 360}), 4);      // fewer pixels on one axis
+    EXPECT_EQ(automatic_samples(display, {2560, 1440}), 1);     // more than the display
+
+    SceneCullerConfig c;
+    c.display = display;
+    ASSERT_EQ(c.samples, 0);  // the default
+    BufferConfig b = scene_buffer_config(c, 0.1f);
+    EXPECT_EQ(b.width, 1280);
+    EXPECT_EQ(b.height, 720);
+    EXPECT_EQ(b.samples, 1);
+    c.buffer = {320, 180};  // conservative: accepted, on the display's pixel centres
+    b = scene_buffer_config(c, 0.1f);
+    EXPECT_EQ(b.width, 320);
+    EXPECT_EQ(b.samples, 4);
+    c.buffer = {256, 128};  // not on them: conservative mode refuses it, approximate mode takes it 4 x 4
+    EXPECT_THROW(scene_buffer_config(c, 0.1f), Error);
+    c.maps.hole_pixels = 4.0;
+    b = scene_buffer_config(c, 0.1f);
+    EXPECT_EQ(b.samples, 4);
+    c.samples = 2;  // given: kept
+    EXPECT_EQ(scene_buffer_config(c, 0.1f).samples, 2);
+    c.samples = 3;
+    EXPECT_THROW(scene_buffer_config(c, 0.1f), Error);
+}
+
 TEST(SceneCulling, EveryStrategyOnGeneratedScenesHasNoFalseCulls) {
     for (const char* spec : {"city:seed=3,blocks=5", "forest:seed=4,radius=40"}) {
         const Scene scene = generate_scene(spec);

@@ -23,28 +23,37 @@ OcclusionMapsConfig maps_config(const SceneCullerConfig& c) {
 
 }  // namespace
 
+int automatic_samples(Resolution display, Resolution buffer) {
+    if (buffer.width == 0 && buffer.height == 0) return 1;
+    for (const int s : {1, 2, 4})
+        if (buffer.width * s == display.width && buffer.height * s == display.height) return s;
+    return buffer.width < display.width || buffer.height < display.height ? 4 : 1;
+}
+
 BufferConfig scene_buffer_config(const SceneCullerConfig& c, float near_w) {
     validate_resolution(c.display);
-    if (c.samples != 1 && c.samples != 2 && c.samples != 4) throw Error("samples per buffer pixel axis must be 1, 2 or 4");
+    if (c.samples != 0 && c.samples != 1 && c.samples != 2 && c.samples != 4)
+        throw Error("samples per buffer pixel axis must be 1, 2 or 4 (or 0: automatic), got " + std::to_string(c.samples));
+    if (!(c.buffer.width == 0 && c.buffer.height == 0)) validate_resolution(c.buffer);
+    const int samples = c.samples != 0 ? c.samples : automatic_samples(c.display, c.buffer);
     BufferConfig b;
-    b.samples = c.samples;
+    b.samples = samples;
     b.near_w = near_w;
     b.sample_depth = c.sample_depth && resolved_occludee_shape(c) == OccludeeShape::samples;
     if (c.buffer.width == 0 && c.buffer.height == 0) {
-        if (c.display.width % c.samples != 0 || c.display.height % c.samples != 0)
+        if (c.display.width % samples != 0 || c.display.height % samples != 0)
             throw Error("the display resolution " + std::to_string(c.display.width) + "x" + std::to_string(c.display.height) +
-                        " is not a multiple of the samples per axis (" + std::to_string(c.samples) + "): give --buffer");
-        b.width = c.display.width / c.samples;
-        b.height = c.display.height / c.samples;
+                        " is not a multiple of the samples per axis (" + std::to_string(samples) + "): give --buffer");
+        b.width = c.display.width / samples;
+        b.height = c.display.height / samples;
     } else {
-        validate_resolution(c.buffer);
         b.width = c.buffer.width;
         b.height = c.buffer.height;
     }
-    const bool same_grid = b.width * c.samples == c.display.width && b.height * c.samples == c.display.height;
+    const bool same_grid = b.width * samples == c.display.width && b.height * samples == c.display.height;
     if (c.maps.hole_pixels == 0.0 && !same_grid)
         throw Error("conservative culling needs the buffer's samples on the display's pixel centres: buffer x samples (" +
-                    std::to_string(b.width * c.samples) + "x" + std::to_string(b.height * c.samples) + ") must equal the display (" +
+                    std::to_string(b.width * samples) + "x" + std::to_string(b.height * samples) + ") must equal the display (" +
                     std::to_string(c.display.width) + "x" + std::to_string(c.display.height) +
                     "); use a matching buffer or approximate mode");
     return b;

@@ -92,15 +92,16 @@ void register_accuracy(CLI::App& app) {
         std::string resolution = "1920x1080", s1_folder = "../shared/workloads/s1";
         SceneChoice scene;
         std::string path;
-        int samples = 1, walk = 0, orbit = 0;
+        int samples = 0, walk = 0, orbit = 0;  // samples 0: 1 on S1, automatic_samples with --scene
         CullOptions cull;  // --scene
         bool json = false;
     };
     auto o = std::make_shared<Options>();
     CLI::App* cmd = app.add_subcommand("accuracy", "False and missed culls on workload S1's rectangles against exact depth");
     cmd->add_option("--resolution", o->resolution, "S1: buffer resolution WxH; --scene: display resolution WxH")->capture_default_str();
-    cmd->add_option("--samples", o->samples, "S x S samples per buffer pixel (1, 2 or 4); with --scene the buffer is display / S")
-        ->capture_default_str();
+    cmd->add_option("--samples", o->samples,
+                    "S x S samples per buffer pixel (1, 2 or 4; S1: default 1; --scene: the buffer is display / S, default as cull's)")
+        ->check(CLI::IsMember({1, 2, 4}));
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
     add_scene_option(*cmd, o->scene, /*required=*/false, "Measure on a scene against Embree ground truth instead of S1");
     cmd->add_option("--path", o->path, "--scene: camera path whose frames are the views");
@@ -125,7 +126,7 @@ void register_accuracy(CLI::App& app) {
         BufferConfig config;
         config.width = res.width;
         config.height = res.height;
-        config.samples = o->samples;
+        config.samples = o->samples == 0 ? 1 : o->samples;
         config.near_w = 1.0f;
         OcclusionBuffer buffer(config);
         buffer.render(s1.occluder_input());
@@ -137,14 +138,14 @@ void register_accuracy(CLI::App& app) {
         const std::size_t hidden = a.truly_hidden, culled = a.culled, false_culls = a.false_culls, missed = a.missed_culls;
         const double missed_share = hidden ? double(missed) / double(hidden) : 0.0;
         if (o->json) {
-            fmt::print("{}\n", nlohmann::json{{"resolution", {res.width, res.height}}, {"samples", o->samples},
+            fmt::print("{}\n", nlohmann::json{{"resolution", {res.width, res.height}}, {"samples", config.samples},
                                               {"rects", s1.rect_count()}, {"truly_hidden", hidden}, {"culled", culled},
                                               {"false_culls", false_culls}, {"missed_culls", missed},
                                               {"missed_share_of_hidden", missed_share}, {"exact_ms", exact_ms}}.dump(1));
             return;
         }
         fmt::print("S1 at {}x{}, {}x{} samples: {} of {} rectangles truly hidden; culled {}; false culls {}; missed {} ({:.2f} % of hidden)\n",
-                   res.width, res.height, o->samples, o->samples, hidden, s1.rect_count(), culled, false_culls, missed,
+                   res.width, res.height, config.samples, config.samples, hidden, s1.rect_count(), culled, false_culls, missed,
                    100.0 * missed_share);
     });
 }

@@ -90,7 +90,7 @@ void run_cull(const CullCommandOptions& o) {
             {"camera", camera_json(camera)},
             {"display", {config.display.width, config.display.height}},
             {"buffer", {culler.buffer().config().width, culler.buffer().config().height}},
-            {"samples", config.samples},
+            {"samples", culler.buffer().config().samples},
             {"isa", selected_isa()},
             {"mode", o.cull.mode},
             {"hole", config.maps.hole_pixels},
@@ -120,8 +120,8 @@ void run_cull(const CullCommandOptions& o) {
     }
     fmt::print("scene      {} ({} objects)\n", scene.source, scene.objects.size());
     fmt::print("display    {}x{}, buffer {}x{} with {}x{} samples, {} mode{}, depth {}\n", config.display.width,
-               config.display.height, culler.buffer().config().width, culler.buffer().config().height, config.samples,
-               config.samples, o.cull.mode, o.cull.mode == "approximate" ? fmt::format(" (hole {} px)", o.cull.hole) : "",
+               config.display.height, culler.buffer().config().width, culler.buffer().config().height, culler.buffer().config().samples,
+               culler.buffer().config().samples, o.cull.mode, o.cull.mode == "approximate" ? fmt::format(" (hole {} px)", o.cull.hole) : "",
                o.cull.depth);
     fmt::print("occluders  {} objects, {} triangles ({})\n", culler.occluder_objects(), culler.occluder_triangles(), o.cull.occluders);
     fmt::print("answers    {} visible, {} occluded, {} view-culled\n", counts[0], counts[1], counts[2]);

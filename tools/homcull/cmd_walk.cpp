@@ -171,7 +171,7 @@ void run_walk(const WalkCommandOptions& o) {
                                     {"hierarchy", o.cull.hierarchy},
                                     {"display", {config.display.width, config.display.height}},
                                     {"buffer", {culler.buffer().config().width, culler.buffer().config().height}},
-                                    {"samples", config.samples},
+                                    {"samples", culler.buffer().config().samples},
                                     {"mode", o.cull.mode},
                                     {"depth", o.cull.depth},
                                     {"isa", selected_isa()},

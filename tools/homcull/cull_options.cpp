@@ -15,10 +15,12 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     if (with_display) {
         app.add_option("--resolution", o.resolution, "Display resolution WxH: the answers are right for its pixel centres")
             ->capture_default_str();
-        app.add_option("--samples", o.samples, "S x S coverage samples per buffer pixel (1, 2 or 4)")
-            ->capture_default_str()->check(CLI::IsMember({1, 2, 4}));
+        app.add_option("--samples", o.samples,
+                       "S x S coverage samples per buffer pixel (1, 2 or 4; default: the S that puts the buffer's samples on the "
+                       "display's pixel centres, else 4 for a buffer smaller than the display, 1 for one as large)")
+            ->check(CLI::IsMember({1, 2, 4}));
     }
-    app.add_option("--buffer", o.buffer, "Occlusion buffer WxH (default: display / samples, the display's own pixel centres)");
+    app.add_option("--buffer", o.buffer, "Occlusion buffer WxH (default: display / samples, the display's own pixel centres; with --samples unset, the display)");
     app.add_option("--mode", o.mode, "conservative (never hides a visible object) or approximate (tolerates --hole)")
         ->capture_default_str()->check(CLI::IsMember({"conservative", "approximate"}));
     app.add_option("--hole", o.hole, "approximate: largest negligible hole L, in display pixels")->capture_default_str();
@@ -70,7 +72,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
 SceneCullerConfig scene_culler_config(const CullOptions& o) {
     SceneCullerConfig c;
     c.display = parse_resolution(o.resolution);
-    if (!o.buffer.empty()) c.buffer = parse_resolution(o.buffer);
+    if (!o.buffer.empty()) c.buffer = parse_resolution(o.buffer, "--buffer");
     c.samples = o.samples;
     if (o.mode == "conservative" && o.hole != 0.0) throw Error("--hole needs --mode approximate (conservative mode tolerates no hole)");
     if (o.mode == "approximate" && !(o.hole > 0.0)) throw Error("--mode approximate needs --hole L with L > 0 display pixels");
@@ -79,7 +81,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.maps.transparency = o.transparency;
     c.maps.finest_level = o.finest_level;
     c.maps.coarsest_level = o.coarsest_level;
-    const Resolution deb = parse_resolution(o.deb);
+    const Resolution deb = parse_resolution(o.deb, "--deb");
     c.maps.deb_width = deb.width;
     c.maps.deb_height = deb.height;
     c.maps.depth = o.depth == "hzb" ? DepthTest::hzb : o.depth == "deb" ? DepthTest::deb : o.depth == "nbz" ? DepthTest::nbz

@@ -15,7 +15,7 @@ namespace homcull::cli {
 // --complexity F: Zhang's complexity filter on the candidates (filter_by_complexity).
 struct CullOptions {
     std::string resolution = "1280x720", buffer, mode = "conservative", depth = "masked", occluders = "role";
-    int samples = 1;
+    int samples = 0;  // 0: automatic_samples (scene_culler.hpp)
     double hole = 0.0, distribution = 1.0, transparency = 0.0;
     int finest_level = 0, coarsest_level = -1;
     std::string deb = "64x64", occludees = "auto", sample_depth = "on", clusters = "off";

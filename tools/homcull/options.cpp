@@ -91,19 +91,15 @@ nlohmann::json stats_json(const RasterStats& s) {
             {"cluster_bands_drawn", s.cluster_bands_drawn}};
 }
 
-Resolution parse_resolution(const std::string& text) {
-    Resolution r;
+Resolution parse_resolution(const std::string& text, const std::string& option) {
+    const std::string expected = option + ": expected WxH between 1x1 and 65536x65536, such as 1920x1080, got '" + text + "'";
     char* end = nullptr;
     const long w = std::strtol(text.c_str(), &end, 10);
-    if (end == text.c_str() || (*end != 'x' && *end != 'X' && *end != ','))
-        throw Error("resolution: expected WxH such as 1920x1080, got '" + text + "'");
+    if (end == text.c_str() || (*end != 'x' && *end != 'X' && *end != ',')) throw Error(expected);
     const char* rest = end + 1;
     const long h = std::strtol(rest, &end, 10);
-    if (end == rest || *end != '\0') throw Error("resolution: expected WxH such as 1920x1080, got '" + text + "'");
-    r.width = int(std::max(-1L, std::min(w, 1L << 30)));
-    r.height = int(std::max(-1L, std::min(h, 1L << 30)));
-    validate_resolution(r);
-    return r;
+    if (end == rest || *end != '\0' || w < 1 || h < 1 || w > 65536 || h > 65536) throw Error(expected);
+    return Resolution{int(w), int(h)};
 }
 
 long long now_ns() {

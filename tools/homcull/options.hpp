@@ -38,8 +38,8 @@ void add_camera_options(CLI::App& app, CameraOptions& options);
 Camera resolve_camera(const CameraOptions& options);
 
 glm::dvec3 parse_vec3(const std::string& text, const char* what);
-// "WxH" (also "W,H").
-Resolution parse_resolution(const std::string& text);
+// "WxH" (also "W,H"), each in [1, 65536]; errors name `option` (the command-line option read).
+Resolution parse_resolution(const std::string& text, const std::string& option = "--resolution");
 
 // {"eye","target","up","fov_y","near","far"}: a camera as commands print it (the path format's fields).
 nlohmann::json camera_json(const Camera& camera);

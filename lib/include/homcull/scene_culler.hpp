@@ -47,7 +47,9 @@ struct SceneCullerConfig {
     // centres. Conservative mode (maps.hole_pixels = 0) requires exactly that: a coverage
     // sample elsewhere says nothing about the display's pixel centres.
     Resolution buffer{0, 0};
-    int samples = 1;
+    // S x S coverage samples per buffer pixel: 1, 2 or 4, or 0 for automatic_samples(display,
+    // buffer): 1 for a buffer the display's size, 4 x 4 for a low-resolution one.
+    int samples = 0;
     OcclusionMapsConfig maps;  // display_width/height are taken from `display`
     // Back faces are surfaces to ground truth and to the eye: none are culled by default.
     Backface backface = Backface::none;
@@ -210,6 +212,13 @@ private:
     std::vector<std::uint32_t> first_visible_triangle_;
     bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
 };
+
+// The samples per buffer pixel axis that SceneCullerConfig::samples = 0 stands for: the S in
+// {1, 2, 4} that puts the buffer's samples on the display's pixel centres (buffer x S = display;
+// S = 1 for buffer 0 x 0, the display itself); for any other buffer, 4 when it has fewer pixels
+// than the display on either axis (a low-resolution buffer: 4 x 4 samples per pixel, as Intel's
+// Masked Occlusion Culling uses), else 1.
+int automatic_samples(Resolution display, Resolution buffer);
 
 // The buffer configuration a SceneCullerConfig asks for (resolved buffer size), for callers
 // that want to check it before building a culler. Throws homcull::Error when invalid.
