@@ -6,7 +6,10 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 #include <sys/wait.h>
 
 namespace homcull {
@@ -257,6 +260,54 @@ TEST(Cli, ExportThenInfoGivesTheSameScene) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto loaded = nlohmann::json::parse(r.out);
     EXPECT_EQ(loaded["objects"], generated["objects"]);
+}
+
+// homcull bench: the command and JSON keys on both workloads (a buffer small enough to
+// be quick; it times, so only the keys and their sense are checked), the scalar comparison,
+// and its bad options.
+TEST(Cli, BenchPrintsItsTimingsAndRefusesBadOptions) {
+    const std::string s1 = std::string(HOMCULL_SOURCE_DIR) + "/../shared/workloads/s1";
+    const std::string castle = test::shared_scene("intel_castle.glb");
+    if (!std::filesystem::exists(s1 + "/rects_ndc_xmin_ymin_xmax_ymax_wmin_f32.bin") || castle.empty())
+        GTEST_SKIP() << "the shared workload S1 or the castle is missing";
+    CliRun r = run_cli("bench --workload s1 --s1 " + s1 + " --resolution 64x36 --samples 2 --threads 2 --repeat 1 --vs-scalar --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    nlohmann::json j = nlohmann::json::parse(r.out);
+    for (const char* key : {"ms", "min_ms", "mtris_per_s", "rect_tests_per_s", "rect_single_calls_per_s", "speedup_vs_scalar"})
+        EXPECT_GT(j[key].get<double>(), 0.0) << key;
+    EXPECT_EQ(j["samples"], 2);
+    EXPECT_EQ(j["threads"], 2);
+    EXPECT_GT(j["scalar"]["ms"].get<double>(), 0.0);
+    EXPECT_GT(j["rects_occluded"].get<std::size_t>(), 0u);
+    EXPECT_EQ(j["stats"]["triangles_in"], 100000);
+
+    const std::string views = std::string(HOMCULL_SOURCE_DIR) + "/data/views/castle.json";
+    r = run_cli("bench --workload castle --scene " + castle + " --views " + views + " --resolution 128x72 --clusters 124 --repeat 1 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["triangles"], 48700);
+    EXPECT_GT(j["clusters"].get<int>(), 0);
+    EXPECT_GT(j["views"].size(), 1u);
+    EXPECT_EQ(j["ms"], j["views"][0]["ms"]);  // view C0's at the top
+    EXPECT_EQ(j["min_ms"], j["views"][0]["min_ms"]);
+
+    for (const auto& [options, message] : std::vector<std::pair<std::string, std::string>>{
+             {"--workload nonsense", "unknown workload 'nonsense'"},
+             {"--isa bogus", "unknown instruction set 'bogus'"},
+             {"--threads 0", "--threads must be in [1, 256]"},
+             {"--threads 300", "--threads must be in [1, 256]"},
+             {"--repeat -1", "--repeat must be at least 1"},
+             {"--samples 3", "samples per pixel axis must be 1, 2 or 4"},
+             {"--resolution 0x0", "--resolution: expected WxH"},
+             {"--clusters 124", "--clusters is for --workload castle"},
+             {"--workload castle --clusters 7", "--clusters must be a multiple of 4"}}) {
+        const auto unless_given = [&](const std::string& option, const std::string& value) {
+            return options.find(option) == std::string::npos ? " " + option + " " + value : std::string();
+        };
+        r = run_cli("bench " + options + " --s1 " + s1 + unless_given("--resolution", "64x36") + unless_given("--repeat", "1"));
+        EXPECT_EQ(r.exit_code, 1) << options;
+        EXPECT_MENTIONS(r.err, message);
+    }
 }
 
 TEST(Cli, BadInputExitsWithOneAndSaysWhatIsWrong) {

@@ -28,7 +28,7 @@ struct BenchOptions {
     std::string workload = "s1", resolution = "1920x1080", isa = "best";
     std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views = "data/views/castle.json";
     int samples = 1, threads = 1, repeat = 0, clusters = 0;
-    bool json = false, sample_depth = false;
+    bool json = false, sample_depth = false, vs_scalar = false;
 };
 
 double median(std::vector<double> v) {
@@ -36,23 +36,21 @@ double median(std::vector<double> v) {
     return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-void run_bench(const BenchOptions& o) {
-    select_isa(o.isa);
-    if (o.threads < 1) throw Error("bench: --threads must be at least 1");
-    // One thread: the library's serial path. More: TBB limited to that many threads.
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
-    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
-    const Resolution res = parse_resolution(o.resolution);
-    BufferConfig config;
-    config.width = res.width;
-    config.height = res.height;
-    config.samples = o.samples;
-    config.sample_depth = o.sample_depth;
-    nlohmann::json out = {{"workload", o.workload}, {"resolution", {res.width, res.height}}, {"samples", o.samples},
-                          {"threads", o.threads}, {"isa", selected_isa()}, {"sample_depth", o.sample_depth}};
+// The timings of one workload under the selected instruction set: the render (median `ms`,
+// fastest `min_ms`), and on S1 the rectangle tests too. The inputs are loaded once by the
+// caller (S1 or the castle's occluders and views, the clusters built).
+struct BenchInputs {
+    const WorkloadS1* s1 = nullptr;
+    const CameraPath* views = nullptr;
+    const WorldTriangles* occluders = nullptr;
+    const OccluderClusters* clusters = nullptr;  // castle with --clusters
+};
 
-    if (o.workload == "s1") {
-        const WorkloadS1 s1 = load_workload_s1(o.s1_folder);
+nlohmann::json time_workload(const BenchOptions& o, const BufferConfig& base, const ParallelFor& parallel, const BenchInputs& inputs) {
+    nlohmann::json out;
+    BufferConfig config = base;
+    if (inputs.s1) {
+        const WorkloadS1& s1 = *inputs.s1;
         config.near_w = 1.0f;  // the near clip plane MOC was measured with
         OcclusionBuffer buffer(config);
         const TriangleInput in = s1.occluder_input();
@@ -110,49 +108,94 @@ void run_bench(const BenchOptions& o) {
         out["rects_occluded"] = occluded;
         out["runs"] = repeat;
         out["stats"] = stats_json(buffer.stats());
-    } else if (o.workload == "castle") {
-        const Scene castle = load_scene(o.scene);
-        const CameraPath views = read_camera_path(o.views);
-        const WorldTriangles occluders = gather_world_triangles(castle, objects_with_role(castle, "occluder"));
-        const int repeat = o.repeat > 0 ? o.repeat : 21;
+        return out;
+    }
+    const WorldTriangles& occluders = *inputs.occluders;
+    const int repeat = o.repeat > 0 ? o.repeat : 21;
+    nlohmann::json per_view = nlohmann::json::array();
+    for (const Camera& view : inputs.views->frames) {
+        config.near_w = float(view.near_plane);
+        OcclusionBuffer buffer(config);
+        const TriangleInput in = occluders.input(clip_from_world(view, double(config.width) / double(config.height)), Backface::cw);
+        const ClusteredInput clustered_in{inputs.clusters, in.model_to_clip, in.backface};
+        std::vector<double> ms;
+        for (int r = 0; r < repeat; ++r) {
+            const long long start = now_ns();
+            if (inputs.clusters) buffer.render_frame(clustered_in, parallel);
+            else buffer.render_frame(in, parallel);
+            ms.push_back(elapsed_ms(start));
+        }
+        per_view.push_back({{"ms", median(ms)}, {"min_ms", *std::min_element(ms.begin(), ms.end())}, {"stats", stats_json(buffer.stats())}});
+    }
+    // The first view's (C0's) figures at the top, as S1's.
+    out["ms"] = per_view.empty() ? 0.0 : per_view.front()["ms"].get<double>();
+    out["min_ms"] = per_view.empty() ? 0.0 : per_view.front()["min_ms"].get<double>();
+    out["mtris_per_s"] = double(occluders.triangle_count()) / (out["ms"].get<double>() * 1e3);
+    out["triangles"] = occluders.triangle_count();
+    out["views"] = per_view;
+    out["runs"] = repeat;
+    return out;
+}
+
+void run_bench(const BenchOptions& o) {
+    if (o.workload != "s1" && o.workload != "castle") throw Error("bench: unknown workload '" + o.workload + "' (s1 or castle)");
+    if (o.clusters != 0 && o.workload != "castle") throw Error("bench: --clusters is for --workload castle");
+    if (o.clusters != 0 && (o.clusters < 4 || o.clusters > 512 || o.clusters % 4 != 0))
+        throw Error("bench: --clusters must be a multiple of 4 in [4, 512] (triangles per cluster), got " + std::to_string(o.clusters));
+    if (o.threads < 1 || o.threads > 256) throw Error("bench: --threads must be in [1, 256], got " + std::to_string(o.threads));
+    if (o.repeat < 0) throw Error("bench: --repeat must be at least 1 (0: the workload's default), got " + std::to_string(o.repeat));
+    select_isa(o.isa);
+    // One thread: the library's serial path. More: TBB limited to that many threads.
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
+    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+    const Resolution res = parse_resolution(o.resolution);
+    BufferConfig config;
+    config.width = res.width;
+    config.height = res.height;
+    config.samples = o.samples;
+    config.sample_depth = o.sample_depth;
+    nlohmann::json out = {{"workload", o.workload}, {"resolution", {res.width, res.height}}, {"samples", o.samples},
+                          {"threads", o.threads}, {"isa", selected_isa()}, {"sample_depth", o.sample_depth}};
+
+    BenchInputs inputs;
+    std::unique_ptr<WorkloadS1> s1;
+    std::unique_ptr<Scene> castle;
+    std::unique_ptr<CameraPath> views;
+    std::unique_ptr<WorldTriangles> occluders;
+    OccluderClusters clustered;
+    if (o.workload == "s1") {
+        s1 = std::make_unique<WorkloadS1>(load_workload_s1(o.s1_folder));
+        inputs.s1 = s1.get();
+    } else {
+        castle = std::make_unique<Scene>(load_scene(o.scene));
+        views = std::make_unique<CameraPath>(read_camera_path(o.views));
+        occluders = std::make_unique<WorldTriangles>(gather_world_triangles(*castle, objects_with_role(*castle, "occluder")));
+        inputs.views = views.get();
+        inputs.occluders = occluders.get();
         // --clusters N: the occluders split into clusters of at most N triangles first (timed
         // apart: it is done once, when the scene is loaded), and rendered as such.
-        OccluderClusters clustered;
         if (o.clusters > 0) {
             const long long start = now_ns();
             ClusterLimits limits;
             limits.max_triangles = std::size_t(o.clusters);
             limits.max_vertices = std::min<std::size_t>(255, std::size_t(o.clusters));
-            clustered = build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3,
-                                                occluders.indices.data(), occluders.triangle_count(), occluders.shared_edges.data(), limits);
+            clustered = build_occluder_clusters(occluders->positions.data(), 3 * sizeof(float), occluders->positions.size() / 3,
+                                                occluders->indices.data(), occluders->triangle_count(), occluders->shared_edges.data(), limits);
             out["cluster_build_ms"] = elapsed_ms(start);
             out["clusters"] = clustered.clusters.size();
+            inputs.clusters = &clustered;
         }
-        nlohmann::json per_view = nlohmann::json::array();
-        std::vector<double> medians;
-        for (const Camera& view : views.frames) {
-            config.near_w = float(view.near_plane);
-            OcclusionBuffer buffer(config);
-            const TriangleInput in = occluders.input(clip_from_world(view, res.aspect()), Backface::cw);
-            const ClusteredInput clustered_in{&clustered, in.model_to_clip, in.backface};
-            std::vector<double> ms;
-            for (int r = 0; r < repeat; ++r) {
-                const long long start = now_ns();
-                if (o.clusters > 0) buffer.render_frame(clustered_in, parallel);
-                else buffer.render_frame(in, parallel);
-                ms.push_back(elapsed_ms(start));
-            }
-            medians.push_back(median(ms));
-            per_view.push_back({{"ms", medians.back()}, {"min_ms", *std::min_element(ms.begin(), ms.end())},
-                                {"stats", stats_json(buffer.stats())}});
-        }
-        out["ms"] = medians.empty() ? 0.0 : medians.front();  // view C0
-        out["mtris_per_s"] = double(occluders.triangle_count()) / (out["ms"].get<double>() * 1e3);
-        out["triangles"] = occluders.triangle_count();
-        out["views"] = per_view;
-        out["runs"] = repeat;
-    } else {
-        throw Error("bench: unknown workload '" + o.workload + "' (s1 or castle)");
+    }
+    out.update(time_workload(o, config, parallel, inputs));
+    if (o.vs_scalar) {
+        // The same workload on the scalar reference path, with the same threads and runs.
+        select_isa("scalar");
+        const nlohmann::json scalar = time_workload(o, config, parallel, inputs);
+        select_isa(o.isa);
+        nlohmann::json& s = out["scalar"];
+        for (const char* key : {"ms", "min_ms", "mtris_per_s", "rect_tests_per_s", "rect_single_calls_per_s"})
+            if (scalar.contains(key)) s[key] = scalar[key];
+        out["speedup_vs_scalar"] = scalar["ms"].get<double>() / out["ms"].get<double>();
     }
     if (o.json) {
         fmt::print("{}\n", out.dump(1));
@@ -164,6 +207,9 @@ void run_bench(const BenchOptions& o) {
         fmt::print("rectangle tests: {:.1f} ms for 1M ({:.1f} M/s batched; {:.1f} M/s one call each, one thread), {} occluded\n",
                    out["rect_ms"].get<double>(), out["rect_tests_per_s"].get<double>() * 1e-6,
                    out["rect_single_calls_per_s"].get<double>() * 1e-6, out["rects_occluded"].get<std::size_t>());
+    if (o.vs_scalar)
+        fmt::print("scalar reference path: {:.2f} ms, {:.2f}x slower\n", out["scalar"]["ms"].get<double>(),
+                   out["speedup_vs_scalar"].get<double>());
 }
 
 }  // namespace
@@ -175,7 +221,7 @@ void register_bench(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--resolution", o->resolution, "Occlusion buffer resolution WxH (pixels)")->capture_default_str();
     cmd->add_option("--samples", o->samples, "S x S samples per pixel (1, 2 or 4)")->capture_default_str();
-    cmd->add_option("--threads", o->threads, "Threads")->capture_default_str();
+    cmd->add_option("--threads", o->threads, "Threads (1 to 256)")->capture_default_str();
     cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
         ->capture_default_str();
     cmd->add_option("--repeat", o->repeat, "Runs to take the median of (0 = 5 for s1, 21 for castle)");
@@ -187,6 +233,9 @@ void register_bench(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--views", o->views, "Camera path with the views for --workload castle")->capture_default_str();
     cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");
+    cmd->add_flag("--vs-scalar", o->vs_scalar,
+                  "Also time the scalar reference path (same threads and runs): \"scalar\" and \"speedup_vs_scalar\" (its median "
+                  "over this one's)");
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o] { run_bench(*o); });
 }
