@@ -133,6 +133,16 @@ TEST(Cli, CullRejectsInconsistentOptions) {
     r = run_cli("cull " + kCityCamera + " --buffer 48x27 --json");
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 2);
+    // Values out of range are refused, not wrapped or ignored.
+    r = run_cli("cull " + kCityCamera + " --budget -1");
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_MENTIONS(r.err, "--budget: must not be negative");
+    r = run_cli("cull " + kCityCamera + " --coarsest-level -5");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MENTIONS(r.err, "coarsest level must be -1");
+    r = run_cli("accuracy --scene gen:city:seed=2,blocks=3 --orbit 2 --walk 2");
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_MENTIONS(r.err, "excludes");
     // A bad size names the option it came from.
     r = run_cli("cull " + kCityCamera + " --buffer 0x0");
     EXPECT_EQ(r.exit_code, 1);

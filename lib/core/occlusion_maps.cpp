@@ -60,9 +60,10 @@ OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsC
     if (config.finest_level < 0 || config.finest_level > last)
         throw Error("occlusion maps: finest level " + std::to_string(config.finest_level) + " outside the pyramid's 0.." +
                     std::to_string(last));
-    start_max_level_ = config.coarsest_level < 0 ? last : config.coarsest_level;
+    start_max_level_ = config.coarsest_level == -1 ? last : config.coarsest_level;
     if (start_max_level_ < config.finest_level || start_max_level_ > last)
-        throw Error("occlusion maps: coarsest level must be -1 or in [finest level, " + std::to_string(last) + "]");
+        throw Error("occlusion maps: coarsest level must be -1 (the last) or in [finest level, " + std::to_string(last) + "], got " +
+                    std::to_string(config.coarsest_level));
     covered_.assign(size, 0u);
     const bool both = config.depth_pyramids == DepthPyramids::both;
     if (both || config.depth == DepthTest::hzb || config.depth == DepthTest::plane) hzb_.assign(size, 0.0f);

@@ -104,9 +104,11 @@ void register_accuracy(CLI::App& app) {
         ->check(CLI::IsMember({1, 2, 4}));
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
     add_scene_option(*cmd, o->scene, /*required=*/false, "Measure on a scene against Embree ground truth instead of S1");
-    cmd->add_option("--path", o->path, "--scene: camera path whose frames are the views");
-    cmd->add_option("--walk", o->walk, "--scene: views from a generated walk (N views, every 10th frame)");
-    cmd->add_option("--orbit", o->orbit, "--scene: N views on an orbit");
+    CLI::Option* path = cmd->add_option("--path", o->path, "--scene: camera path whose frames are the views");
+    CLI::Option* walk = cmd->add_option("--walk", o->walk, "--scene: views from a generated walk (N views, every 10th frame)");
+    CLI::Option* orbit = cmd->add_option("--orbit", o->orbit, "--scene: N views on an orbit");
+    path->excludes(walk)->excludes(orbit);  // one source of views
+    walk->excludes(orbit);
     add_cull_options(*cmd, o->cull, /*with_display=*/false);  // --scene: --buffer, --mode, --hole, --depth, --occluders, ...
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o, cmd] {

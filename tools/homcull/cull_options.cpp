@@ -49,7 +49,9 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--complexity", o.complexity,
                    "Drop candidates with more than F times the median triangles per unit of box surface (Zhang's complexity "
                    "filter); 0: keep all")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()
+        ->check(CLI::Validator([](const std::string& v) { return v.find('-') == std::string::npos ? std::string() : "must not be negative"; },
+                               "N >= 0"));
     app.add_option("--strategy", o.strategy,
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
                    "to back) or temporal (last frame's visible candidates plus those new in the frustum)")
@@ -61,7 +63,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--lod", o.lod, "on: draw occluders with simplified, verified-inner LODs (meshoptimizer) where their box lies "
                                    "beyond the near plane; never hides more than the originals")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
-    app.add_option("--budget", o.budget, "Occluder triangles per frame at most (0: no limit)")->capture_default_str();
+    app.add_option("--budget", o.budget, "Occluder triangles per frame at most (0: no limit)")
+        ->capture_default_str()
+        ->check(CLI::Validator([](const std::string& v) { return v.find('-') == std::string::npos ? std::string() : "must not be negative"; },
+                               "N >= 0"));
     app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
         ->capture_default_str()->check(CLI::PositiveNumber);
     app.add_option("--hierarchy", o.hierarchy, "on: test the object hierarchy's nodes and skip what a hidden node holds; off: test "
