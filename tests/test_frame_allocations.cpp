@@ -1,0 +1,124 @@
+// "No heap allocation per frame once the buffer is set up": after a buffer's first frame, its
+// renders (every kind of input, with and without a job system) and its queries allocate
+// nothing. Counted by replacing the global operator new for this test binary: it forwards to
+// malloc and counts while a test asks it to.
+#include "support.hpp"
+
+#include <homcull/generate.hpp>
+#include <homcull/occluder_clusters.hpp>
+#include <homcull/occlusion_buffer.hpp>
+#include <homcull/world_triangles.hpp>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+std::atomic<bool> counting{false};
+std::atomic<std::size_t> allocations{0};
+
+void* counted_allocation(std::size_t size, std::size_t alignment) {
+    if (counting.load(std::memory_order_relaxed)) allocations.fetch_add(1, std::memory_order_relaxed);
+    if (size == 0) size = 1;
+    void* p = alignment <= alignof(std::max_align_t) ? std::malloc(size) : std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+    if (!p) throw std::bad_alloc();
+    return p;
+}
+
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_allocation(size, 0); }
+void* operator new[](std::size_t size) { return counted_allocation(size, 0); }
+void* operator new(std::size_t size, std::align_val_t a) { return counted_allocation(size, std::size_t(a)); }
+void* operator new[](std::size_t size, std::align_val_t a) { return counted_allocation(size, std::size_t(a)); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+namespace homcull {
+namespace {
+
+// A job system that allocates nothing itself (test::run_shuffled builds a vector): the tasks
+// last to first, on the calling thread.
+void run_backwards(void*, std::size_t count, void (*task)(void*, std::size_t), void* data) {
+    for (std::size_t i = count; i-- > 0;) task(data, i);
+}
+
+// The allocations `frame` makes.
+template <typename Frame>
+std::size_t allocations_of(Frame&& frame) {
+    allocations.store(0);
+    counting.store(true);
+    frame();
+    counting.store(false);
+    return allocations.load();
+}
+
+TEST(FrameAllocations, NoneAfterTheFirstFrame) {
+    const std::vector<float> soup_xyzw = test::random_clip_triangles(5, 4000, 0.3f);
+    const TriangleInput soup = test::clip_space_input(soup_xyzw);
+    const Scene city = generate_scene("city:seed=8,blocks=6");
+    const WorldTriangles occluders = gather_world_triangles(city, objects_with_role(city, "occluder"));
+    const OccluderClusters clusters =
+        build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3, occluders.indices.data(),
+                                occluders.triangle_count(), occluders.shared_edges.data(), ClusterLimits{});
+    Camera street;
+    street.eye = {-3, 1.7, -40};
+    street.target = {10, 3, 20};
+    const std::array<float, 16> clip = clip_from_world(street, 320.0 / 180.0);
+    const TriangleInput city_input = occluders.input(clip);
+    const ClusteredInput clustered{&clusters, clip, Backface::none};
+
+    // Queries: rectangles, boxes (the scene's objects) and one object's triangles.
+    std::vector<ScreenRect> rects;
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<float> ndc(-1.0f, 0.9f), size(0.01f, 0.4f), w(1.0f, 80.0f);
+    for (int k = 0; k < 200; ++k) {
+        const float x = ndc(rng), y = ndc(rng);
+        rects.push_back({x, y, x + size(rng), y + size(rng), w(rng)});
+    }
+    std::vector<Aabb> boxes;
+    for (const Object& o : city.objects) boxes.push_back(o.world_bounds);
+    const WorldTriangles occludee = gather_world_triangles(city, {std::uint32_t(city.objects.size() - 1)});
+    const TriangleInput occludee_input = occludee.input(clip);
+    std::vector<Visibility> answers(std::max(rects.size(), boxes.size()));
+
+    const ParallelFor serial{}, job_system{&run_backwards, nullptr, 2};
+    for (const bool sample_depth : {false, true})
+        for (const ParallelFor* parallel : {&serial, &job_system}) {
+            const std::string what = std::string(sample_depth ? "per-sample depth, " : "") + (parallel->run ? "job system" : "serial");
+            OcclusionBuffer buffer(test::buffer_config(320, 180, 1, float(street.near_plane), sample_depth));
+            const auto frames = [&] {
+                buffer.render_frame(soup, *parallel);
+                buffer.render_frame(city_input, *parallel);
+                buffer.render_frame(clustered, *parallel);
+                buffer.render(city_input, *parallel);  // a second input into the same frame
+            };
+            const auto queries = [&] {
+                for (const ScreenRect& r : rects) (void)buffer.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
+                buffer.test_rects(rects.data(), rects.size(), answers.data());
+                for (const Aabb& b : boxes) (void)buffer.test_aabb(&b.min.x, &b.max.x, clip);
+                buffer.test_aabbs(boxes.data(), boxes.size(), clip, answers.data());
+                (void)buffer.test_triangles(occludee_input);
+            };
+            frames();  // the first frame may allocate (draw order, scratch sized to the input)
+            queries();
+            EXPECT_EQ(allocations_of(frames), 0u) << what;
+            EXPECT_EQ(allocations_of(queries), 0u) << what;
+            EXPECT_GT(buffer.stats().rasterized, 0u) << what;  // the frames drew something
+        }
+}
+
+}  // namespace
+}  // namespace homcull
