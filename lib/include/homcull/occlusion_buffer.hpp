@@ -58,7 +58,7 @@ enum class Visibility : std::uint8_t { visible, occluded, view_culled };
 
 struct BufferConfig {
     int width = 0, height = 0;  // pixels, >= 1
-    int samples = 1;            // S: S x S samples per pixel, 1, 2 or 4
+    int samples = 1;            // S: S x S samples per pixel, 1, 2 or 4 (SceneCuller: automatic_samples)
     // Triangles are clipped at clip w >= near_w (the camera's near distance for a standard
     // perspective projection). Occludees reaching w < near_w are visible.
     float near_w = 0.1f;
@@ -209,7 +209,10 @@ public:
     };
     static constexpr int kSubtileWidth = 8, kSubtileHeight = 4;
 
-    // Throws homcull::Error on an invalid configuration. All memory is allocated here.
+    // Throws homcull::Error on an invalid configuration. The buffer's planes and pyramid are
+    // allocated here; the first render sizes its scratch (draw order, clusters, bins) to its
+    // input, and from then on renders of inputs no larger, and every query, allocate nothing
+    // (tested: FrameAllocations.NoneAfterTheFirstFrame).
     explicit OcclusionBuffer(const BufferConfig& config);
 
     void clear();
