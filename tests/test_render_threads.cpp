@@ -16,6 +16,7 @@
 #include <new>
 #include <numeric>
 #include <random>
+#include <thread>
 
 namespace homcull {
 namespace {
@@ -219,6 +220,80 @@ TEST(RenderThreads, ARenderFailingPartWayLeavesAMatchingConservativeBuffer) {
                 EXPECT_LT(failures, 12);  // and a render that did not fail
             }
         }
+    }
+}
+
+// Queries are thread-safe while no render is in flight: four threads asking every kind of
+// question at once, each in its own order, get the answers one thread gets.
+TEST(RenderThreads, QueriesFromManyThreadsAnswerAsOneThread) {
+    const Scene city = generate_scene("city:seed=8,blocks=6");
+    const WorldTriangles occluders = gather_world_triangles(city, objects_with_role(city, "occluder"));
+    Camera street;
+    street.eye = {-3, 1.7, -40};
+    street.target = {10, 3, 20};
+    const auto clip = clip_from_world(street, 320.0 / 180.0);
+    OcclusionBuffer buffer(test::buffer_config(320, 180, 1, float(street.near_plane), /*sample_depth=*/true));
+    buffer.render(occluders.input(clip));
+
+    std::vector<ScreenRect> rects;
+    std::mt19937_64 rng(21);
+    std::uniform_real_distribution<float> ndc(-1.1f, 1.0f), size(0.005f, 0.5f), w(1.0f, 60.0f);
+    for (int k = 0; k < 3000; ++k) {
+        const float x = ndc(rng), y = ndc(rng);
+        rects.push_back({x, y, x + size(rng), y + size(rng), w(rng)});
+    }
+    std::vector<Aabb> boxes;
+    std::vector<WorldTriangles> objects;
+    for (std::uint32_t id = 0; id < city.objects.size(); ++id) {
+        boxes.push_back(city.objects[id].world_bounds);
+        objects.push_back(gather_world_triangles(city, {id}));
+    }
+    // Every answer, in the order `start` rotates the questions by.
+    struct Answers {
+        std::vector<Visibility> rect, rects, box, boxes, triangles;
+        std::vector<std::uint64_t> samples;
+    };
+    const auto ask = [&](std::size_t start) {
+        Answers a;
+        a.rect.resize(rects.size());
+        a.rects.resize(rects.size());
+        a.box.resize(boxes.size());
+        a.boxes.resize(boxes.size());
+        a.triangles.resize(objects.size());
+        a.samples.resize(objects.size());
+        for (std::size_t n = 0; n < rects.size(); ++n) {
+            const std::size_t k = (n + start) % rects.size();
+            a.rect[k] = buffer.test_rect(rects[k].ndc_min_x, rects[k].ndc_min_y, rects[k].ndc_max_x, rects[k].ndc_max_y, rects[k].w_min);
+        }
+        buffer.test_rects(rects.data(), rects.size(), a.rects.data());
+        for (std::size_t n = 0; n < boxes.size(); ++n) {
+            const std::size_t k = (n + start) % boxes.size();
+            a.box[k] = buffer.test_aabb(&boxes[k].min.x, &boxes[k].max.x, clip);
+        }
+        buffer.test_aabbs(boxes.data(), boxes.size(), clip, a.boxes.data());
+        for (std::size_t n = 0; n < objects.size(); ++n) {
+            const std::size_t k = (n + start) % objects.size();
+            const OcclusionBuffer::TriangleTest t = buffer.test_triangles(objects[k].input(clip));
+            a.triangles[k] = t.visibility;
+            a.samples[k] = t.samples;
+        }
+        return a;
+    };
+    const Answers one = ask(0);
+    EXPECT_GT(std::count(one.box.begin(), one.box.end(), Visibility::occluded), 0);  // both answers are exercised
+    EXPECT_GT(std::count(one.box.begin(), one.box.end(), Visibility::visible), 0);
+    constexpr int kThreads = 4;
+    std::vector<Answers> many(kThreads);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) threads.emplace_back([&, t] { many[std::size_t(t)] = ask(std::size_t(t) * 997); });
+    for (std::thread& t : threads) t.join();
+    for (const Answers& a : many) {
+        EXPECT_EQ(a.rect, one.rect);
+        EXPECT_EQ(a.rects, one.rect);
+        EXPECT_EQ(a.box, one.box);
+        EXPECT_EQ(a.boxes, one.box);
+        EXPECT_EQ(a.triangles, one.triangles);
+        EXPECT_EQ(a.samples, one.samples);
     }
 }
 
