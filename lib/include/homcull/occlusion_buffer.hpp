@@ -261,10 +261,14 @@ public:
     void render(const ClusteredInput& input, const ParallelFor& parallel = {});
     void render_frame(const ClusteredInput& input, const ParallelFor& parallel = {});
 
-    // Occludee tests. Thread-safe with each other (no render in flight).
+    // Occludee tests. Thread-safe with each other (no render in flight; tested:
+    // RenderThreads.QueriesFromManyThreadsAnswerAsOneThread).
     // Screen rectangle in NDC (y up) with the nearest clip w of the occludee. Occluded when
     // every sample whose centre lies in it has an occluder nearer than w_min, by the subtile
     // bounds: d0, or max(d0, d1) where the rectangle's samples are all in the working layer.
+    // So a rectangle (inside the view) that holds no sample centre is occluded, even in an
+    // empty buffer: it covers nothing the buffer's samples (the display's pixel centres, when
+    // they are its samples) could show.
     // Answered with a pyramid of the farthest depth (Greene, Kass, Miller, "Hierarchical
     // Z-buffer visibility", SIGGRAPH 1993): a coarse check, then a pruned search.
     Visibility test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
