@@ -22,13 +22,27 @@
 # below mirror that target (C++17, -ffp-contract=off, include dirs lib/include and lib), the
 # top-level Release flags (-O3 -DNDEBUG) and cmake/HomcullWarnings.cmake.
 #
-# Usage: scripts/check-neon.sh [extra compiler flags, e.g. -Werror]
-#   Installs g++-aarch64-linux-gnu with apt-get when it is missing and the script runs as root.
-#   AARCH64_CXX overrides the compiler (default aarch64-linux-gnu-g++).
-# Exit status: 0 when everything compiled and the NEON symbols are there, 1 otherwise,
-# 2 when the cross compiler or the Highway/GLM headers are missing.
+# With --run it then also runs them: tests/isa_bits_check.cpp (every instruction set against
+# the scalar reference path: buffer bits, statistics, rectangle, box, triangle and maps answers)
+# is linked with those objects and the arm64 builds of Highway's and meshoptimizer's libraries
+# (Debian multiarch), and run under qemu-aarch64 with -cpu max, which has NEON, SVE and SVE2,
+# at SVE vector lengths of 128, 256 and 512 bits (about 5 minutes in all).
+#
+# Usage: scripts/check-neon.sh [--run] [extra compiler flags, e.g. -Werror]
+#   Installs g++-aarch64-linux-gnu with apt-get when it is missing and the script runs as root;
+#   with --run also qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64 (adding the
+#   arm64 architecture to dpkg). AARCH64_CXX overrides the compiler (default aarch64-linux-gnu-g++).
+# Exit status: 0 when everything compiled, the NEON symbols are there and (--run) every
+# instruction set gave the scalar reference's bits; 1 otherwise; 2 when a tool or library is
+# missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+run=0
+if [ "${1:-}" = "--run" ]; then
+  run=1
+  shift
+fi
 
 cxx=${AARCH64_CXX:-aarch64-linux-gnu-g++}
 nm=aarch64-linux-gnu-nm
@@ -132,3 +146,38 @@ if [ "$neon_ops" -eq 0 ]; then
 fi
 echo "check-neon: OK: ${#sources[@]} sources of homcull_core compile for aarch64;" \
   "N_NEON::RasterizeRows has $neon_ops NEON vector instructions"
+
+[ "$run" -eq 1 ] || exit 0
+
+# --- Run every instruction set against the scalar reference, under qemu ------------------------
+arm_libs=(/usr/lib/aarch64-linux-gnu/libhwy.so.1 /usr/lib/aarch64-linux-gnu/libmeshoptimizer.so.2d)
+missing=0
+command -v qemu-aarch64-static >/dev/null 2>&1 || missing=1
+for lib in "${arm_libs[@]}"; do [ -e "$lib" ] || missing=1; done
+if [ "$missing" -eq 1 ]; then
+  if [ "$(id -u)" -eq 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "check-neon: installing qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64..."
+    dpkg --add-architecture arm64
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-user-static libhwy1:arm64 libmeshoptimizer2d:arm64 >/dev/null
+  else
+    echo "check-neon: --run needs qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64, e.g." >&2
+    echo "  sudo dpkg --add-architecture arm64 && sudo apt-get update &&" \
+      "sudo apt-get install qemu-user-static libhwy1:arm64 libmeshoptimizer2d:arm64" >&2
+    exit 2
+  fi
+fi
+echo "check-neon: linking tests/isa_bits_check.cpp for aarch64"
+"$cxx" "${flags[@]}" tests/isa_bits_check.cpp "$tmp"/obj/*.o "${arm_libs[@]}" -o "$tmp/isa_bits_check"
+for bytes in 16 32 64; do
+  echo "check-neon: running it under qemu-aarch64 -cpu max with SVE vectors of $((bytes * 8)) bits"
+  if ! QEMU_LD_PREFIX=/usr/aarch64-linux-gnu LD_LIBRARY_PATH=/usr/lib/aarch64-linux-gnu \
+    qemu-aarch64-static -cpu "max,sve-default-vector-length=$bytes" "$tmp/isa_bits_check"; then
+    status=1
+  fi
+done
+if [ "$status" -ne 0 ]; then
+  echo "check-neon: FAILED: an instruction set differs from the scalar reference on aarch64" >&2
+  exit 1
+fi
+echo "check-neon: OK: NEON, SVE and SVE2 give the scalar reference's bits and answers (qemu-aarch64)"
