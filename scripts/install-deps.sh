@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libglm-dev                      # math vocabulary (the only dependency of the core library)
+  libglm-dev                      # math vocabulary (the core library's public headers use it)
   libembree-dev libtbb-dev        # ground truth ray casts; TBB drives the tools' parallel-for
   libopenimageio-dev openimageio-tools  # image dumps (id images, buffer and pyramid EXR/PNG dumps)
   fonts-dejavu-core               # the legend text of the PNG dumps (OIIO render_text; its default font is not packaged)
@@ -19,6 +19,7 @@ packages=(
   assimp-testmodels               # test data: the IFC source of fzk_haus.glb, for the IFC import test
   libgtest-dev libgmock-dev libbenchmark-dev
   g++-aarch64-linux-gnu           # the test that the SIMD kernels compile for Arm NEON/SVE (scripts/check-neon.sh)
+  qemu-user-static libhwy1:arm64 libmeshoptimizer2d:arm64  # ... and run there with the scalar path's bits (check-neon.sh --run)
 )
 
 sudo_cmd=()
@@ -34,5 +35,12 @@ if [ ${#missing[@]} -eq 0 ]; then
 fi
 echo "install-deps: installing ${missing[*]}" >&2
 export DEBIAN_FRONTEND=noninteractive
+# Packages of another architecture (name:arch, Debian multiarch) need it added to dpkg first.
+for p in "${missing[@]}"; do
+  case "$p" in
+    *:*) arch=${p##*:}
+         dpkg --print-foreign-architectures | grep -qx "$arch" || "${sudo_cmd[@]}" dpkg --add-architecture "$arch" ;;
+  esac
+done
 "${sudo_cmd[@]}" apt-get update -q
 "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"

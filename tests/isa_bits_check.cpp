@@ -6,13 +6,16 @@
 // and as clusters, at 1, 2 and 4 samples per axis, with and without per-sample depth, on one
 // thread and through a job system; then asks the buffer rectangles, boxes and occludee
 // triangles, and the occlusion maps rectangles under every depth test. Prints one line per
-// instruction set and exits 1 on any difference.
+// instruction set and exits 1 on any difference, or when an instruction set named on the
+// command line is not available.
 #include <homcull/camera.hpp>
 #include <homcull/generate.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/occlusion_maps.hpp>
 #include <homcull/world_triangles.hpp>
+
+#include "clip_soup.hpp"
 
 #include <array>
 #include <cstdio>
@@ -25,22 +28,6 @@
 namespace {
 
 using namespace homcull;
-
-// Clip-space triangles (12 floats each): centres in NDC [-1.2, 1.2]^2, up to max_size NDC
-// across, w in [1, 80] per vertex.
-std::vector<float> random_soup(std::uint64_t seed, int count, float max_size) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<float> centre(-1.2f, 1.2f), offset(-1.0f, 1.0f), w(1.0f, 80.0f);
-    std::vector<float> xyzw;
-    for (int t = 0; t < count; ++t) {
-        const float cx = centre(rng), cy = centre(rng), size = max_size * (0.05f + 0.95f * (offset(rng) * 0.5f + 0.5f));
-        for (int k = 0; k < 3; ++k) {
-            const float vw = w(rng);
-            xyzw.insert(xyzw.end(), {(cx + size * offset(rng)) * vw, (cy + size * offset(rng)) * vw, 0.0f, vw});
-        }
-    }
-    return xyzw;
-}
 
 // A job system that runs the tasks last to first, on the calling thread.
 void run_backwards(void*, std::size_t count, void (*task)(void*, std::size_t), void* data) {
@@ -98,9 +85,9 @@ Outcome run(const Inputs& in, int samples, bool sample_depth, bool job_system) {
             o.subtile_floats.insert(o.subtile_floats.end(), {s.d0, s.d1});
             o.subtile_masks.insert(o.subtile_masks.end(), {s.mask, s.covered});
         }
-        std::vector<float> depth;
-        buffer.read_depth(depth);
-        o.depth.insert(o.depth.end(), depth.begin(), depth.end());
+        std::vector<float> read_back;
+        buffer.read_depth(read_back);
+        o.depth.insert(o.depth.end(), read_back.begin(), read_back.end());
         const RasterStats& s = buffer.stats();
         o.stats.insert(o.stats.end(), {s.triangles_in, s.invalid, s.outside, s.near_clipped, s.too_large, s.backface_culled, s.degenerate,
                                        s.rasterized, s.subtiles_updated});
@@ -132,15 +119,7 @@ Outcome run(const Inputs& in, int samples, bool sample_depth, bool job_system) {
             }
         }
     };
-    const std::vector<float>& soup = in.soup;
-    TriangleInput soup_input;
-    soup_input.positions = soup.data();
-    soup_input.position_components = 4;
-    soup_input.position_stride = 4 * sizeof(float);
-    soup_input.vertex_count = soup.size() / 4;
-    soup_input.triangle_count = soup.size() / 12;
-    soup_input.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    soup_input.backface = Backface::none;
+    const TriangleInput soup_input = test::clip_space_input(in.soup);
     buffer.render_frame(soup_input, parallel);
     record();
     buffer.render_frame(in.occluders.input(in.clip), parallel);
@@ -152,10 +131,11 @@ Outcome run(const Inputs& in, int samples, bool sample_depth, bool job_system) {
 
 }  // namespace
 
-int main() {
+// Arguments: the instruction sets to check (default: every one available but scalar).
+int main(int argc, char** argv) {
     try {
         Inputs in;
-        in.soup = random_soup(7, 6000, 0.3f);
+        in.soup = test::random_clip_triangles(7, 6000, 0.3f);
         in.city = generate_scene("city:seed=8,blocks=6");
         in.occluders = gather_world_triangles(in.city, objects_with_role(in.city, "occluder"));
         in.clusters = build_occluder_clusters(in.occluders.positions.data(), 3 * sizeof(float), in.occluders.positions.size() / 3,
@@ -165,24 +145,22 @@ int main() {
         street.eye = {-3, 1.7, -40};
         street.target = {10, 3, 20};
         in.clip = clip_from_world(street, 157.0 / 93.0);
-        std::mt19937_64 rng(3);
-        std::uniform_real_distribution<float> ndc(-1.1f, 1.0f), size(0.005f, 0.5f), w(0.5f, 80.0f);
-        for (int k = 0; k < 2000; ++k) {
-            const float x = ndc(rng), y = ndc(rng);
-            in.rects.push_back({x, y, x + size(rng), y + size(rng), w(rng)});
-        }
+        in.rects = test::random_screen_rects(3, 2000);
         for (std::uint32_t id = 0; id < in.city.objects.size(); ++id) {
             in.boxes.push_back(in.city.objects[id].world_bounds);
             if (id % 3 == 0) in.objects.push_back(gather_world_triangles(in.city, {id}));
         }
 
-        const std::vector<std::string> isas = available_isas();
+        const std::vector<std::string> available = available_isas();
         std::printf("isa_bits_check: available:");
-        for (const std::string& isa : isas) std::printf(" %s", isa.c_str());
+        for (const std::string& isa : available) std::printf(" %s", isa.c_str());
         std::printf("\n");
+        std::vector<std::string> isas(argv + 1, argv + argc);
+        if (isas.empty())
+            for (const std::string& isa : available)
+                if (isa != "scalar") isas.push_back(isa);
         int failures = 0;
         for (const std::string& isa : isas) {
-            if (isa == "scalar") continue;
             int configurations = 0, different = 0;
             for (const int samples : {1, 2, 4})
                 for (const bool sample_depth : {false, true})
@@ -203,7 +181,7 @@ int main() {
             failures += different;
         }
         select_isa("best");
-        return failures == 0 && isas.size() > 1 ? 0 : 1;
+        return failures == 0 && !isas.empty() ? 0 : 1;  // select_isa threw for a name not available
     } catch (const std::exception& e) {
         std::fprintf(stderr, "isa_bits_check: %s\n", e.what());
         return 1;

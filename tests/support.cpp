@@ -56,20 +56,6 @@ Camera camera_down_minus_z(double fov_y_degrees, double near_plane, double far_p
     return c;
 }
 
-std::vector<float> random_clip_triangles(std::uint64_t seed, int count, float max_size, float extent) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<float> ndc(-extent, extent), w(1.0f, 80.0f), size(0.005f, max_size);
-    std::vector<float> xyzw;
-    for (int t = 0; t < count; ++t) {
-        const float cx = ndc(rng), cy = ndc(rng), r = size(rng);
-        for (int k = 0; k < 3; ++k) {
-            const float wk = w(rng);
-            xyzw.insert(xyzw.end(), {(cx + r * float(k == 1) - r * float(k == 2)) * wk, (cy + r * float(k == 2)) * wk, 0.0f, wk});
-        }
-    }
-    return xyzw;
-}
-
 BufferConfig buffer_config(int width, int height, int samples, float near_w, bool sample_depth) {
     BufferConfig c;
     c.width = width;
@@ -78,18 +64,6 @@ BufferConfig buffer_config(int width, int height, int samples, float near_w, boo
     c.near_w = near_w;
     c.sample_depth = sample_depth;
     return c;
-}
-
-TriangleInput clip_space_input(const std::vector<float>& xyzw) {
-    TriangleInput in;
-    in.positions = xyzw.data();
-    in.position_components = 4;
-    in.position_stride = 16;
-    in.vertex_count = xyzw.size() / 4;
-    in.triangle_count = in.vertex_count / 3;
-    in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    in.backface = Backface::none;
-    return in;
 }
 
 std::string temp_dir(const std::string& test_name) {

@@ -4,6 +4,8 @@
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/scene.hpp>
 
+#include "clip_soup.hpp"  // random_clip_triangles, clip_space_input
+
 #include <string>
 #include <vector>
 
@@ -20,14 +22,9 @@ std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::
 // A camera at the origin looking down -z with the given vertical field of view.
 Camera camera_down_minus_z(double fov_y_degrees = 90.0, double near_plane = 0.1, double far_plane = 1000.0);
 
-// `count` random small triangles as clip-space xyzw (12 floats each): centres uniform in NDC
-// [-1.2, 1.2]^2 (or `extent`), sizes up to `max_size` NDC, w uniform in [1, 80] per vertex.
-std::vector<float> random_clip_triangles(std::uint64_t seed, int count, float max_size, float extent = 1.2f);
 // A buffer configuration: width x height pixels of samples x samples, clipped at near_w.
 BufferConfig buffer_config(int width, int height, int samples, float near_w, bool sample_depth = false);
 
-// An identity-matrix TriangleInput over clip-space xyzw triangles, no backface culling.
-TriangleInput clip_space_input(const std::vector<float>& xyzw);
 
 // A "job system" (ParallelFor::run, user = a std::mt19937_64) that runs the tasks in a
 // shuffled order on the calling thread.

@@ -81,13 +81,7 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
     const ClusteredInput clustered{&clusters, clip, Backface::none};
 
     // Queries: rectangles, boxes (the scene's objects) and one object's triangles.
-    std::vector<ScreenRect> rects;
-    std::mt19937_64 rng(3);
-    std::uniform_real_distribution<float> ndc(-1.0f, 0.9f), size(0.01f, 0.4f), w(1.0f, 80.0f);
-    for (int k = 0; k < 200; ++k) {
-        const float x = ndc(rng), y = ndc(rng);
-        rects.push_back({x, y, x + size(rng), y + size(rng), w(rng)});
-    }
+    const std::vector<ScreenRect> rects = test::random_screen_rects(3, 200);
     std::vector<Aabb> boxes;
     for (const Object& o : city.objects) boxes.push_back(o.world_bounds);
     const WorldTriangles occludee = gather_world_triangles(city, {std::uint32_t(city.objects.size() - 1)});

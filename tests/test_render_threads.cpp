@@ -235,13 +235,7 @@ TEST(RenderThreads, QueriesFromManyThreadsAnswerAsOneThread) {
     OcclusionBuffer buffer(test::buffer_config(320, 180, 1, float(street.near_plane), /*sample_depth=*/true));
     buffer.render(occluders.input(clip));
 
-    std::vector<ScreenRect> rects;
-    std::mt19937_64 rng(21);
-    std::uniform_real_distribution<float> ndc(-1.1f, 1.0f), size(0.005f, 0.5f), w(1.0f, 60.0f);
-    for (int k = 0; k < 3000; ++k) {
-        const float x = ndc(rng), y = ndc(rng);
-        rects.push_back({x, y, x + size(rng), y + size(rng), w(rng)});
-    }
+    const std::vector<ScreenRect> rects = test::random_screen_rects(21, 3000);
     std::vector<Aabb> boxes;
     std::vector<WorldTriangles> objects;
     for (std::uint32_t id = 0; id < city.objects.size(); ++id) {

@@ -493,8 +493,11 @@ struct NamedTarget {
     const char* name;
     std::int64_t bits;
 };
-const NamedTarget kTargets[] = {{"avx512", HWY_AVX3}, {"avx2", HWY_AVX2}, {"sse4", HWY_SSE4},     {"sve2", HWY_SVE2},
-                                 {"sve", HWY_SVE},       {"neon", HWY_NEON}, {"emu128", HWY_EMU128}};
+// Best first, as Highway prefers them. sve2_128 and sve_256 are Highway's builds for SVE
+// vectors of exactly 128 (with SVE2) and 256 bits: the CPU supports them only at that length.
+const NamedTarget kTargets[] = {{"avx512", HWY_AVX3},      {"avx2", HWY_AVX2},       {"sse4", HWY_SSE4}, {"sve2_128", HWY_SVE2_128},
+                                {"sve_256", HWY_SVE_256},  {"sve2", HWY_SVE2},       {"sve", HWY_SVE},   {"neon", HWY_NEON},
+                                {"emu128", HWY_EMU128}};
 
 }  // namespace
 
