@@ -26,7 +26,7 @@
 # the scalar reference path: buffer bits, statistics, rectangle, box, triangle and maps answers)
 # is linked with those objects and the arm64 builds of Highway's and meshoptimizer's libraries
 # (Debian multiarch), and run under qemu-aarch64 with -cpu max, which has NEON, SVE and SVE2,
-# at SVE vector lengths of 128, 256 and 512 bits (about 4 minutes in all).
+# at SVE vector lengths of 128, 256 and 512 bits (4-6 minutes in all).
 #
 # Usage: scripts/check-neon.sh [--run] [extra compiler flags, e.g. -Werror]
 #   Installs g++-aarch64-linux-gnu with apt-get when it is missing and the script runs as root;
