@@ -7,12 +7,13 @@
 # SVE_256, SVE2_128) from the same code. Code that is fine on x86 can fail there (SVE vectors
 # are sizeless: no arrays of vectors, no sizeof, no vectors as struct members).
 #
-# What: compiles (-c, no linking) every source of homcull_core with the aarch64 cross compiler
-# and the core target's flags; then checks that every source using hwy/foreach_target.h
-# defines functions in namespace N_NEON (and lists the other targets built), and that
+# What: compiles (-c) every source of homcull_core with the aarch64 cross compiler and the core
+# target's flags; then checks that every source using hwy/foreach_target.h defines functions in
+# namespace N_NEON (and lists the other targets built), and that
 # homcull::detail::N_NEON::RasterizeRows exists and uses NEON vector registers. Kernels that
 # are HWY_INLINE (e.g. UpdateSubtileRow) have no symbol of their own; they are compiled, and
-# checked, inside their callers. Nothing is run (no aarch64 machine or emulator is needed).
+# checked, inside their callers. Without --run nothing is linked or run (no aarch64 machine or
+# emulator is needed).
 #
 # Why not CMake with a toolchain file: lib/CMakeLists.txt defines all the libraries in one
 # file and find_package()s TBB, Embree, assimp, OpenImageIO and nlohmann_json unconditionally,
@@ -26,12 +27,14 @@
 # the scalar reference path: buffer bits, statistics, rectangle, box, triangle and maps answers)
 # is linked with those objects and the arm64 builds of Highway's and meshoptimizer's libraries
 # (Debian multiarch), and run under qemu-aarch64 with -cpu max, which has NEON, SVE and SVE2,
-# at SVE vector lengths of 128, 256 and 512 bits (4-6 minutes in all).
+# at SVE vector lengths of 128, 256 and 512 bits (4-6 minutes in all), with the arm64 loader and
+# C library of the same multiarch packages.
 #
 # Usage: scripts/check-neon.sh [--run] [extra compiler flags, e.g. -Werror]
-#   Installs g++-aarch64-linux-gnu with apt-get when it is missing and the script runs as root;
-#   with --run also qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64 (adding the
-#   arm64 architecture to dpkg). AARCH64_CXX overrides the compiler (default aarch64-linux-gnu-g++).
+#   Installs g++-aarch64-linux-gnu with apt-get when it is missing and the script runs as root.
+#   --run needs qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64, which
+#   scripts/install-deps.sh installs; without them it exits 2 (the test suite then counts the
+#   check as skipped). AARCH64_CXX overrides the compiler (default aarch64-linux-gnu-g++).
 # Exit status: 0 when everything compiled, the NEON symbols are there and (--run) every
 # instruction set gave the scalar reference's bits; 1 otherwise; 2 when a tool or library is
 # missing.
@@ -155,17 +158,9 @@ missing=0
 command -v qemu-aarch64-static >/dev/null 2>&1 || missing=1
 for lib in "${arm_libs[@]}"; do [ -e "$lib" ] || missing=1; done
 if [ "$missing" -eq 1 ]; then
-  if [ "$(id -u)" -eq 0 ] && command -v apt-get >/dev/null 2>&1; then
-    echo "check-neon: installing qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64..."
-    dpkg --add-architecture arm64
-    apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-user-static libhwy1:arm64 libmeshoptimizer2d:arm64 >/dev/null
-  else
-    echo "check-neon: --run needs qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64, e.g." >&2
-    echo "  sudo dpkg --add-architecture arm64 && sudo apt-get update &&" \
-      "sudo apt-get install qemu-user-static libhwy1:arm64 libmeshoptimizer2d:arm64" >&2
-    exit 2
-  fi
+  echo "check-neon: --run needs qemu-user-static, libhwy1:arm64 and libmeshoptimizer2d:arm64" \
+    "(scripts/install-deps.sh installs them); skipped" >&2
+  exit 2
 fi
 echo "check-neon: linking tests/isa_bits_check.cpp for aarch64"
 "$cxx" "${flags[@]}" tests/isa_bits_check.cpp "$tmp"/obj/*.o "${arm_libs[@]}" -o "$tmp/isa_bits_check"
@@ -178,8 +173,7 @@ for bytes in 64 32 16; do
     16) isas=(sve2_128 sve2 sve) ;;
   esac
   echo "check-neon: running it under qemu-aarch64 -cpu max with SVE vectors of $((bytes * 8)) bits: ${isas[*]}"
-  if ! QEMU_LD_PREFIX=/usr/aarch64-linux-gnu LD_LIBRARY_PATH=/usr/lib/aarch64-linux-gnu \
-    qemu-aarch64-static -cpu "max,sve-default-vector-length=$bytes" "$tmp/isa_bits_check" "${isas[@]}"; then
+  if ! qemu-aarch64-static -cpu "max,sve-default-vector-length=$bytes" "$tmp/isa_bits_check" "${isas[@]}"; then
     status=1
   fi
 done

@@ -4,7 +4,7 @@
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/scene.hpp>
 
-#include "clip_soup.hpp"  // random_clip_triangles, clip_space_input
+#include "inputs.hpp"  // random_clip_triangles, clip_space_input, random_screen_rects, run_backwards, CityStreet
 
 #include <string>
 #include <vector>

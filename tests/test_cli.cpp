@@ -123,20 +123,24 @@ TEST(Cli, CullRejectsInconsistentOptions) {
     // accuracy's culling options belong to --scene; without it (S1) they would be ignored.
     expect_refused("accuracy --mode approximate --hole 4", 1, "--mode needs --scene");
     // Values out of range are refused, not wrapped or ignored.
-    expect_refused(cull + " --budget -1", kUsageError, "--budget: must not be negative");
+    expect_refused(cull + " --budget -1", kUsageError, "--budget: must be a whole number >= 0");
     expect_refused(cull + " --coarsest-level -5", 1, "coarsest level must be -1");
     expect_refused("accuracy --scene gen:city:seed=2,blocks=3 --orbit 2 --walk 2", kUsageError, "excludes");
     // A bad size names the option it came from.
     expect_refused(cull + " --buffer 0x0", 1, "--buffer: expected WxH between 1x1 and 65536x65536");
     expect_refused(cull + " --deb 64x-3", 1, "--deb: expected WxH");
 
-    // Approximate mode takes any buffer: 4 x 4 samples unless told otherwise (a low-resolution one).
+    // Approximate mode takes any buffer: by default the most samples per pixel (4, 2 or 1) that
+    // fit within the display.
     CliRun r = run_cli(cull + " --buffer 40x20 --samples 2 --mode approximate --hole 2 --json");
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 2);
-    r = run_cli(cull + " --buffer 40x20 --mode approximate --hole 2 --json");
+    r = run_cli(cull + " --buffer 24x12 --mode approximate --hole 2 --json");
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 4);
+    r = run_cli(cull + " --buffer 40x20 --mode approximate --hole 2 --json");  // 4 x 4 would pass the 96 x 54 display
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 2);
     // A buffer whose samples can lie on the display's pixel centres gets those samples.
     r = run_cli(cull + " --buffer 48x27 --json");
     EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -299,7 +303,7 @@ TEST(Cli, BenchPrintsItsTimingsAndRefusesBadOptions) {
     expect_refused("bench --threads 300" + small, 1, "--threads must be in [1, 256]");
     expect_refused("bench --samples 3" + small, 1, "samples per pixel axis must be 1, 2 or 4");
     expect_refused("bench --clusters 124" + small, 1, "--clusters is for --workload castle");
-    expect_refused("bench --workload castle --clusters 7" + small, 1, "--clusters must be a multiple of 4");
+    expect_refused("bench --workload castle --clusters 7" + small, 1, "--clusters 7: build_occluder_clusters: max_triangles must be a multiple of 4");
     expect_refused("bench --s1 " + s1 + " --repeat -1", 1, "--repeat must be at least 1");
     expect_refused("bench --s1 " + s1 + " --resolution 0x0", 1, "--resolution: expected WxH");
 }

@@ -20,11 +20,13 @@
 
 namespace {
 
-std::atomic<bool> counting{false};
+// Only the counting thread's allocations count (a full run of the binary may have other
+// threads, a job system's say, allocating at the same time).
+thread_local bool counting = false;
 std::atomic<std::size_t> allocations{0};
 
 void* counted_allocation(std::size_t size, std::size_t alignment) {
-    if (counting.load(std::memory_order_relaxed)) allocations.fetch_add(1, std::memory_order_relaxed);
+    if (counting) allocations.fetch_add(1, std::memory_order_relaxed);
     if (size == 0) size = 1;
     void* p = alignment <= alignof(std::max_align_t) ? std::malloc(size) : std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
     if (!p) throw std::bad_alloc();
@@ -49,34 +51,26 @@ void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::f
 namespace homcull {
 namespace {
 
-// A job system that allocates nothing itself (test::run_shuffled builds a vector): the tasks
-// last to first, on the calling thread.
-void run_backwards(void*, std::size_t count, void (*task)(void*, std::size_t), void* data) {
-    for (std::size_t i = count; i-- > 0;) task(data, i);
-}
-
 // The allocations `frame` makes.
 template <typename Frame>
 std::size_t allocations_of(Frame&& frame) {
     allocations.store(0);
-    counting.store(true);
+    counting = true;
     frame();
-    counting.store(false);
+    counting = false;
     return allocations.load();
 }
 
 TEST(FrameAllocations, NoneAfterTheFirstFrame) {
     const std::vector<float> soup_xyzw = test::random_clip_triangles(5, 4000, 0.3f);
     const TriangleInput soup = test::clip_space_input(soup_xyzw);
-    const Scene city = generate_scene("city:seed=8,blocks=6");
-    const WorldTriangles occluders = gather_world_triangles(city, objects_with_role(city, "occluder"));
+    const test::CityStreet street;
+    const Scene& city = street.city;
+    const WorldTriangles& occluders = street.occluders;
     const OccluderClusters clusters =
         build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3, occluders.indices.data(),
                                 occluders.triangle_count(), occluders.shared_edges.data(), ClusterLimits{});
-    Camera street;
-    street.eye = {-3, 1.7, -40};
-    street.target = {10, 3, 20};
-    const std::array<float, 16> clip = clip_from_world(street, 320.0 / 180.0);
+    const std::array<float, 16> clip = street.clip(320.0 / 180.0);
     const TriangleInput city_input = occluders.input(clip);
     const ClusteredInput clustered{&clusters, clip, Backface::none};
 
@@ -88,11 +82,11 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
     const TriangleInput occludee_input = occludee.input(clip);
     std::vector<Visibility> answers(std::max(rects.size(), boxes.size()));
 
-    const ParallelFor serial{}, job_system{&run_backwards, nullptr, 2};
+    const ParallelFor serial{}, job_system{&test::run_backwards, nullptr, 2};
     for (const bool sample_depth : {false, true})
         for (const ParallelFor* parallel : {&serial, &job_system}) {
             const std::string what = std::string(sample_depth ? "per-sample depth, " : "") + (parallel->run ? "job system" : "serial");
-            OcclusionBuffer buffer(test::buffer_config(320, 180, 1, float(street.near_plane), sample_depth));
+            OcclusionBuffer buffer(test::buffer_config(320, 180, 1, float(street.camera.near_plane), sample_depth));
             const auto frames = [&] {
                 buffer.render_frame(soup, *parallel);
                 buffer.render_frame(city_input, *parallel);

@@ -220,7 +220,9 @@ TEST(SceneCulling, AutomaticSamplesPutTheBufferOnTheDisplayOrGiveLowResolutionOn
     EXPECT_EQ(automatic_samples(display, {640, 360}), 2);
     EXPECT_EQ(automatic_samples(display, {320, 180}), 4);
     EXPECT_EQ(automatic_samples({1920, 1080}, {256, 128}), 4);  // low resolution, not on the display's grid
-    EXPECT_EQ(automatic_samples(display, {1280, 360}), 4);      // fewer pixels on one axis
+    EXPECT_EQ(automatic_samples({1920, 1080}, {600, 300}), 2);  // 4 x 4 would pass the display
+    EXPECT_EQ(automatic_samples(display, {1280, 360}), 1);      // as wide as the display
+    EXPECT_EQ(automatic_samples(display, {1200, 700}), 1);      // a little smaller: not 16 times the samples
     EXPECT_EQ(automatic_samples(display, {2560, 1440}), 1);     // more than the display
 
     SceneCullerConfig c;

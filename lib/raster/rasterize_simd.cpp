@@ -514,13 +514,11 @@ bool hidden_skip_enabled() { return skip_hidden; }
 
 namespace {
 
-// select_isa's target (0: every one the CPU supports). Highway's SupportedTargets() returns
-// only this one while it is set, so the CPU's own are read with it lifted for a moment.
-std::int64_t forced_targets = 0;
+// The CPU's own targets, read once, before select_isa forces one: while a target is forced,
+// Highway's SupportedTargets() returns only that one. (Lifting the force to read them again
+// would change what renders and queries on other threads dispatch to.)
 std::int64_t cpu_targets() {
-    hwy::SetSupportedTargetsForTest(0);
-    const std::int64_t cpu = hwy::SupportedTargets();
-    hwy::SetSupportedTargetsForTest(forced_targets);
+    static const std::int64_t cpu = hwy::SupportedTargets();
     return cpu;
 }
 
@@ -536,6 +534,7 @@ std::vector<std::string> available_isas() {
 
 // Checks the name first: a name that cannot be selected throws and leaves the selection as it was.
 void select_isa(const std::string& name) {
+    (void)cpu_targets();  // read before anything is forced
     bool scalar = false;
     std::int64_t bits = 0;  // best
     if (name == "scalar") {
@@ -553,7 +552,6 @@ void select_isa(const std::string& name) {
     }
     detail::use_reference = scalar;
     if (scalar) return;  // the SIMD targets stay as they were: the scalar paths do not dispatch
-    forced_targets = bits;
     hwy::SetSupportedTargetsForTest(bits);
 }
 

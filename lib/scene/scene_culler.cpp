@@ -7,6 +7,7 @@
 #include "scene/scene_culler_frame.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <string>
 
 namespace homcull {
@@ -25,9 +26,9 @@ OcclusionMapsConfig maps_config(const SceneCullerConfig& c) {
 
 int automatic_samples(Resolution display, Resolution buffer) {
     if (buffer.width == 0 && buffer.height == 0) return 1;
-    for (const int s : {1, 2, 4})
-        if (buffer.width * s == display.width && buffer.height * s == display.height) return s;
-    return buffer.width < display.width || buffer.height < display.height ? 4 : 1;
+    for (const int s : {4, 2})
+        if (std::int64_t(buffer.width) * s <= display.width && std::int64_t(buffer.height) * s <= display.height) return s;
+    return 1;
 }
 
 BufferConfig scene_buffer_config(const SceneCullerConfig& c, float near_w) {

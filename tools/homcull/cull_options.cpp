@@ -11,13 +11,24 @@
 
 namespace homcull::cli {
 
+namespace {
+
+// A count given on the command line: digits only. (Read into a size_t, "-1" would wrap.)
+const CLI::Validator kWholeNumber(
+    [](const std::string& v) {
+        return !v.empty() && v.find_first_not_of("0123456789") == std::string::npos ? std::string() : "must be a whole number >= 0";
+    },
+    "N >= 0");
+
+}  // namespace
+
 void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     if (with_display) {
         app.add_option("--resolution", o.resolution, "Display resolution WxH: the answers are right for its pixel centres")
             ->capture_default_str();
         app.add_option("--samples", o.samples,
-                       "S x S coverage samples per buffer pixel (1, 2 or 4; default: the S that puts the buffer's samples on the "
-                       "display's pixel centres, else 4 for a buffer smaller than the display, 1 for one as large)")
+                       "S x S coverage samples per buffer pixel (1, 2 or 4; default: the largest whose buffer x S samples fit "
+                       "within the display, so 4 for a buffer a quarter of the display or smaller)")
             ->check(CLI::IsMember({1, 2, 4}));
     }
     app.add_option("--buffer", o.buffer, "Occlusion buffer WxH (default: display / samples, the display's own pixel centres; with --samples unset, the display)");
@@ -50,8 +61,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "Drop candidates with more than F times the median triangles per unit of box surface (Zhang's complexity "
                    "filter); 0: keep all")
         ->capture_default_str()
-        ->check(CLI::Validator([](const std::string& v) { return v.find('-') == std::string::npos ? std::string() : "must not be negative"; },
-                               "N >= 0"));
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--strategy", o.strategy,
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
                    "to back) or temporal (last frame's visible candidates plus those new in the frustum)")
@@ -65,8 +75,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--budget", o.budget, "Occluder triangles per frame at most (0: no limit)")
         ->capture_default_str()
-        ->check(CLI::Validator([](const std::string& v) { return v.find('-') == std::string::npos ? std::string() : "must not be negative"; },
-                               "N >= 0"));
+        ->check(kWholeNumber);
     app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
         ->capture_default_str()->check(CLI::PositiveNumber);
     app.add_option("--hierarchy", o.hierarchy, "on: test the object hierarchy's nodes and skip what a hidden node holds; off: test "

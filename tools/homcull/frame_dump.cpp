@@ -48,7 +48,7 @@ std::vector<std::uint32_t> write_frame_dump(const SceneCuller& culler, const Ray
 
     const OcclusionBuffer& buffer = culler.buffer();
     fmt::print(to, "buffer     {}x{} pixels of {}x{} samples; {} pyramid levels\n", buffer.config().width, buffer.config().height,
-               culler.config().samples, culler.config().samples, culler.maps().levels());
+               buffer.config().samples, buffer.config().samples, culler.maps().levels());
     fmt::print(to, "wrote      {} ({} parts, {} bytes, {:.0f} ms)\n", exr, parts.size(), std::filesystem::file_size(exr), exr_ms);
     for (const ColormapPng& p : pngs) {
         const std::string range = p.finite ? fmt::format("[{:.5g}, {:.5g}]", p.range_min, p.range_max) : "no finite values";

@@ -5,6 +5,7 @@
 #include <homcull/io/scene_io.hpp>
 #include <homcull/soup_subdivision.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -98,8 +99,15 @@ Resolution parse_resolution(const std::string& text, const std::string& option) 
     if (end == text.c_str() || (*end != 'x' && *end != 'X' && *end != ',')) throw Error(expected);
     const char* rest = end + 1;
     const long h = std::strtol(rest, &end, 10);
-    if (end == rest || *end != '\0' || w < 1 || h < 1 || w > 65536 || h > 65536) throw Error(expected);
-    return Resolution{int(w), int(h)};
+    if (end == rest || *end != '\0') throw Error(expected);
+    const auto to_int = [](long v) { return int(std::max(-1L, std::min(v, 1L << 30))); };  // out of range either way
+    const Resolution r{to_int(w), to_int(h)};
+    try {
+        validate_resolution(r);  // the one definition of a valid size
+    } catch (const Error&) {
+        throw Error(expected);
+    }
+    return r;
 }
 
 long long now_ns() {

@@ -58,7 +58,7 @@ enum class Visibility : std::uint8_t { visible, occluded, view_culled };
 
 struct BufferConfig {
     int width = 0, height = 0;  // pixels, >= 1
-    int samples = 1;            // S: S x S samples per pixel, 1, 2 or 4 (SceneCuller: automatic_samples)
+    int samples = 1;            // S: S x S samples per pixel, 1, 2 or 4 (SceneCuller picks it from its display)
     // Triangles are clipped at clip w >= near_w (the camera's near distance for a standard
     // perspective projection). Occludees reaching w < near_w are visible.
     float near_w = 0.1f;
@@ -261,8 +261,9 @@ public:
     void render(const ClusteredInput& input, const ParallelFor& parallel = {});
     void render_frame(const ClusteredInput& input, const ParallelFor& parallel = {});
 
-    // Occludee tests. Thread-safe with each other (no render in flight; tested:
-    // RenderThreads.QueriesFromManyThreadsAnswerAsOneThread).
+    // Occludee tests. Thread-safe with each other (no render in flight): they only read the
+    // buffer (RenderThreads.QueriesFromManyThreadsAnswerAsOneThread compares the answers of
+    // four threads asking at once with one thread's).
     // Screen rectangle in NDC (y up) with the nearest clip w of the occludee. Occluded when
     // every sample whose centre lies in it has an occluder nearer than w_min, by the subtile
     // bounds: d0, or max(d0, d1) where the rectangle's samples are all in the working layer.

@@ -48,7 +48,8 @@ struct SceneCullerConfig {
     // sample elsewhere says nothing about the display's pixel centres.
     Resolution buffer{0, 0};
     // S x S coverage samples per buffer pixel: 1, 2 or 4, or 0 for automatic_samples(display,
-    // buffer): 1 for a buffer the display's size, 4 x 4 for a low-resolution one.
+    // buffer): 1 for a buffer the display's size, 4 x 4 for a low-resolution one (a quarter of
+    // the display or less).
     int samples = 0;
     OcclusionMapsConfig maps;  // display_width/height are taken from `display`
     // Back faces are surfaces to ground truth and to the eye: none are culled by default.
@@ -213,11 +214,12 @@ private:
     bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
 };
 
-// The samples per buffer pixel axis that SceneCullerConfig::samples = 0 stands for: the S in
-// {1, 2, 4} that puts the buffer's samples on the display's pixel centres (buffer x S = display;
-// S = 1 for buffer 0 x 0, the display itself); for any other buffer, 4 when it has fewer pixels
-// than the display on either axis (a low-resolution buffer: 4 x 4 samples per pixel, as Intel's
-// Masked Occlusion Culling uses), else 1.
+// The samples per buffer pixel axis that SceneCullerConfig::samples = 0 stands for: the largest
+// S in {4, 2, 1} whose buffer x S samples fit within the display on both axes. A low-resolution
+// buffer (a quarter of the display or less on each axis) gets 4 x 4, as Intel's Masked
+// Occlusion Culling uses; a buffer of display / S gets S, its samples on the display's pixel
+// centres; buffer 0 x 0 (the display itself) and any buffer more than half the display on an
+// axis get 1, so that a buffer never holds more samples than the display has pixels.
 int automatic_samples(Resolution display, Resolution buffer);
 
 // The buffer configuration a SceneCullerConfig asks for (resolved buffer size), for callers

@@ -1,9 +1,14 @@
 #pragma once
-// Random clip-space triangle soups, as workload S1 gives triangles, and screen rectangles to
-// test, for the test suite and for
-// tests/isa_bits_check.cpp (which needs only homcull::core): header-only for that reason.
+// Inputs shared by the test suite and tests/isa_bits_check.cpp, which needs only homcull::core
+// (header-only for that reason): random clip-space triangle soups, as workload S1 gives
+// triangles; random screen rectangles to test; a job system that allocates nothing; the
+// generated city seen from its street.
+#include <homcull/camera.hpp>
+#include <homcull/generate.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/world_triangles.hpp>
 
+#include <array>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -51,5 +56,24 @@ inline std::vector<ScreenRect> random_screen_rects(std::uint64_t seed, int count
     }
     return rects;
 }
+
+// A job system (ParallelFor::run) that runs the tasks last to first on the calling thread, and
+// allocates nothing itself.
+inline void run_backwards(void*, std::size_t count, void (*task)(void*, std::size_t), void* data) {
+    for (std::size_t i = count; i-- > 0;) task(data, i);
+}
+
+// The generated city (seed 8, 6 blocks), its occluders, and a camera down its street.
+struct CityStreet {
+    Scene city = generate_scene("city:seed=8,blocks=6");
+    WorldTriangles occluders = gather_world_triangles(city, objects_with_role(city, "occluder"));
+    Camera camera = [] {
+        Camera c;
+        c.eye = {-3, 1.7, -40};
+        c.target = {10, 3, 20};
+        return c;
+    }();
+    std::array<float, 16> clip(double aspect) const { return clip_from_world(camera, aspect); }
+};
 
 }  // namespace homcull::test
