@@ -141,6 +141,9 @@ TEST(Cli, CullRejectsInconsistentOptions) {
     r = run_cli(cull + " --buffer 40x20 --mode approximate --hole 2 --json");  // 4 x 4 would pass the 96 x 54 display
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 2);
+    // What those checks must still accept.
+    r = run_cli(cull + " --budget 1000 --complexity 5e-1 --coarsest-level -1 --json");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
     // A buffer whose samples can lie on the display's pixel centres gets those samples.
     r = run_cli(cull + " --buffer 48x27 --json");
     EXPECT_EQ(r.exit_code, 0) << r.err;
