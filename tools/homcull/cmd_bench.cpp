@@ -142,6 +142,18 @@ void run_bench(const BenchOptions& o) {
     if (o.clusters != 0 && o.workload != "castle") throw Error("bench: --clusters is for --workload castle");
     if (o.clusters < 0) throw Error("bench: --clusters must be 0 (the triangles as one input) or triangles per cluster, got " +
                                     std::to_string(o.clusters));
+    ClusterLimits limits;  // --clusters N: at most N triangles and min(N, 255) vertices per cluster
+    limits.max_triangles = std::size_t(o.clusters);
+    limits.max_vertices = std::min<std::size_t>(255, std::size_t(o.clusters));
+    if (o.clusters > 0) {
+        // The library's check of the limits, before the scene is loaded: a build of no triangles
+        // checks them and nothing else.
+        try {
+            (void)build_occluder_clusters(nullptr, 3 * sizeof(float), 0, nullptr, 0, nullptr, limits);
+        } catch (const Error& e) {
+            throw Error("bench: --clusters " + std::to_string(o.clusters) + ": " + e.what());
+        }
+    }
     if (o.threads < 1 || o.threads > 256) throw Error("bench: --threads must be in [1, 256], got " + std::to_string(o.threads));
     if (o.repeat < 0) throw Error("bench: --repeat must be at least 1 (0: the workload's default), got " + std::to_string(o.repeat));
     select_isa(o.isa);
@@ -176,16 +188,9 @@ void run_bench(const BenchOptions& o) {
         // apart: it is done once, when the scene is loaded), and rendered as such.
         if (o.clusters > 0) {
             const long long start = now_ns();
-            ClusterLimits limits;
-            limits.max_triangles = std::size_t(o.clusters);
-            limits.max_vertices = std::min<std::size_t>(255, std::size_t(o.clusters));
-            try {
-                clustered = build_occluder_clusters(occluders->positions.data(), 3 * sizeof(float), occluders->positions.size() / 3,
-                                                    occluders->indices.data(), occluders->triangle_count(), occluders->shared_edges.data(),
-                                                    limits);
-            } catch (const Error& e) {  // the limits' check is the library's: name the option it came from
-                throw Error("bench: --clusters " + std::to_string(o.clusters) + ": " + e.what());
-            }
+            clustered = build_occluder_clusters(occluders->positions.data(), 3 * sizeof(float), occluders->positions.size() / 3,
+                                                occluders->indices.data(), occluders->triangle_count(), occluders->shared_edges.data(),
+                                                limits);
             out["cluster_build_ms"] = elapsed_ms(start);
             out["clusters"] = clustered.clusters.size();
             inputs.clusters = &clustered;
