@@ -306,7 +306,7 @@ TEST(Cli, BenchPrintsItsTimingsAndRefusesBadOptions) {
     expect_refused("bench --threads 300" + small, 1, "--threads must be in [1, 256]");
     expect_refused("bench --samples 3" + small, 1, "samples per pixel axis must be 1, 2 or 4");
     expect_refused("bench --clusters 124" + small, 1, "--clusters is for --workload castle");
-    expect_refused("bench --workload castle --clusters 7" + small, 1, "--clusters 7: build_occluder_clusters: max_triangles must be a multiple of 4");
+    expect_refused("bench --workload castle --clusters 7" + small, 1, "bench: --clusters 7: max_triangles must be a multiple of 4");
     expect_refused("bench --s1 " + s1 + " --repeat -1", 1, "--repeat must be at least 1");
     expect_refused("bench --s1 " + s1 + " --resolution 0x0", 1, "--resolution: expected WxH");
 }

@@ -29,14 +29,18 @@ struct NumberedTriangle {
 
 }  // namespace
 
+void check_cluster_limits(const ClusterLimits& limits, const std::string& caller) {
+    if (limits.max_vertices < 3 || limits.max_vertices > 255) throw Error(caller + ": max_vertices must be in [3, 255]");
+    if (limits.max_triangles < 4 || limits.max_triangles > 512 || limits.max_triangles % 4 != 0)
+        throw Error(caller + ": max_triangles must be a multiple of 4 in [4, 512]");
+}
+
 OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                                          const std::uint32_t* indices, std::size_t triangle_count, const std::uint8_t* shared_edges,
                                          const ClusterLimits& limits) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     const auto fail = [](const std::string& why) { throw Error("build_occluder_clusters: " + why); };
-    if (limits.max_vertices < 3 || limits.max_vertices > 255) fail("max_vertices must be in [3, 255]");
-    if (limits.max_triangles < 4 || limits.max_triangles > 512 || limits.max_triangles % 4 != 0)
-        fail("max_triangles must be a multiple of 4 in [4, 512]");
+    check_cluster_limits(limits);
     OccluderClusters out;
     if (triangle_count == 0) return out;
     if (!positions || !indices) fail("positions or indices missing");

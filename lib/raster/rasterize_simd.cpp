@@ -534,7 +534,6 @@ std::vector<std::string> available_isas() {
 
 // Checks the name first: a name that cannot be selected throws and leaves the selection as it was.
 void select_isa(const std::string& name) {
-    (void)cpu_targets();  // read before anything is forced
     bool scalar = false;
     std::int64_t bits = 0;  // best
     if (name == "scalar") {

@@ -116,7 +116,7 @@ nlohmann::json time_workload(const BenchOptions& o, const BufferConfig& base, co
     for (const Camera& view : inputs.views->frames) {
         config.near_w = float(view.near_plane);
         OcclusionBuffer buffer(config);
-        const TriangleInput in = occluders.input(clip_from_world(view, double(config.width) / double(config.height)), Backface::cw);
+        const TriangleInput in = occluders.input(clip_from_world(view, Resolution{config.width, config.height}.aspect()), Backface::cw);
         const ClusteredInput clustered_in{inputs.clusters, in.model_to_clip, in.backface};
         std::vector<double> ms;
         for (int r = 0; r < repeat; ++r) {
@@ -145,15 +145,7 @@ void run_bench(const BenchOptions& o) {
     ClusterLimits limits;  // --clusters N: at most N triangles and min(N, 255) vertices per cluster
     limits.max_triangles = std::size_t(o.clusters);
     limits.max_vertices = std::min<std::size_t>(255, std::size_t(o.clusters));
-    if (o.clusters > 0) {
-        // The library's check of the limits, before the scene is loaded: a build of no triangles
-        // checks them and nothing else.
-        try {
-            (void)build_occluder_clusters(nullptr, 3 * sizeof(float), 0, nullptr, 0, nullptr, limits);
-        } catch (const Error& e) {
-            throw Error("bench: --clusters " + std::to_string(o.clusters) + ": " + e.what());
-        }
-    }
+    if (o.clusters > 0) check_cluster_limits(limits, "bench: --clusters " + std::to_string(o.clusters));  // before the scene is loaded
     if (o.threads < 1 || o.threads > 256) throw Error("bench: --threads must be in [1, 256], got " + std::to_string(o.threads));
     if (o.repeat < 0) throw Error("bench: --repeat must be at least 1 (0: the workload's default), got " + std::to_string(o.repeat));
     select_isa(o.isa);

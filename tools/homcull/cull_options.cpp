@@ -60,8 +60,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--complexity", o.complexity,
                    "Drop candidates with more than F times the median triangles per unit of box surface (Zhang's complexity "
                    "filter); 0: keep all")
-        ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
     app.add_option("--strategy", o.strategy,
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
                    "to back) or temporal (last frame's visible candidates plus those new in the frustum)")

@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace homcull {
@@ -42,6 +43,9 @@ struct ClusterLimits {
     std::size_t max_vertices = 64;
     std::size_t max_triangles = 124;
 };
+// Throws homcull::Error, naming `caller`, for limits meshopt_buildMeshlets does not accept
+// (build_occluder_clusters' own check, for callers that want it before loading a mesh).
+void check_cluster_limits(const ClusterLimits& limits, const std::string& caller = "build_occluder_clusters");
 
 // Splits an indexed triangle mesh (x, y, z floats every position_stride bytes; 32-bit indices)
 // into clusters. Each triangle keeps its vertices in order and its shared-edge bits (null:
