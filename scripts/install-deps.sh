@@ -18,6 +18,7 @@ packages=(
   libtinygltf-dev                 # glTF/GLB import and export (keeps node order and extras)
   assimp-testmodels               # test data: the IFC source of fzk_haus.glb, for the IFC import test
   libgtest-dev libgmock-dev libbenchmark-dev
+  libgmp-dev                      # the conservativeness tests' exact rational oracle (gmpxx)
   g++-aarch64-linux-gnu           # the test that the SIMD kernels compile for Arm NEON/SVE (scripts/check-neon.sh)
 )
 # ... and give the scalar path's bits there, run under qemu (scripts/check-neon.sh --run): arm64

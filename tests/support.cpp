@@ -1,16 +1,19 @@
 #include "support.hpp"
 
+#include <homcull/tbb_parallel_for.hpp>
 #include <homcull/truth/ray_scene.hpp>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
 #include <random>
+#include <thread>
 
 namespace homcull::test {
 namespace {
@@ -87,6 +90,32 @@ void write_text(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;
 }
 
+namespace {
+void run_on_threads(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data) {
+    const std::size_t threads = std::max<std::size_t>(1, reinterpret_cast<std::uintptr_t>(user));
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+        for (std::size_t i; (i = next.fetch_add(1, std::memory_order_relaxed)) < count;) task(data, i);
+    };
+    std::vector<std::thread> helpers;
+    for (std::size_t t = 1; t < threads && t < count; ++t) helpers.emplace_back(work);
+    work();
+    for (std::thread& h : helpers) h.join();
+}
+}  // namespace
+
+ParallelFor thread_jobs(std::size_t threads) {
+    return ParallelFor{run_on_threads, reinterpret_cast<void*>(std::uintptr_t(threads)), threads};
+}
+
+ParallelFor parallel_jobs() {
+#ifdef HOMCULL_TSAN
+    return thread_jobs(2);
+#else
+    return tbb_parallel_for();
+#endif
+}
+
 void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data) {
     std::vector<std::size_t> order(count);
     std::iota(order.begin(), order.end(), std::size_t(0));
@@ -119,7 +148,7 @@ long expect_claims_behind_embree_hits(const RayScene& rays, const Camera& camera
             if (!std::isfinite(w)) continue;
             ++claimed;
             const glm::vec3 direction(ray_direction(camera, basis, aspect, pixel_to_ndc({sw, sh}, i + 0.5, j + 0.5)));
-            const RayHit hit = rays.intersect(glm::vec3(camera.eye), direction, float(camera.near_plane), float(camera.far_plane));
+            const RayHit hit = rays.intersect(camera.eye, direction, float(camera.near_plane), float(camera.far_plane));
             if (!hit.hit() || double(hit.t) > double(w) * (1.0 + 1e-5)) {
                 ADD_FAILURE() << what << ": sample " << i << "," << j << " claimed at w " << w
                               << (hit.hit() ? ", nearer than the first hit" : " with nothing behind it");

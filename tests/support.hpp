@@ -26,6 +26,13 @@ Camera camera_down_minus_z(double fov_y_degrees = 90.0, double near_plane = 0.1,
 BufferConfig buffer_config(int width, int height, int samples, float near_w, bool sample_depth = false);
 
 
+// The tests' job system with real threads: oneTBB's (homcull::tbb), or in a ThreadSanitizer
+// build (HOMCULL_TSAN) threads_jobs(), since TSan reports the internals of the uninstrumented
+// libtbb as races.
+ParallelFor parallel_jobs();
+// A plain job system: each run starts `threads` - 1 std::threads that take task numbers from
+// an atomic counter with the calling thread, and joins them.
+ParallelFor thread_jobs(std::size_t threads = 2);
 // A "job system" (ParallelFor::run, user = a std::mt19937_64) that runs the tasks in a
 // shuffled order on the calling thread.
 void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t), void* data);

@@ -1,6 +1,9 @@
 // The homcull program end to end: exit codes, messages, JSON.
 #include "support.hpp"
 
+#include <homcull/generate.hpp>
+#include <homcull/io/scene_io.hpp>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -268,6 +271,33 @@ TEST(Cli, ExportThenInfoGivesTheSameScene) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto loaded = nlohmann::json::parse(r.out);
     EXPECT_EQ(loaded["objects"], generated["objects"]);
+}
+
+// Files that cannot be written are errors naming the file and why, never "wrote X": a folder as
+// the path, a full disk (/dev/full), a missing folder (export and path alike).
+TEST(Cli, OutputsThatCannotBeWrittenAreErrors) {
+    const std::string dir = test::temp_dir("cli_unwritable");
+    const std::string forest = "--scene gen:forest:radius=15";
+    expect_refused("export " + forest + " --out " + dir, 1, dir + ": cannot write the scene: it is a folder");
+    expect_refused("export " + forest + " --out /dev/full", 1, "/dev/full: cannot write the scene");
+    expect_refused("path " + forest + " --kind orbit --frames 3 --out /dev/full", 1, "/dev/full: cannot write the camera path");
+    expect_refused("export " + forest + " --out " + dir + "/missing/forest.glb", 1, "the folder " + dir + "/missing does not exist");
+    expect_refused("path " + forest + " --kind orbit --frames 3 --out " + dir + "/missing/path.json", 1,
+                   "the folder " + dir + "/missing does not exist");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/missing"));
+}
+
+// A node matrix that takes finite vertices to infinity is said, not silent.
+TEST(Cli, InfiniteWorldVerticesAreReported) {
+    const std::string dir = test::temp_dir("cli_infinite");
+    Scene scene = generate_scene("city:blocks=1,cars=0");
+    scene.objects[2].world = glm::dmat4(1e39);
+    scene.objects[2].world[3][3] = 1.0;
+    scene.finalize();
+    save_glb(scene, dir + "/huge.glb");
+    const CliRun r = run_cli("info --scene " + dir + "/huge.glb");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_MENTIONS(r.err, "1 object with vertices that become infinite in world space (first: object 2");
 }
 
 // homcull bench: the command and JSON keys on both workloads (a buffer small enough to

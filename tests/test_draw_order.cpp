@@ -189,7 +189,7 @@ TEST(DrawOrder, HoldsEveryTriangleOnceNearestClassFirstAndInInputOrderWithin) {
                 const Input input = make_input(kind, n, rng, /*bad=*/true, /*far=*/n == 5000);
                 DrawOrderScratch scratch;
                 TriangleInput sorted;
-                ASSERT_TRUE(sort_nearest_first(input.in, nullptr, near_w, threads ? tbb_parallel_for() : ParallelFor{}, scratch, sorted));
+                ASSERT_TRUE(sort_nearest_first(input.in, nullptr, near_w, threads ? test::parallel_jobs() : ParallelFor{}, scratch, sorted));
                 check_order(input.in, sorted, near_w, where);
             }
 }
@@ -242,7 +242,7 @@ TEST(DrawOrder, FromTheVertexCacheLeavesOutWhatTheSetupWouldSkipWithoutReorderin
         ASSERT_GT(expected.outside, 1000u);
         for (const bool threads : {false, true}) {
             const std::string where = name(kind) + (threads ? ", job system" : "");
-            const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+            const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
             DrawOrderScratch all_scratch, left_scratch;
             TriangleInput all, left;
             RasterStats skipped;
@@ -275,7 +275,7 @@ TEST(DrawOrder, ARenderFromTheCacheNearestFirstCountsAsARenderAsGiven) {
     ASSERT_TRUE(use_vertex_cache(in));
     in.model_to_clip = {0.5f, 0, 0, 0, 0, 0.5f, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0};
     for (const bool threads : {false, true}) {
-        const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+        const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
         OcclusionBuffer nearest_first(test::buffer_config(320, 180, 2, 0.1f)), as_given(test::buffer_config(320, 180, 2, 0.1f));
         nearest_first.render_frame(in, parallel);
         TriangleInput unsorted = in;
@@ -291,7 +291,7 @@ TEST(DrawOrder, ARenderFromTheCacheNearestFirstCountsAsARenderAsGiven) {
     // Every triangle left out: the frame is cleared and counted, on one thread and with a job
     // system, over a buffer that held the frame above.
     for (const bool threads : {false, true}) {
-        const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+        const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
         OcclusionBuffer buffer(test::buffer_config(320, 180, 2, 0.1f)), cleared(test::buffer_config(320, 180, 2, 0.1f));
         TriangleInput inside = in;
         for (std::size_t v = 0; v < in.vertex_count; ++v) input.positions[3 * v] = 0.0f;
@@ -404,7 +404,7 @@ TEST(DrawOrder, ARenderNearestFirstIsTheRenderOfTheSortedTriangles) {
     TriangleInput sorted;
     ASSERT_TRUE(sort_nearest_first(in, nullptr, 0.1, {}, scratch, sorted));
     for (const bool threads : {false, true}) {
-        const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+        const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
         OcclusionBuffer nearest_first(test::buffer_config(320, 180, 2, 0.1f)), of_sorted(test::buffer_config(320, 180, 2, 0.1f)),
             as_given(test::buffer_config(320, 180, 2, 0.1f));
         nearest_first.render_frame(in, parallel);

@@ -39,6 +39,24 @@ void* operator new(std::size_t size) { return counted_allocation(size, 0); }
 void* operator new[](std::size_t size) { return counted_allocation(size, 0); }
 void* operator new(std::size_t size, std::align_val_t a) { return counted_allocation(size, std::size_t(a)); }
 void* operator new[](std::size_t size, std::align_val_t a) { return counted_allocation(size, std::size_t(a)); }
+// The nothrow forms too: the library's are not replaced with the others, so std::stable_sort's
+// buffer (nothrow new) would otherwise come from the library's allocator and be freed here
+// (AddressSanitizer reports that mismatch).
+static void* nothrow_allocation(std::size_t size, std::size_t alignment) noexcept {
+    try {
+        return counted_allocation(size, alignment);
+    } catch (const std::bad_alloc&) {
+        return nullptr;
+    }
+}
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept { return nothrow_allocation(size, 0); }
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept { return nothrow_allocation(size, 0); }
+void* operator new(std::size_t size, std::align_val_t a, const std::nothrow_t&) noexcept { return nothrow_allocation(size, std::size_t(a)); }
+void* operator new[](std::size_t size, std::align_val_t a, const std::nothrow_t&) noexcept { return nothrow_allocation(size, std::size_t(a)); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }

@@ -136,7 +136,7 @@ void expect_same_with_and_without_skip(const TriangleInput& in, int width, int h
         for (bool sample_depth : {false, true})
             for (bool threads : {false, true}) {
                 const std::string where = isa + (threads ? ", two threads" : ", one thread") + (sample_depth ? ", per-sample depth" : "");
-                const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+                const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
                 OcclusionBuffer skipping(test::buffer_config(width, height, samples, near_w, sample_depth));
                 OcclusionBuffer oracle(test::buffer_config(width, height, samples, near_w, sample_depth));
                 skipping.render_frame(in, parallel);

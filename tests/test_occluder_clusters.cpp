@@ -288,7 +288,7 @@ TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
     if (!c) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
     const OccluderClusters clusters = cluster_world(c->world);
     std::mt19937_64 order_rng(5);
-    const ParallelFor tbb = tbb_parallel_for(), shuffled{test::run_shuffled, &order_rng};
+    const ParallelFor tbb = test::parallel_jobs(), shuffled{test::run_shuffled, &order_rng};
     for (const std::size_t view : {std::size_t(0), c->views.frames.size() - 1}) {
         const Camera& camera = c->views.frames[view];
         const ClusteredInput in{&clusters, clip_from_world(camera, 1280.0 / 720.0), Backface::cw};
@@ -352,7 +352,7 @@ TEST(ClusteredRender, ManyClustersGiveTheSameBitsWithAnyJobSystem) {
     std::shuffle(ids.begin(), ids.end(), rng);
     const std::array<float, 16> m = clip_from_world(test::camera_down_minus_z(80.0, 0.5), 320.0 / 200.0);
     std::mt19937_64 order_rng(3);
-    const ParallelFor tbb = tbb_parallel_for(), shuffled{test::run_shuffled, &order_rng};
+    const ParallelFor tbb = test::parallel_jobs(), shuffled{test::run_shuffled, &order_rng};
     const BufferConfig config = test::buffer_config(320, 200, 2, 0.5f);
     OcclusionBuffer serial(config), threaded(config), shuffled_order(config);
     for (const std::size_t count : {std::size_t(197), std::size_t(70), ids.size()}) {

@@ -126,7 +126,7 @@ struct RayTally {
 RayTally cast_at_both(const Mesh& original, const Mesh& lod, float margin, const glm::dmat4& world, int eyes, int grid,
                       std::uint64_t seed) {
     const Scene o_scene = one_object(original, world), s_scene = one_object(lod, world);
-    const RayScene o_rays(o_scene), s_rays(s_scene);
+    const RayScene o_rays(o_scene), s_rays(s_scene, o_rays.anchor());  // rounded alike: their hits are compared
     const Aabb box = o_scene.objects[0].world_bounds;
     const glm::dvec3 centre(box.center());
     const double half_diagonal = 0.5 * glm::length(glm::dvec3(box.extent()));
@@ -418,7 +418,7 @@ void expect_scene_lods_never_hide_more(const Scene& scene, const std::vector<std
         std::vector<RayTally>& tallies;
         int eyes, grid;
     } job{scene, lods, checks, tallies, eyes, grid};
-    const ParallelFor parallel = tbb_parallel_for();
+    const ParallelFor parallel = test::parallel_jobs();
     parallel.run(
         parallel.user, checks.size(),
         [](void* data, std::size_t i) {

@@ -190,7 +190,7 @@ TEST(ReferenceCells, ANewFrameForgetsTheLastFramesCells) {
     const TriangleInput near_in = test::clip_space_input(near_soup), far_in = test::clip_space_input(far_soup);
     const BufferConfig config = test::buffer_config(320, 180, 1, 0.5f);
     for (const bool threads : {false, true}) {
-        const ParallelFor parallel = threads ? tbb_parallel_for() : ParallelFor{};
+        const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
         const std::string where = threads ? "two threads" : "one thread";
         OcclusionBuffer fresh(config);
         fresh.render_frame(far_in, parallel);

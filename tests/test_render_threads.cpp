@@ -51,7 +51,7 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
 
     OcclusionBuffer serial(config), threaded(config), shuffled(config);
     serial.render(in);
-    threaded.render(in, tbb_parallel_for());
+    threaded.render(in, test::parallel_jobs());
     std::mt19937_64 order_rng(9);
     shuffled.render(in, ParallelFor{test::run_shuffled, &order_rng});
     EXPECT_TRUE(test::same_subtiles(serial, threaded));
@@ -64,7 +64,7 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     serial.clear();
     threaded.clear();
     serial.render(in);
-    threaded.render(in, tbb_parallel_for());
+    threaded.render(in, test::parallel_jobs());
     EXPECT_TRUE(test::same_subtiles(serial, threaded));
 }
 
@@ -83,7 +83,7 @@ TEST(RenderThreads, RenderFrameIsClearThenRender) {
     config.near_w = 1.0f;
     config.sample_depth = true;
     std::mt19937_64 order_rng(5);
-    for (const ParallelFor& parallel : {ParallelFor{}, tbb_parallel_for(), ParallelFor{test::run_shuffled, &order_rng}}) {
+    for (const ParallelFor& parallel : {ParallelFor{}, test::parallel_jobs(), ParallelFor{test::run_shuffled, &order_rng}}) {
         OcclusionBuffer reference(config), framed(config);
         reference.render(test::clip_space_input(first));
         framed.render(test::clip_space_input(first), parallel);
@@ -123,7 +123,7 @@ TEST(RenderThreads, RenderFrameThrowsBeforeClearing) {
     reference.render(test::clip_space_input(xyzw));
     TriangleInput bad = test::clip_space_input(xyzw);
     bad.position_components = 2;
-    EXPECT_THROW(buffer.render_frame(bad, tbb_parallel_for()), Error);
+    EXPECT_THROW(buffer.render_frame(bad, test::parallel_jobs()), Error);
     EXPECT_TRUE(test::same_subtiles(reference, buffer));
     EXPECT_TRUE(test::same_pyramid(reference, buffer));
 }
@@ -302,7 +302,7 @@ TEST(RenderThreads, CityFromAboveSameBits) {
     OcclusionBuffer serial(config), threaded(config);
     const auto clip = clip_from_world(c, 640.0 / 360.0);
     serial.render(occluders.input(clip));
-    threaded.render(occluders.input(clip), tbb_parallel_for());
+    threaded.render(occluders.input(clip), test::parallel_jobs());
     EXPECT_TRUE(test::same_subtiles(serial, threaded));
     EXPECT_TRUE(test::same_pyramid(serial, threaded));
 }
@@ -611,7 +611,7 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
     in.triangle_count = kTriangles;
     in.model_to_clip = clip_from_world(camera, 331.0 / 197.0);
     in.backface = Backface::cw;
-    const ParallelFor tbb = tbb_parallel_for();
+    const ParallelFor tbb = test::parallel_jobs();
     auto render = [&](std::size_t vertex_count, const ParallelFor& parallel, DrawOrder order = DrawOrder::nearest_first) {
         TriangleInput input = in;
         input.vertex_count = vertex_count;

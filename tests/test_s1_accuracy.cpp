@@ -20,7 +20,7 @@ namespace {
 
 RectAccuracy measure(const WorkloadS1& s1, int width, int height, int samples) {
     OcclusionBuffer buffer(test::buffer_config(width, height, samples, 1.0f));
-    buffer.render(s1.occluder_input(), tbb_parallel_for());
+    buffer.render(s1.occluder_input(), test::parallel_jobs());
     const ExactDepth exact =
         exact_depth_of_triangles(s1.occluders.data(), s1.occluder_count(), buffer.sample_width(), buffer.sample_height(), true);
     const RectAccuracy a = count_rect_accuracy(buffer, exact, s1.rects.data(), s1.rect_count());

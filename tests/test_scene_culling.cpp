@@ -304,7 +304,7 @@ TEST(SceneCulling, ClustersGiveTheSameAnswersWithAJobSystem) {
         std::vector<OccludeeAnswer> a, b;
         for (std::size_t f = 0; f < frames.frames.size(); f += 3) {
             serial.cull(frames.frames[f], a);
-            threaded.cull(frames.frames[f], b, tbb_parallel_for());
+            threaded.cull(frames.frames[f], b, test::parallel_jobs());
             ASSERT_EQ(a.size(), b.size());
             for (std::size_t id = 0; id < a.size(); ++id) {
                 EXPECT_EQ(a[id].visibility, b[id].visibility) << "frame " << f << ", object " << id;

@@ -111,13 +111,22 @@ Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const
 
 namespace detail {
 
-void box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, glm::dvec4 corners[8]) {
+double box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, glm::dvec4 corners[8]) {
     const glm::dvec4 base = transform_to_clip(m, box_min[0], box_min[1], box_min[2], 1.0);
     const glm::dvec4 ex = transform_to_clip(m, double(box_max[0]) - double(box_min[0]), 0, 0, 0);
     const glm::dvec4 ey = transform_to_clip(m, 0, double(box_max[1]) - double(box_min[1]), 0, 0);
     const glm::dvec4 ez = transform_to_clip(m, 0, 0, double(box_max[2]) - double(box_min[2]), 0);
     for (int k = 0; k < 8; ++k)
         corners[k] = base + ((k & 1) ? ex : glm::dvec4(0)) + ((k & 2) ? ey : glm::dvec4(0)) + ((k & 4) ? ez : glm::dvec4(0));
+    // 2^-52 for each transform and the edge lengths' subtraction, 3 * 2^-53 for the sums: 2^-50
+    // of the terms' magnitude covers both.
+    const glm::dvec4 magnitude = glm::abs(base) + glm::abs(ex) + glm::abs(ey) + glm::abs(ez);
+    return 0x1.0p-50 * std::max({magnitude.x, magnitude.y, magnitude.z, magnitude.w});
+}
+
+double ndc_error_bound(double error, double max_abs_ndc, double min_w) {
+    if (!(min_w > error)) return HUGE_VAL;
+    return error * (1.0 + max_abs_ndc) / (min_w - error) + 0x1.0p-52 * max_abs_ndc;
 }
 
 ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w) {
@@ -143,14 +152,22 @@ ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w) {
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, ScreenRect& rect,
                    Visibility& decided) {
     glm::dvec4 corners[8];
-    box_corners(box_min, box_max, m, corners);
+    const double error = box_corners(box_min, box_max, m, corners);
     const ClipBounds b = clip_bounds(corners, 8, double(near_w));
     if (!b.finite || b.behind > 0) {  // nothing to reason with, or crossing the near plane: visible
         decided = b.finite && b.behind == 8 ? Visibility::view_culled : Visibility::visible;
         return false;
     }
-    // Round the rectangle outwards and the depth towards the eye when going to float.
-    rect = {float_down(b.min_x), float_down(b.min_y), float_up(b.max_x), float_up(b.max_y), float_down(b.min_w)};
+    // Wherever the exact corners are, they lie within the widened rectangle and at or beyond
+    // its lowered w; rounded outwards and towards the eye when going to float. A bound that
+    // reaches the nearest w leaves no rectangle to reason with: visible.
+    const double ndc = ndc_error_bound(error, std::max({-b.min_x, b.max_x, -b.min_y, b.max_y}), b.min_w);
+    if (!(ndc < HUGE_VAL)) {
+        decided = Visibility::visible;
+        return false;
+    }
+    rect = {float_down(b.min_x - ndc), float_down(b.min_y - ndc), float_up(b.max_x + ndc), float_up(b.max_y + ndc),
+            float_down(b.min_w - error)};
     return true;
 }
 

@@ -540,7 +540,10 @@ void OcclusionBuffer::read_sample_depth(std::vector<float>& d) const {
 
 std::array<float, 16> clip_from_world(const Camera& camera, double aspect) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
-    const glm::dmat4 m = projection_matrix(camera, aspect) * view_matrix(camera);
+    return float_matrix(projection_matrix(camera, aspect) * view_matrix(camera));
+}
+
+std::array<float, 16> float_matrix(const glm::dmat4& m) {
     std::array<float, 16> out{};
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) out[std::size_t(4 * c + r)] = float(m[c][r]);

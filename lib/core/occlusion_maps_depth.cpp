@@ -43,8 +43,14 @@ void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16
     const int gw = config_.deb_width, gh = config_.deb_height;
     const int sample_width = width_ * samples_, sample_height = height_ * samples_;
     glm::dvec4 corners[8];
-    detail::box_corners(&box.min.x, &box.max.x, m, corners);
-    const detail::ClipBounds b = detail::clip_bounds(corners, 8, double(near_w_));
+    const double error = detail::box_corners(&box.min.x, &box.max.x, m, corners);
+    detail::ClipBounds b = detail::clip_bounds(corners, 8, double(near_w_));
+    // The far depth raised by the corners' error bound (so that it stays a bound of the exact
+    // box's farthest w); the rectangle's slack below is far larger than their NDC error, unless
+    // the bound is not small, when the box bounds no cell.
+    b.max_w += error;
+    if (b.finite && b.behind == 0 && !(detail::ndc_error_bound(error, std::max({-b.min_x, b.max_x, -b.min_y, b.max_y}), b.min_w) < 0x1.0p-30))
+        b.behind = 1;
     if (b.finite && b.behind == 8) return;  // entirely before the near plane: draws nothing
     int cx0 = 0, cx1 = gw - 1, cy0 = 0, cy1 = gh - 1;
     float depth = 0.0f;  // no bound

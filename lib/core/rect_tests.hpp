@@ -86,8 +86,16 @@ using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& 
 RectScanKernel selected_rect_scan_kernel();
 
 // The eight corners of a box under a model-to-clip matrix, by the incremental corner transform
-// (Zhang: the base corner plus the three transformed edge vectors), in double.
-void box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, glm::dvec4 corners[8]);
+// (Zhang: the base corner plus the three transformed edge vectors), in double. Returns a bound
+// on the error of every corner coordinate against the exact transform of the float box: each of
+// the four transforms is accurate to about 2^-52 of its result (transform_to_clip), and the
+// three sums of a corner round by at most 2^-53 of their terms each.
+double box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, glm::dvec4 corners[8]);
+
+// How far points' NDC bounds may move when each of their clip coordinates may be off by
+// `error`: at most error (1 + |ndc|) / (w - error) for a point at w, plus the division's own
+// rounding. Infinite when the error reaches the nearest w.
+double ndc_error_bound(double error, double max_abs_ndc, double min_w);
 
 // What an occludee test needs of clip-space points: their NDC bounds and nearest w over the
 // points at or beyond near_w, their farthest w over all, how many lie before near_w, and
@@ -100,7 +108,8 @@ struct ClipBounds {
 ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w);
 
 // The screen rectangle of a box under a model-to-clip matrix (incremental corner transform:
-// base corner plus three edge vectors), rounded outwards, with its nearest w rounded down; or,
+// base corner plus three edge vectors), widened by the corners' error bound and rounded
+// outwards, with its nearest w lowered by that bound and rounded down; or,
 // returning false, the answer when it needs none (non-finite corners: visible; entirely
 // before the near plane: view-culled; crossing it: visible).
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,

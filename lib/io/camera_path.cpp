@@ -1,5 +1,6 @@
 #include <homcull/error.hpp>
 #include <homcull/io/camera_path.hpp>
+#include <homcull/io/write_file.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -82,10 +83,7 @@ std::string camera_path_to_json(const CameraPath& path) {
 }
 
 void write_camera_path(const CameraPath& path, const std::string& file) {
-    std::ofstream out(file, std::ios::binary);
-    if (!out) throw Error(file + ": cannot write the camera path file");
-    out << camera_path_to_json(path);
-    if (!out) throw Error(file + ": error while writing the camera path file");
+    write_file(file, camera_path_to_json(path), "the camera path");
 }
 
 }  // namespace homcull

@@ -1,5 +1,6 @@
 #include <homcull/error.hpp>
 #include <homcull/io/dumps.hpp>
+#include <homcull/io/write_file.hpp>
 
 #include "io/legend_font.hpp"
 
@@ -313,9 +314,7 @@ std::vector<ColormapPng> write_colormap_pngs(const std::vector<DumpPart>& parts,
         index.push_back(std::move(entry));
     }
     const std::string path = dir + "/colormaps.json";
-    std::ofstream out(path);
-    out << index.dump(1) << '\n';
-    if (!out.flush()) throw Error(path + ": cannot write");
+    write_file(path, index.dump(1) + "\n", "the colormap index");
     return written;
 }
 

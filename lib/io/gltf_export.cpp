@@ -2,11 +2,13 @@
 // any glTF viewer, and fed to other culling tools.
 #include <homcull/error.hpp>
 #include <homcull/io/scene_io.hpp>
+#include <homcull/io/write_file.hpp>
 
 #include "io/tinygltf_config.hpp"
 
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 namespace homcull {
 namespace {
@@ -89,10 +91,13 @@ void save_glb(const Scene& scene, const std::string& path) {
     model.scenes.push_back(root);
     model.defaultScene = 0;
 
+    // Serialized in memory, then written by write_file, which reports what tinygltf's own file
+    // writing does not (a folder as the path, a missing folder, a full disk).
     tinygltf::TinyGLTF writer;
-    if (!writer.WriteGltfSceneToFile(&model, path, /*embedImages=*/false, /*embedBuffers=*/true,
-                                     /*prettyPrint=*/false, /*writeBinary=*/true))
-        throw Error(path + ": could not write the file");
+    std::ostringstream glb;
+    if (!writer.WriteGltfSceneToStream(&model, glb, /*prettyPrint=*/false, /*writeBinary=*/true))
+        throw Error(path + ": could not serialize the scene as glTF");
+    write_file(path, glb.str(), "the scene");
 }
 
 }  // namespace homcull

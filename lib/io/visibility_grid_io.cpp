@@ -1,4 +1,5 @@
 #include <homcull/error.hpp>
+#include <homcull/io/write_file.hpp>
 #include <homcull/io/visibility_grid_io.hpp>
 
 #include <nlohmann/json.hpp>
@@ -97,10 +98,7 @@ void write_visibility_grid(const VisibilityGrid& grid, const GridShard& shard, c
         }
     }
     j["points"] = std::move(points);
-    std::ofstream out(file);
-    if (!out) throw Error("cannot write the visibility grid " + file);
-    out << j.dump() << "\n";
-    if (!out) throw Error("cannot write the visibility grid " + file);
+    write_file(file, j.dump() + "\n", "the visibility grid");
 }
 
 VisibilityGridPart read_visibility_grid_part(const std::string& file) {

@@ -150,6 +150,12 @@ void sample_row_interval(const TriangleEdges& edges, int row, int i0, int i1, st
         const double x = edges.ox[k] + c * edges.inverse_sa[k];  // boundary, in samples
         // The boundary may lie far outside the buffer for a nearly horizontal edge: clamp
         // before converting to int (the interval is clamped to [i0, i1] anyway).
+        // A NaN boundary (only from non-finite or extreme setup values) bounds nothing: the row is
+        // empty, never the whole span (std::clamp would pass NaN on to an undefined int conversion).
+        if (x != x) {
+            last = first - 1;
+            continue;
+        }
         const double xs = std::clamp(x - 0.5, double(i0) - 2.0, double(i1) + 2.0);
         if (edges.sa[k] > 0.0) first = std::max(first, edges.shared[k] ? ceil_int(xs) : floor_int(xs) + 1);
         else last = std::min(last, edges.shared[k] ? floor_int(xs) : ceil_int(xs) - 1);

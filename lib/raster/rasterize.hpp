@@ -301,10 +301,12 @@ inline std::uint32_t subtile_rect_bits(int tx, int ty, int i0, int i1, int j0, i
 // empty when first > last. The one rule for what a span of the screen covers, used by the
 // triangle bounding box, the binning and the rectangle tests.
 // lo and hi are first clamped to [-1, count + 1], which changes no non-empty answer and keeps
-// the conversions to int defined for any finite input.
+// the conversions to int defined for any input: a NaN bound gives an empty span (callers that
+// must not read "no sample" as "hidden" reject non-finite input before).
 inline void sample_span(double lo, double hi, int count, int& first, int& last) {
-    lo = std::min(std::max(lo, -1.0), double(count) + 1.0);
-    hi = std::min(std::max(hi, -1.0), double(count) + 1.0);
+    const double top = double(count) + 1.0;
+    lo = lo >= -1.0 ? std::min(lo, top) : (lo < -1.0 ? -1.0 : top);  // NaN: top
+    hi = hi <= top ? std::max(hi, -1.0) : (hi > top ? top : -1.0);   // NaN: -1
     // ceil and floor of numbers in [-1.5, count + 0.5] by truncation: exact for any int count,
     // and cheaper than std::ceil and std::floor, which the baseline x86-64 target (no SSE4.1
     // round) computes with a range check and two conversions (single test_rect calls on S1:

@@ -26,11 +26,23 @@ using D = hn::CappedTag<double, 8>;  // at most 8 lanes: one byte of mask bits p
 using V = hn::Vec<D>;
 using M = hn::Mask<D>;
 
-// transform_to_clip's row r: ((m[r] x + m[4 + r] y) + m[8 + r] z) + m[12 + r] w.
+// two_sum_error and accurate_sum4 (triangle_setup.hpp) lane by lane: the same operations.
+HWY_INLINE V TwoSumError(V a, V b, V s) {
+    const V b_virtual = hn::Sub(s, a);
+    return hn::Add(hn::Sub(a, hn::Sub(s, b_virtual)), hn::Sub(b, b_virtual));
+}
+
+// transform_to_clip's row r: accurate_sum4(m[r] x, m[4 + r] y, m[8 + r] z, m[12 + r] w).
 HWY_INLINE V ClipRow(D d, const std::array<float, 16>& m, int r, V x, V y, V z, V w) {
-    return hn::Add(hn::Add(hn::Add(hn::Mul(hn::Set(d, double(m[r])), x), hn::Mul(hn::Set(d, double(m[4 + r])), y)),
-                           hn::Mul(hn::Set(d, double(m[8 + r])), z)),
-                   hn::Mul(hn::Set(d, double(m[12 + r])), w));
+    const V p0 = hn::Mul(hn::Set(d, double(m[r])), x), p1 = hn::Mul(hn::Set(d, double(m[4 + r])), y);
+    const V p2 = hn::Mul(hn::Set(d, double(m[8 + r])), z), p3 = hn::Mul(hn::Set(d, double(m[12 + r])), w);
+    const V s1 = hn::Add(p0, p1);
+    V error = TwoSumError(p0, p1, s1);
+    const V s2 = hn::Add(s1, p2);
+    error = hn::Add(error, TwoSumError(s1, p2, s2));
+    const V s3 = hn::Add(s2, p3);
+    error = hn::Add(error, TwoSumError(s2, p3, s3));
+    return hn::Add(s3, error);
 }
 
 // Transforms the lanes' positions (count of them, from vertex `at`) and stores their clip

@@ -11,12 +11,40 @@
 
 namespace homcull::detail {
 
+// The rounding error of s = a + b in double: a + b = s + two_sum_error(a, b, s) exactly
+// (Knuth's TwoSum, six additions, no branch; needs round-to-nearest and no fused or
+// reassociated arithmetic, which -ffp-contract=off and the absence of -ffast-math give).
+inline double two_sum_error(double a, double b, double s) {
+    const double b_virtual = s - a;
+    return (a - (s - b_virtual)) + (b - b_virtual);
+}
+
+// p0 + p1 + p2 + p3 as if computed in twice the precision, then rounded (Ogita, Rump and
+// Oishi, "Accurate sum and dot product", SIAM J. Sci. Comput. 26(6), 2005, Algorithm 4.4,
+// Sum2): the error is at most 2^-53 |sum| + (3 * 2^-53)^2 (|p0| + |p1| + |p2| + |p3|). A plain
+// sum errs by up to 3 * 2^-53 (|p0| + ... + |p3|), which is no bound at all where the terms
+// cancel: model coordinates near 2^42 that the matrix translates back next to the eye lose
+// 2^-11 of a clip unit, far more than the coverage margin absorbs.
+inline double accurate_sum4(double p0, double p1, double p2, double p3) {
+    const double s1 = p0 + p1;
+    double error = two_sum_error(p0, p1, s1);
+    const double s2 = s1 + p2;
+    error += two_sum_error(s1, p2, s2);
+    const double s3 = s2 + p3;
+    error += two_sum_error(s2, p3, s3);
+    return s3 + error;
+}
+
 // Model to clip space in double, column-major m[column * 4 + row], one fixed order of
-// operations (the rasterizer and the occludee tests must agree to the bit).
+// operations (the rasterizer and the occludee tests must agree to the bit). The products of a
+// float matrix entry and a float coordinate are exact in double; their sum is accurate_sum4's,
+// so each clip coordinate is within about 2^-52 of its exact value relative to itself, however
+// large the model coordinates the matrix brings back near the eye (up to 2^50 times the clip
+// coordinate, where the second term of accurate_sum4's bound reaches 2^-52 of it).
 inline glm::dvec4 transform_to_clip(const std::array<float, 16>& m, double x, double y, double z, double w) {
     glm::dvec4 r;
     for (int row = 0; row < 4; ++row)
-        r[row] = double(m[row]) * x + double(m[4 + row]) * y + double(m[8 + row]) * z + double(m[12 + row]) * w;
+        r[row] = accurate_sum4(double(m[row]) * x, double(m[4 + row]) * y, double(m[8 + row]) * z, double(m[12 + row]) * w);
     return r;
 }
 

@@ -1,6 +1,9 @@
 #include <homcull/error.hpp>
 #include <homcull/scene.hpp>
 
+#include "raster/rasterize.hpp"  // float_down, float_up
+
+#include <cmath>
 #include <string>
 
 namespace homcull {
@@ -32,6 +35,42 @@ Aabb Scene::bounds() const {
 glm::vec3 transform_point(const glm::dmat4& world, const glm::vec3& p) {
     // glTF node transforms are affine; the fourth row is not used.
     return glm::vec3(glm::dvec3(world * glm::dvec4(glm::dvec3(p), 1.0)));
+}
+
+Scene translated_scene(const Scene& scene, const glm::dvec3& offset) {
+    Scene moved = scene;
+    glm::dmat4 translation(1.0);
+    translation[3] = glm::dvec4(offset, 1.0);
+    for (Object& object : moved.objects) object.world = translation * object.world;
+    moved.finalize();
+    return moved;
+}
+
+glm::dvec3 scene_anchor(const Scene& scene) {
+    const Aabb b = scene.bounds();
+    if (b.empty()) return glm::dvec3(0.0);
+    const glm::dvec3 centre = (glm::dvec3(b.min) + glm::dvec3(b.max)) * 0.5;
+    if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) return glm::dvec3(0.0);
+    return centre;
+}
+
+glm::vec3 transform_point_from(const glm::dmat4& world, const glm::vec3& p, const glm::dvec3& anchor) {
+    return glm::vec3(glm::dvec3(world * glm::dvec4(glm::dvec3(p), 1.0)) - anchor);
+}
+
+Aabb anchored_box(const Aabb& world_box, const glm::dvec3& anchor) {
+    if (world_box.empty()) return world_box;
+    // World boxes hold transform_point's floats, each within 2^-24 of its exact world position:
+    // widened by 2^-23 of each bound (and the subtraction's 2^-53), the double bounds hold every
+    // exact position, and float rounding is monotone, so the rounded anchored vertices of
+    // transform_point_from lie within their float_down / float_up.
+    Aabb b;
+    for (int k = 0; k < 3; ++k) {
+        const double lo = double(world_box.min[k]), hi = double(world_box.max[k]);
+        b.min[k] = detail::float_down((lo - 0x1.0p-23 * std::abs(lo)) - anchor[k] - 0x1.0p-50 * (std::abs(lo) + std::abs(anchor[k])));
+        b.max[k] = detail::float_up((hi + 0x1.0p-23 * std::abs(hi)) - anchor[k] + 0x1.0p-50 * (std::abs(hi) + std::abs(anchor[k])));
+    }
+    return b;
 }
 
 void Scene::finalize() {

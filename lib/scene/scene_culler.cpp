@@ -6,6 +6,8 @@
 #include "core/float_mode.hpp"
 #include "scene/scene_culler_frame.hpp"
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <algorithm>
 #include <cstdint>
 #include <string>
@@ -69,7 +71,8 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
     : scene_(&scene),
       config_(config),
       occluder_ids_(occluders),
-      occluders_(gather_world_triangles(scene, occluders)),
+      anchor_(scene_anchor(scene)),
+      occluders_(gather_world_triangles(scene, occluders, anchor_)),
       hierarchy_(ObjectHierarchy::build(scene, config.hierarchy_leaf_size)),
       buffer_(scene_buffer_config(config, 0.1f)),
       maps_(buffer_, maps_config(config)) {
@@ -95,6 +98,11 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
         compute_shared_edges(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
                              occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first);
     }
+    // The boxes the buffer and the maps test, relative to the anchor as the triangles are.
+    object_boxes_.reserve(scene.objects.size());
+    for (const Object& object : scene.objects) object_boxes_.push_back(anchored_box(object.world_bounds, anchor_));
+    node_boxes_.reserve(hierarchy_.nodes.size());
+    for (const ObjectHierarchy::Node& node : hierarchy_.nodes) node_boxes_.push_back(anchored_box(node.bounds, anchor_));
     gather_lods();
     build_clusters();
     drawn_.assign(occluders.size(), 0);
@@ -110,7 +118,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
         const Object& object = scene.objects[id];
         if (scene.triangle_count(object) > config.triangle_test_limit) continue;
         occludee_first_vertex_[id] = occludee_positions_.size() / 3;
-        append_world_positions(scene, object, occludee_positions_);
+        append_world_positions(scene, object, occludee_positions_, anchor_);
     }
 }
 
@@ -123,7 +131,10 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
         maps_ = OcclusionMaps(buffer_, maps_config(config_));
     }
     const double aspect = config_.display.aspect();
-    const Frame frame{&camera, clip_from_world(camera, aspect), projection_matrix(camera, aspect) * view_matrix(camera)};
+    // The buffer's matrix takes positions relative to the anchor: composed in double, so that the
+    // float matrix holds the eye's offset from the scene, not from the world's origin.
+    const glm::dmat4 clip_double = projection_matrix(camera, aspect) * view_matrix(camera);
+    const Frame frame{&camera, float_matrix(clip_double * glm::translate(glm::dmat4(1.0), anchor_)), clip_double};
     timings_ = {};
     work_ = {};
     exits_ = {};
@@ -200,7 +211,7 @@ void SceneCuller::gather_lods() {
         if (!lod || lod->mesh.triangle_count() == 0) continue;
         const auto base = std::uint32_t(occluders_.positions.size() / 3);
         for (const glm::vec3& p : lod->mesh.positions) {
-            const glm::vec3 w = transform_point(object.world, p);
+            const glm::vec3 w = transform_point_from(object.world, p, anchor_);
             occluders_.positions.insert(occluders_.positions.end(), {w.x, w.y, w.z});
         }
         for (std::uint32_t index : lod->mesh.indices) lod_indices_.push_back(base + index);
@@ -358,7 +369,7 @@ void SceneCuller::build_maps(const Frame& frame) {
     if (!frame_started_) buffer_.clear();  // nothing drawn yet this frame: it still holds the last one
     maps_.clear();
     if (config_.maps.depth == DepthTest::deb)
-        for (std::uint32_t id : frame_occluders_) maps_.add_occluder_box(scene_->objects[id].world_bounds, frame.clip);
+        for (std::uint32_t id : frame_occluders_) maps_.add_occluder_box(object_boxes_[id], frame.clip);
     maps_.build(buffer_);
     timings_.maps_ms += ms_since(start);
 }

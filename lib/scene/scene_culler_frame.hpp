@@ -10,8 +10,8 @@ namespace homcull {
 
 struct SceneCuller::Frame {
     const Camera* camera;
-    std::array<float, 16> clip;  // world to clip, in float: the buffer's and the maps' input
-    glm::dmat4 clip_double;      // the same in double, as ground truth transforms
+    std::array<float, 16> clip;  // anchored world (world minus the anchor) to clip, in float: the buffer's and the maps' input
+    glm::dmat4 clip_double;      // world to clip in double, as ground truth transforms
 };
 
 inline double ms_since(std::chrono::steady_clock::time_point start) {

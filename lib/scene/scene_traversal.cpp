@@ -49,7 +49,8 @@ void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answ
     if (!hierarchy_.nodes.empty()) node_heap_.emplace_back(0.0f, 0u);
     while (!node_heap_.empty()) {
         std::pop_heap(node_heap_.begin(), node_heap_.end(), nearest_first);
-        const ObjectHierarchy::Node& node = hierarchy_.nodes[node_heap_.back().second];
+        const std::uint32_t node_index = node_heap_.back().second;
+        const ObjectHierarchy::Node& node = hierarchy_.nodes[node_index];
         const float node_key = node_heap_.back().first;
         node_heap_.pop_back();
         const std::size_t waiting = triangles_waiting();
@@ -59,7 +60,7 @@ void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answ
             waiting_nearest_far = std::numeric_limits<float>::infinity();
         }
         if (config_.hierarchy && node.end - node.begin > 1) {
-            const OccludeeAnswer a = maps_.test_aabb(node.bounds, frame.clip);
+            const OccludeeAnswer a = maps_.test_aabb(node_boxes_[node_index], frame.clip);
             ++work_.nodes_tested;
             if (a.visibility != Visibility::visible) {
                 for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
@@ -91,7 +92,7 @@ void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answ
 // The object's box, then, where the box is visible and the object small enough, its triangles.
 OccludeeAnswer SceneCuller::test_object(const Frame& frame, std::uint32_t id) {
     const Object& object = scene_->objects[id];
-    OccludeeAnswer answer = maps_.test_aabb(object.world_bounds, frame.clip);
+    OccludeeAnswer answer = maps_.test_aabb(object_boxes_[id], frame.clip);
     ++work_.objects_tested;
     ++exits_.count[answer.overlap_exit];
     if (answer.visibility != Visibility::visible || scene_->triangle_count(object) > config_.triangle_test_limit) return answer;

@@ -16,21 +16,21 @@ TriangleInput WorldTriangles::input(const std::array<float, 16>& clip_from_world
     return in;
 }
 
-void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions) {
+void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions, const glm::dvec3& anchor) {
     for (const glm::vec3& p : scene.meshes[object.mesh].positions) {
-        const glm::vec3 w = transform_point(object.world, p);
+        const glm::vec3 w = transform_point_from(object.world, p, anchor);
         positions.insert(positions.end(), {w.x, w.y, w.z});
     }
 }
 
-WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects) {
+WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects, const glm::dvec3& anchor) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     WorldTriangles out;
     for (std::uint32_t id : objects) {
         const Object& object = scene.objects.at(id);
         const Mesh& mesh = scene.meshes[object.mesh];
         const auto base = std::uint32_t(out.positions.size() / 3);
-        append_world_positions(scene, object, out.positions);
+        append_world_positions(scene, object, out.positions, anchor);
         for (std::uint32_t index : mesh.indices) out.indices.push_back(base + index);
     }
     out.shared_edges.resize(out.triangle_count());

@@ -61,7 +61,7 @@ AnswerOverlay render_answer_overlay(const RayScene& rays, const Camera& camera, 
     const int w = resolution.width, h = resolution.height;
     const double aspect = resolution.aspect();
     const CameraBasis basis = camera_basis(camera);
-    const glm::vec3 eye(camera.eye);
+    const glm::dvec3 eye = camera.eye;
     std::vector<std::uint32_t> ids(std::size_t(w) * std::size_t(h), kNoObject);
     std::vector<float> shade(ids.size(), 0.0f);
     // The same rays as ground truth: pixel centres, t from the near to the far plane.

@@ -5,12 +5,16 @@
 
 namespace homcull {
 
-void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally) {
+void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally,
+                   const glm::dvec3& culler_offset) {
     TruthOptions truth_options;
     truth_options.resolution = culler.config().display;
     const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
     std::vector<OccludeeAnswer> answers;
-    culler.cull(camera, answers);
+    Camera moved = camera;
+    moved.eye += culler_offset;
+    moved.target += culler_offset;
+    culler.cull(moved, answers);
     tally.total_ms.render_ms += culler.timings().render_ms;
     tally.total_ms.maps_ms += culler.timings().maps_ms;
     tally.total_ms.test_ms += culler.timings().test_ms;

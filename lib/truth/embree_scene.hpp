@@ -13,6 +13,7 @@ struct RayScene::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::size_t objects = 0;
+    glm::dvec3 anchor{0.0};  // vertices and ray origins are relative to it
 
     // Embree reports errors through a callback; the first one is kept here.
     std::mutex error_mutex;

@@ -73,7 +73,9 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
     const double aspect = display.aspect();
     const CameraBasis basis = camera_basis(camera);
     const float t_near = float(camera.near_plane), t_far = float(camera.far_plane);
-    const float origin[3] = {float(camera.eye.x), float(camera.eye.y), float(camera.eye.z)};
+    // The eye relative to the Embree vertices' anchor, in double, then rounded.
+    const glm::vec3 eye(camera.eye - rays.anchor());
+    const float origin[3] = {eye.x, eye.y, eye.z};
     const float tie_lo = float(1.0 - options.tie_relative_depth), tie_hi = float(1.0 + options.tie_relative_depth);
 
     // Per sample: the object seen, and whether another object lies within the tie window.

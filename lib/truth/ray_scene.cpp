@@ -26,7 +26,9 @@ RayScene::Impl::~Impl() {
     if (device) rtcReleaseDevice(device);
 }
 
-RayScene::RayScene(const Scene& source) : impl_(std::make_unique<Impl>()) {
+RayScene::RayScene(const Scene& source) : RayScene(source, scene_anchor(source)) {}
+
+RayScene::RayScene(const Scene& source, const glm::dvec3& anchor) : impl_(std::make_unique<Impl>()) {
     Impl& impl = *impl_;
     impl.device = rtcNewDevice(nullptr);
     if (!impl.device) throw Error("Embree: cannot create a device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
@@ -37,6 +39,7 @@ RayScene::RayScene(const Scene& source) : impl_(std::make_unique<Impl>()) {
     rtcSetSceneFlags(impl.scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(impl.scene, RTC_BUILD_QUALITY_MEDIUM);
     impl.objects = source.objects.size();
+    impl.anchor = anchor;
     if (impl.objects >= std::numeric_limits<unsigned>::max())
         throw Error(source.source + ": too many objects for Embree");
 
@@ -55,7 +58,7 @@ RayScene::RayScene(const Scene& source) : impl_(std::make_unique<Impl>()) {
             throw Error("Embree: cannot allocate geometry for object " + std::to_string(id));
         }
         for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-            const glm::vec3 p = transform_point(object.world, mesh.positions[v]);
+            const glm::vec3 p = transform_point_from(object.world, mesh.positions[v], impl.anchor);
             vertices[3 * v + 0] = p.x;
             vertices[3 * v + 1] = p.y;
             vertices[3 * v + 2] = p.z;
@@ -75,10 +78,13 @@ RayScene& RayScene::operator=(RayScene&&) noexcept = default;
 
 std::size_t RayScene::object_count() const { return impl_->objects; }
 
-RayHit RayScene::intersect(const glm::vec3& origin, const glm::vec3& direction, float t_near, float t_far) const {
+glm::dvec3 RayScene::anchor() const { return impl_->anchor; }
+
+RayHit RayScene::intersect(const glm::dvec3& world_origin, const glm::vec3& direction, float t_near, float t_far) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh{};
+    const glm::vec3 origin(world_origin - impl_->anchor);
     rh.ray.org_x = origin.x;
     rh.ray.org_y = origin.y;
     rh.ray.org_z = origin.z;

@@ -146,7 +146,7 @@ VisibilityGrid bake_visibility_grid(const RayScene& rays, const Scene& scene, co
     if (o.candidates.empty()) throw Error("bake: no occluder candidates in " + scene.source);
     for (std::uint32_t id : o.candidates)
         if (id >= scene.objects.size()) throw Error("bake: occluder candidate " + std::to_string(id) + " is not an object");
-    const RayScene candidate_rays(candidate_scene(scene, o.candidates));
+    const RayScene candidate_rays(candidate_scene(scene, o.candidates), rays.anchor());  // rounded as `rays`: their hits are compared
     const std::vector<glm::vec3> directions = sphere_directions(h.rays);
     const Aabb bounds = scene.bounds();
     const double diagonal = glm::length(glm::dvec3(bounds.extent()));

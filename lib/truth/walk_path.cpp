@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -210,6 +211,49 @@ CameraPath walk_path(const RayScene& rays, const Scene& scene, const WalkOptions
         }
         pending_turn = best_turn;
         turn_rate = 0.0;
+    }
+    return path;
+}
+
+CameraPath random_views(const RayScene& rays, const Scene& scene, int count, std::uint64_t seed) {
+    if (count < 1) throw Error("random views: the number of views must be at least 1");
+    const Aabb bounds = scene.bounds();
+    if (bounds.empty()) throw Error("random views: the scene " + scene.source + " is empty");
+    const glm::dvec3 lo(bounds.min), hi(bounds.max);
+    const double unit = default_eye_height(scene) / 1.7;  // 1, or 64 for scenes in inches
+    detail::SplitMix64 rng(seed);
+    // The six axes and the eight diagonals.
+    std::vector<glm::dvec3> probes;
+    for (int axis = 0; axis < 3; ++axis)
+        for (double sign : {-1.0, 1.0}) {
+            glm::dvec3 d(0.0);
+            d[axis] = sign;
+            probes.push_back(d);
+        }
+    for (int k = 0; k < 8; ++k) probes.push_back(glm::normalize(glm::dvec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1)));
+    CameraPath path;
+    for (int attempt = 0; int(path.frames.size()) < count; ++attempt) {
+        if (attempt >= 200 * count) throw Error("random views: no free space found in " + scene.source);
+        const glm::dvec3 eye(rng.uniform(lo.x, hi.x), rng.uniform(lo.y, hi.y), rng.uniform(lo.z, hi.z));
+        int hits = 0, back_faces = 0;
+        for (const glm::dvec3& d : probes) {
+            const RayHit hit = rays.intersect(eye, glm::vec3(d), 0.0f, std::numeric_limits<float>::infinity());
+            if (!hit.hit()) continue;
+            ++hits;
+            back_faces += glm::dot(glm::dvec3(hit.normal), d) > 0.0;
+        }
+        if (2 * back_faces > hits) continue;  // inside a solid
+        // A direction uniform on the sphere: z uniform in [-1, 1], the azimuth uniform.
+        const double z = rng.uniform(-1.0, 1.0), azimuth = rng.uniform(0.0, 2.0 * glm::pi<double>());
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const glm::dvec3 direction(r * std::cos(azimuth), z, r * std::sin(azimuth));
+        Camera c;
+        c.eye = eye;
+        c.target = eye + direction;
+        c.up = std::abs(direction.y) > 0.99 ? glm::dvec3(1.0, 0.0, 0.0) : glm::dvec3(0.0, 1.0, 0.0);
+        c.near_plane = 0.1 * unit;
+        c.far_plane = 10000.0 * unit;
+        path.frames.push_back(c);
     }
     return path;
 }

@@ -2,7 +2,9 @@
 //   S1 (default): workload S1's 1M rectangles against an exact double-precision depth at the
 //                 same sample centres.
 //   --scene F:    every object's AABB test against Embree ground truth at the display's pixel
-//                 centres, from the frames of --path, or of a generated walk or orbit.
+//                 centres, from the frames of --path, or of a generated walk, orbit or random
+//                 views. --offset X,Y,Z culls the scene moved by that much (from the views moved
+//                 with it) and judges it against ground truth on the unmoved scene.
 #include "commands.hpp"
 #include "cull_options.hpp"
 #include "options.hpp"
@@ -31,8 +33,10 @@ void run_scene_accuracy(const Options& o) {
     const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const RayScene rays(scene);
+    const glm::dvec3 offset = o.offset.empty() ? glm::dvec3(0.0) : parse_vec3(o.offset, "--offset");
     CameraPath views;
     if (!o.path.empty()) views = read_camera_path(o.path);
+    else if (o.random > 0) views = random_views(rays, scene, o.random, o.seed);
     else if (o.walk > 0) {
         WalkOptions walk;
         walk.frames = o.walk * 10;
@@ -42,20 +46,25 @@ void run_scene_accuracy(const Options& o) {
         const Aabb b = scene.bounds();
         views = orbit_path(glm::dvec3(b.min), glm::dvec3(b.max), o.orbit);
     } else {
-        throw Error("accuracy --scene needs views: --path P, --walk N or --orbit N");
+        throw Error("accuracy --scene needs views: --path P, --walk N, --orbit N or --random N");
     }
-    SceneCuller culler(scene, resources.occluders, config);
+    // The culler's own scene: the same, or moved (its resources, the occluder list and LODs, are
+    // by object id and model space, so they serve both).
+    const Scene moved = offset == glm::dvec3(0.0) ? Scene{} : translated_scene(scene, offset);
+    const Scene& culled_scene = offset == glm::dvec3(0.0) ? scene : moved;
+    SceneCuller culler(culled_scene, resources.occluders, config);
     const Resolution display = config.display;
     const BufferConfig& buffer = culler.buffer().config();
     CullingTally tally;
     for (std::size_t k = 0; k < views.frames.size(); ++k) {
-        tally_culling(scene, rays, culler, views.frames[k], tally);
+        tally_culling(scene, rays, culler, views.frames[k], tally, offset);
         if (!o.json) fmt::print(stderr, "\rview {}/{}", k + 1, views.frames.size());
     }
     if (!o.json) fmt::print(stderr, "\n");
     if (o.json) {
         const double views_count = std::max(1, tally.views);
-        fmt::print("{}\n", nlohmann::json{{"scene", scene.source}, {"display", {display.width, display.height}},
+        fmt::print("{}\n", nlohmann::json{{"scene", scene.source}, {"offset", {offset.x, offset.y, offset.z}},
+                                          {"display", {display.width, display.height}},
                                           {"buffer", {buffer.width, buffer.height}}, {"samples", buffer.samples},
                                           {"mode", o.cull.mode}, {"hole", config.maps.hole_pixels}, {"depth", o.cull.depth},
                                           {"views", tally.views}, {"occluder_triangles", culler.occluder_triangles()},
@@ -92,7 +101,9 @@ void register_accuracy(CLI::App& app) {
         std::string resolution = "1920x1080", s1_folder = "../shared/workloads/s1";
         SceneChoice scene;
         std::string path;
-        int samples = 0, walk = 0, orbit = 0;  // samples 0: 1 on S1, automatic_samples with --scene
+        int samples = 0, walk = 0, orbit = 0, random = 0;  // samples 0: 1 on S1, automatic_samples with --scene
+        std::uint64_t seed = 1;
+        std::string offset;
         CullOptions cull;  // --scene
         bool json = false;
     };
@@ -107,14 +118,19 @@ void register_accuracy(CLI::App& app) {
     CLI::Option* path = cmd->add_option("--path", o->path, "--scene: camera path whose frames are the views");
     CLI::Option* walk = cmd->add_option("--walk", o->walk, "--scene: views from a generated walk (N views, every 10th frame)");
     CLI::Option* orbit = cmd->add_option("--orbit", o->orbit, "--scene: N views on an orbit");
-    path->excludes(walk)->excludes(orbit);  // one source of views
-    walk->excludes(orbit);
+    CLI::Option* random = cmd->add_option("--random", o->random, "--scene: N random views from the scene's free space, looking anywhere");
+    cmd->add_option("--seed", o->seed, "--random: the views' seed")->capture_default_str();
+    cmd->add_option("--offset", o->offset,
+                    "--scene: cull the scene moved by x,y,z (views moved with it), judged against ground truth on the unmoved scene");
+    path->excludes(walk)->excludes(orbit)->excludes(random);  // one source of views
+    walk->excludes(orbit)->excludes(random);
+    orbit->excludes(random);
     add_cull_options(*cmd, o->cull, /*with_display=*/false);  // --scene: --buffer, --mode, --hole, --depth, --occluders, ...
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o, cmd] {
         if (o->scene.file.empty())  // S1 has its own buffer and no scene: these would be silently ignored
             for (const char* name : {"--path", "--walk", "--orbit", "--buffer", "--mode", "--hole", "--distribution", "--transparency",
-                                     "--soup-cells", "--depth", "--deb", "--finest-level", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--complexity", "--strategy", "--rank", "--grid", "--lod", "--budget", "--batch",
+                                     "--soup-cells", "--depth", "--deb", "--finest-level", "--random", "--offset", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--complexity", "--strategy", "--rank", "--grid", "--lod", "--budget", "--batch",
                                      "--hierarchy"})
                 if (cmd->get_option(name)->count() > 0) throw Error(std::string("accuracy: ") + name + " needs --scene");
         if (!o->scene.file.empty()) {

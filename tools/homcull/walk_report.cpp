@@ -2,6 +2,7 @@
 
 #include <homcull/error.hpp>
 #include <homcull/io/plots.hpp>
+#include <homcull/io/write_file.hpp>
 
 #include <fmt/core.h>
 
@@ -108,9 +109,7 @@ std::vector<std::string> write_walk_report(const std::string& dir, const std::st
             "});</script>\n";
     html += "</body></html>\n";
     const std::string page = dir + "/report.html";
-    std::ofstream out(page);
-    out << html;
-    if (!out) throw Error(page + ": cannot write the report");
+    write_file(page, html, "the report");
     written.push_back(page);
     return written;
 }

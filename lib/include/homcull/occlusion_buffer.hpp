@@ -453,5 +453,8 @@ std::string selected_isa();
 // A camera's view-projection matrix as a column-major float array for TriangleInput and
 // test_aabb (projection_matrix * view_matrix).
 std::array<float, 16> clip_from_world(const Camera& camera, double aspect);
+// A double matrix as the column-major float array TriangleInput and test_aabb take (each entry
+// rounded to nearest).
+std::array<float, 16> float_matrix(const glm::dmat4& m);
 
 }  // namespace homcull

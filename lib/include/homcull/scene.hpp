@@ -59,4 +59,21 @@ struct Scene {
 // the one definition used by ground truth, bounds and (later) the rasterizer's input.
 glm::vec3 transform_point(const glm::dmat4& world, const glm::vec3& p);
 
+// The scene moved by `offset`, as by a parent node translating it: every object's world
+// matrix is translate(offset) * world, in double; ids and meshes unchanged.
+Scene translated_scene(const Scene& scene, const glm::dvec3& offset);
+
+// Where the culler and ground truth put their floats' origin: the centre of the scene's bounds
+// (the origin for an empty scene or infinite bounds). World positions rounded to float lose
+// 2^-24 of their distance from the origin they are taken from: at 1e4 from the world's origin
+// that is 5e-4, enough to open or close one-pixel cracks; taken from the anchor it is 2^-24 of
+// the scene's extent, wherever the scene lies.
+glm::dvec3 scene_anchor(const Scene& scene);
+// transform_point relative to an anchor: the world position minus the anchor, in double, then
+// rounded to float. The one definition of "a vertex as the culler and ground truth see it".
+glm::vec3 transform_point_from(const glm::dmat4& world, const glm::vec3& p, const glm::dvec3& anchor);
+// A world box relative to an anchor, rounded outwards: it holds every anchored point of the
+// objects inside the world box (and the world box itself, moved).
+Aabb anchored_box(const Aabb& world_box, const glm::dvec3& anchor);
+
 }  // namespace homcull

@@ -143,6 +143,10 @@ private:
     const Scene* scene_;
     SceneCullerConfig config_;
     std::vector<std::uint32_t> occluder_ids_;
+    // Every float position and box the buffer and maps see is relative to this point
+    // (scene_anchor, as ground truth's), so that scenes far from the origin keep their precision.
+    glm::dvec3 anchor_;
+    std::vector<Aabb> object_boxes_, node_boxes_;  // world_bounds and the hierarchy's node bounds, anchored
     WorldTriangles occluders_;  // shared-edge flags across the whole candidate set
     // Per candidate k (occluder_ids_[k]): its triangles are [first_triangle_[k], first_triangle_[k + 1]).
     std::vector<std::uint32_t> first_triangle_;

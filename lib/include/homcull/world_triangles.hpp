@@ -1,7 +1,8 @@
 #pragma once
 // A scene's occluders as one world-space triangle list, ready for OcclusionBuffer::render:
-// positions transformed exactly as ground truth transforms them (transform_point), and the
-// shared-edge flags of the whole set (edges shared between objects count too).
+// positions transformed exactly as ground truth transforms them (transform_point_from, relative
+// to an anchor: the scene culler's and ground truth's is scene_anchor), and the shared-edge
+// flags of the whole set (edges shared between objects count too).
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/scene.hpp>
 
@@ -19,12 +20,14 @@ struct WorldTriangles {
     TriangleInput input(const std::array<float, 16>& clip_from_world, Backface backface = Backface::cw) const;
 };
 
-// Appends an object's vertices in world space (x, y, z each), transformed exactly as ground
-// truth transforms them, in the order of its mesh's positions.
-void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions);
+// Appends an object's vertices in world space relative to `anchor` (x, y, z each), transformed
+// exactly as ground truth transforms them, in the order of its mesh's positions.
+void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions,
+                            const glm::dvec3& anchor = glm::dvec3(0.0));
 
-// The triangles of the given objects. Allocates: meant for load time or tools.
-WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects);
+// The triangles of the given objects, relative to `anchor`. Allocates: meant for load time or tools.
+WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects,
+                                      const glm::dvec3& anchor = glm::dvec3(0.0));
 
 // Ids of the objects whose extra "role" equals `role`, or of every object when role is empty.
 std::vector<std::uint32_t> objects_with_role(const Scene& scene, std::string_view role);

@@ -40,7 +40,10 @@ void tally_answers(const Scene& scene, const TruthResult& truth, const std::vect
                    CullingTally& tally);
 
 // Culls the scene from `camera` with `culler` and tallies its answers against ground truth
-// cast at the display's pixel centres (the culler's display resolution).
-void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally);
+// cast at the display's pixel centres (the culler's display resolution). With an offset, the
+// culler's scene is `scene` moved by it (translated_scene, the same object ids) and it culls
+// from the camera moved by it: the moved culler judged against the exact, unmoved geometry.
+void tally_culling(const Scene& scene, const RayScene& rays, SceneCuller& culler, const Camera& camera, CullingTally& tally,
+                   const glm::dvec3& culler_offset = glm::dvec3(0.0));
 
 }  // namespace homcull

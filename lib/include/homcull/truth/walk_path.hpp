@@ -26,6 +26,14 @@ struct WalkOptions {
 // Throws homcull::Error when no walkable floor with room to walk is found.
 CameraPath walk_path(const RayScene& rays, const Scene& scene, const WalkOptions& options);
 
+// `count` still views from random points of the scene's free space, looking anywhere: each eye
+// uniform in the scene's bounding box, kept when it is not inside a solid (it sees the back of
+// surfaces in at most half of 14 directions that meet any), with a direction uniform on the
+// sphere (up +y, or +x when looking nearly straight up or down) and fov_y 60. Near 0.1 and far
+// 10000 (64 times both for scenes over 2,000 units across, as default_eye_height). Throws
+// homcull::Error when the scene is empty or 200 times `count` eyes were all inside solids.
+CameraPath random_views(const RayScene& rays, const Scene& scene, int count, std::uint64_t seed);
+
 // The automatic eye height of WalkOptions for a scene.
 double default_eye_height(const Scene& scene);
 

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Builds the test suite with a sanitizer (gcc) into build-<kind>/ and runs it with ctest.
+#   scripts/sanitize.sh asan   AddressSanitizer + UndefinedBehaviorSanitizer (float-cast-overflow
+#                              too, which -fsanitize=undefined leaves out), the whole suite
+#   scripts/sanitize.sh tsan   ThreadSanitizer, the threading tests (their job system is plain
+#                              std::thread: oneTBB is not instrumented, and TSan reports its
+#                              internals as races)
+# Any report fails the run (halt_on_error). Expects the dependencies installed
+# (scripts/install-deps.sh). Extra arguments go to ctest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+kind=${1:?usage: scripts/sanitize.sh asan|tsan [ctest arguments]}
+shift
+case "$kind" in
+  asan)
+    flags="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer"
+    export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
+    export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+    # Leaks inside uninstrumented system libraries (fontconfig through OpenImageIO's text) are theirs.
+    export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0"
+    filter=()
+    ;;
+  tsan)
+    flags="-fsanitize=thread -fno-omit-frame-pointer"
+    export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1"
+    # The tests whose work runs on several threads: renders, queries and the culler with a job
+    # system (tests/support.hpp's StdThreadJobs under TSan).
+    filter=(-R "RenderThreads|HiddenTriangleSkip|FrameAllocations|SceneCulling|OccluderClusters|ThreadedJobs")
+    ;;
+  *) echo "sanitize.sh: unknown kind '$kind' (asan or tsan)" >&2; exit 2 ;;
+esac
+dir="build-$kind"
+generator=()
+if [ ! -f "$dir/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DHOMCULL_BUILD_TESTS=ON \
+  -DHOMCULL_SANITIZE="$kind" -DCMAKE_CXX_FLAGS="$flags -g1" \
+  -DCMAKE_EXE_LINKER_FLAGS="$flags" -DCMAKE_SHARED_LINKER_FLAGS="$flags"
+cmake --build "$dir" --parallel "$(nproc)"
+cd "$dir"
+ctest --output-on-failure --parallel "$(nproc)" --timeout 1800 "${filter[@]}" "$@"
