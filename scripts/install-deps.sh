@@ -18,6 +18,7 @@ packages=(
   libtinygltf-dev                 # glTF/GLB import and export (keeps node order and extras)
   assimp-testmodels               # test data: the IFC source of fzk_haus.glb, for the IFC import test
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev        # the fuzzers (libFuzzer, scripts/fuzz.sh)
   libgmp-dev                      # the conservativeness tests' exact rational oracle (gmpxx)
   g++-aarch64-linux-gnu           # the test that the SIMD kernels compile for Arm NEON/SVE (scripts/check-neon.sh)
 )

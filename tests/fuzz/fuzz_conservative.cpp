@@ -1,0 +1,87 @@
+// libFuzzer target: the conservativeness property against the exact oracle (exact_oracle.hpp).
+// The bytes give a small buffer and a few occluder triangles (float positions, any finite value,
+// under a matrix that may translate large model coordinates back near the eye), queries, and the
+// instruction set. Every claimed sample must be backed by an occluder at or nearer than the claim,
+// and every rectangle and occludee triangle answered occluded must be hidden at every sample
+// centre, exactly; any violation traps.
+#include "../exact_oracle.hpp"
+#include "fuzz_input.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/occlusion_buffer.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace {
+
+using homcull::fuzz::Bytes;
+
+// A finite float from the bytes: as it comes when finite, else a small value made from it.
+float finite(Bytes& in) {
+    const float f = in.take<float>();
+    return std::isfinite(f) ? f : float(in.below(2001)) * 0.001f - 1.0f;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    using namespace homcull;
+    static const std::vector<std::string> isas = available_isas();
+    Bytes in(data, size);
+    select_isa(isas[in.below(std::uint32_t(isas.size()))]);
+    const int samples[3] = {1, 2, 4};
+    BufferConfig config;
+    config.width = 1 + int(in.below(24));
+    config.height = 1 + int(in.below(16));
+    config.samples = samples[in.below(3)];
+    config.near_w = 0.01f + float(in.below(200)) * 0.01f;
+    config.sample_depth = in.flag();
+
+    // The matrix: clip (x, y, ., w) = (position - origin) for positions (x, y, w), or the cancelling
+    // form x = (h + a) - h, y = (h + b) - h, w = 1 with one large h for positions (h, a, b).
+    TriangleInput tri;
+    std::vector<float> positions;
+    const int triangles = 1 + int(in.below(8));
+    if (in.flag()) {
+        const float h = std::ldexp(1.0f + float(in.below(1u << 20)) * 0x1.0p-20f, int(in.below(100)));
+        tri.model_to_clip = {1, 1, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -h, -h, 0, 1};
+        for (int v = 0; v < 3 * triangles; ++v) positions.insert(positions.end(), {h, finite(in), finite(in)});
+    } else {
+        const float origin[3] = {finite(in), finite(in), finite(in)};
+        tri.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, -origin[0], -origin[1], 0, -origin[2]};
+        for (int v = 0; v < 3 * triangles; ++v) {
+            const float x = finite(in), y = finite(in), w = finite(in);
+            positions.insert(positions.end(), {x + origin[0], y + origin[1], w + origin[2]});
+        }
+    }
+    tri.positions = positions.data();
+    tri.vertex_count = positions.size() / 3;
+    tri.triangle_count = std::size_t(triangles);
+    tri.backface = Backface::none;
+
+    OcclusionBuffer buffer(config);
+    buffer.render_frame(tri);
+    const std::vector<test::ExactTriangle> occluders = test::exact_triangles(tri);
+    if (test::unbacked_claims(buffer, occluders) != 0) __builtin_trap();
+    const int sw = buffer.sample_width(), sh = buffer.sample_height();
+    for (int q = 0; q < 4 && in.left() >= 20; ++q) {
+        const ScreenRect r{finite(in), finite(in), finite(in), finite(in), finite(in)};
+        if (buffer.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min) == Visibility::occluded &&
+            !test::rect_truly_hidden(occluders, r, sw, sh, config.near_w))
+            __builtin_trap();
+    }
+    if (in.left() >= 36) {
+        TriangleInput occludee = tri;
+        std::vector<float> p;
+        for (int k = 0; k < 9; ++k) p.push_back(finite(in));
+        occludee.positions = p.data();
+        occludee.vertex_count = 3;
+        occludee.triangle_count = 1;
+        if (buffer.test_triangles(occludee).visibility == Visibility::occluded &&
+            !test::triangles_truly_hidden(occluders, test::exact_triangles(occludee), sw, sh, config.near_w))
+            __builtin_trap();
+    }
+    return 0;
+}
