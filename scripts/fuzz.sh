@@ -20,6 +20,7 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TY
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
 cmake --build build-fuzz --parallel "$(nproc)" --target "${targets[@]}"
 export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1"
+export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 status=0
 for t in "${targets[@]}"; do
@@ -31,7 +32,7 @@ for t in "${targets[@]}"; do
     tail -40 "build-fuzz/$t.log" >&2
     status=1
   else
-    grep -E "stat::number_of_executed_runs|stat::peak_rss_mb" "build-fuzz/$t.log" | sed "s/^/fuzz: $t: /" >&2 || true
+    grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "build-fuzz/$t.log" | sed "s/^/fuzz: $t: /" >&2 || true
     echo "fuzz: $t clean" >&2
   fi
 done

@@ -8,6 +8,7 @@
 #include "exact_oracle.hpp"
 #include "support.hpp"
 
+#include "raster/rasterize.hpp"
 #include "raster/triangle_setup.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -15,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <cfloat>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -264,6 +266,57 @@ TEST(Conservative, LargeCancellingCoordinatesClaimNoSampleOutsideTheOccluders) {
         }
     }
     select_isa("best");
+}
+
+// A triangle whose w spans 10^33 down to behind the eye: the near-plane clip's interpolation
+// parameter rounds to 1 and the clipped vertex lands at w = 0, not near_w, so the buffer claimed
+// depths in front of the near plane (443 samples; found by fuzz_conservative). Such a triangle is
+// too large to clip precisely, and is skipped.
+TEST(Conservative, AWRangeTooLargeToClipClaimsNothing) {
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        // fuzz_conservative's case as it found it: clip = position - origin, origin (-0.0018, 1.7e-6, -6.7e16).
+        const std::vector<float> positions = {-0.00182647293f, 1.6704563e-06f, 4.64922061e+33f, 29.6489086f, 3.56850887e-06f,
+                                              -6.73231571e+16f, -3500.91016f, 1.6704563e-06f, -8.98869087e+20f};
+        TriangleInput in;
+        in.positions = positions.data();
+        in.vertex_count = 3;
+        in.triangle_count = 1;
+        in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0.00182650844f, -1.6704563e-06f, 0, 6.73231571e+16f};
+        in.backface = Backface::none;
+        OcclusionBuffer buffer(test::buffer_config(17, 13, 4, 0.43f, true));
+        buffer.render_frame(in);
+        EXPECT_EQ(test::unbacked_claims(buffer, test::exact_triangles(in)), 0) << isa;
+        EXPECT_EQ(buffer.stats().too_large, 1u) << isa;
+    }
+    select_isa("best");
+}
+
+// A NaN bound (from extreme finite setup values) must bound nothing, never drop its bound: int(NaN)
+// is undefined, and on x86 INT_MIN, which made the span or the row the whole range.
+TEST(Conservative, NanBoundsGiveEmptySpansAndRows) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    int first = 0, last = 0;
+    detail::sample_span(nan, 5.0, 64, first, last);
+    EXPECT_GT(first, last);
+    detail::sample_span(2.0, nan, 64, first, last);
+    EXPECT_GT(first, last);
+    detail::sample_span(2.0, 5.0, 64, first, last);  // and the finite case as before: centres 2.5 .. 4.5
+    EXPECT_EQ(first, 2);
+    EXPECT_EQ(last, 4);
+
+    detail::TriangleEdges edges{};
+    for (int k = 0; k < 3; ++k) {  // three edges keeping x > 0.5 (samples 1 and on)
+        edges.ox[k] = 0.5, edges.oy[k] = 0.0, edges.sa[k] = 1.0, edges.sb[k] = 0.0, edges.inverse_sa[k] = 1.0;
+        edges.threshold[k] = 0.0, edges.shared[k] = false;
+    }
+    std::int32_t row_first = 0, row_last = 0;
+    detail::sample_row_interval(edges, 3, 0, 63, row_first, row_last);
+    EXPECT_EQ(row_first, 1);
+    EXPECT_EQ(row_last, 63);
+    edges.ox[1] = nan;
+    detail::sample_row_interval(edges, 3, 0, 63, row_first, row_last);
+    EXPECT_GT(row_first, row_last);
 }
 
 }  // namespace

@@ -118,6 +118,18 @@ TEST(MalformedInput, NonFiniteVerticesDropTheirTrianglesOnly) {
             << o.name;
 }
 
+// Names are bytes in OBJ files, UTF-8 in glTF and JSON: invalid bytes become U+FFFD at load, so
+// that the scene can be saved and printed (fuzz_scene_import found the exception that escaped).
+TEST(MalformedInput, NamesThatAreNotUtf8AreMadeValid) {
+    const std::string dir = test::temp_dir("NotUtf8");
+    test::write_text(dir + "/names.obj", "o bad\x8a\xe3name\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const Scene scene = load_scene(dir + "/names.obj");
+    ASSERT_EQ(scene.objects.size(), 1u);
+    EXPECT_EQ(scene.objects[0].name, "bad\xEF\xBF\xBD\xEF\xBF\xBDname");
+    save_glb(scene, dir + "/names.glb");
+    EXPECT_EQ(load_scene(dir + "/names.glb").objects[0].name, scene.objects[0].name);
+}
+
 TEST(MalformedInput, BrokenObjFiles) {
     const std::string dir = test::temp_dir("BrokenObj");
     test::write_text(dir + "/garbage.obj", "\x01\x02\x03 not an obj\n");

@@ -95,8 +95,12 @@ void save_glb(const Scene& scene, const std::string& path) {
     // writing does not (a folder as the path, a missing folder, a full disk).
     tinygltf::TinyGLTF writer;
     std::ostringstream glb;
-    if (!writer.WriteGltfSceneToStream(&model, glb, /*prettyPrint=*/false, /*writeBinary=*/true))
-        throw Error(path + ": could not serialize the scene as glTF");
+    try {
+        if (!writer.WriteGltfSceneToStream(&model, glb, /*prettyPrint=*/false, /*writeBinary=*/true))
+            throw Error(path + ": could not serialize the scene as glTF");
+    } catch (const std::exception& e) {  // nlohmann::json's, for text JSON cannot hold
+        throw Error(path + ": could not serialize the scene as glTF: " + e.what());
+    }
     write_file(path, glb.str(), "the scene");
 }
 

@@ -56,10 +56,10 @@ HWY_INLINE void ClipFates(D d, Backface backface, double near_w, hwy::HWY_NAMESP
     M behind = finite, right = finite, left = finite, above = finite, below = finite, needs_clip = hn::Not(finite);
     V extent = zero, min_w = infinity;
     const auto corner = [&](V x, V y, V w) {
-        const V ax = hn::Abs(x), ay = hn::Abs(y);
+        const V ax = hn::Abs(x), ay = hn::Abs(y), aw = hn::Abs(w);
         AddSidePlaneCorner(d, x, y, w, finite, right, left, above, below);  // finite_clip, outside_side_plane
         behind = hn::And(behind, hn::Lt(w, near));                          // outside_frustum
-        extent = hn::Max(extent, hn::Max(ax, ay));  // too_large_to_clip (max and min are exact)
+        extent = hn::Max(extent, hn::Max(hn::Max(ax, ay), aw));  // too_large_to_clip (max and min are exact)
         min_w = hn::Min(min_w, w);
         const V band = hn::Mul(guard, w);  // needs_clipping
         needs_clip = hn::Or(needs_clip, hn::Or(hn::Lt(w, near), hn::Or(hn::Gt(ax, band), hn::Gt(ay, band))));

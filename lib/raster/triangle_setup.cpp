@@ -52,7 +52,7 @@ bool too_large_to_clip(const glm::dvec4 clip[3], double near_w) {
     double extent = 0.0, min_w = HUGE_VAL;
     for (int k = 0; k < 3; ++k) {
         const glm::dvec4& c = clip[k];
-        extent = std::max({extent, std::abs(c.x), std::abs(c.y)});
+        extent = std::max({extent, std::abs(c.x), std::abs(c.y), std::abs(c.w)});
         min_w = std::min(min_w, c.w);
     }
     return extent > 0x1.0p28 * std::max(near_w, min_w);

@@ -110,8 +110,10 @@ bool outside_frustum(const glm::dvec4 clip[3], double near_w);
 // exact to far below the coverage margin.
 constexpr double kGuardBand = 32.0;
 
-// Reaching more than 2^28 times its nearest w (or near_w) in x or y: clipping it in double would
-// lose the precision conservative coverage needs (RasterStats::too_large).
+// Reaching more than 2^28 times its nearest w (or near_w) in x, y or w: clipping it in double would
+// lose the precision conservative coverage needs (RasterStats::too_large). w counts too: a vertex
+// at w = 4.6e33 and one behind the eye put the clipped vertex at w = 0 instead of near_w (the
+// interpolation's parameter rounds to 1), and so a depth in front of the near plane.
 bool too_large_to_clip(const glm::dvec4 clip[3], double near_w);
 
 // Whether a vertex lies before the near plane or beyond the guard band: the triangle is clipped.

@@ -73,7 +73,45 @@ Aabb anchored_box(const Aabb& world_box, const glm::dvec3& anchor) {
     return b;
 }
 
+namespace {
+
+// `text` with every byte that does not start or continue a valid UTF-8 sequence replaced by
+// U+FFFD: names reach glTF and JSON, which hold only UTF-8 (an OBJ group name may be any bytes).
+std::string valid_utf8(const std::string& text) {
+    std::string out;
+    out.reserve(text.size());
+    const auto* b = reinterpret_cast<const unsigned char*>(text.data());
+    const std::size_t n = text.size();
+    for (std::size_t i = 0; i < n;) {
+        const unsigned char c = b[i];
+        std::size_t length = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+        bool ok = length > 0 && i + length <= n;
+        for (std::size_t k = 1; ok && k < length; ++k) ok = (b[i + k] & 0xC0) == 0x80;
+        if (ok && length > 1) {  // no overlong forms, surrogates or code points past U+10FFFF
+            std::uint32_t cp = c & (0xFFu >> (length + 1));
+            for (std::size_t k = 1; k < length; ++k) cp = (cp << 6) | (b[i + k] & 0x3Fu);
+            const std::uint32_t least[5] = {0, 0, 0x80, 0x800, 0x10000};
+            ok = cp >= least[length] && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF);
+        }
+        if (ok) {
+            out.append(text, i, length);
+            i += length;
+        } else {
+            out += "\xEF\xBF\xBD";
+            ++i;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
 void Scene::finalize() {
+    for (Mesh& mesh : meshes) mesh.name = valid_utf8(mesh.name);
+    for (Object& object : objects) {
+        object.name = valid_utf8(object.name);
+        for (auto& [key, value] : object.extras) key = valid_utf8(key), value = valid_utf8(value);
+    }
     for (std::size_t m = 0; m < meshes.size(); ++m) {
         const Mesh& mesh = meshes[m];
         if (mesh.indices.size() % 3 != 0)

@@ -77,8 +77,8 @@ struct RasterStats {
     std::uint64_t invalid = 0;            // non-finite vertex or index out of range
     std::uint64_t outside = 0;            // entirely outside the frustum
     std::uint64_t near_clipped = 0;       // crossed the near plane (or the guard band)
-    // Reaching more than 2^28 times its nearest w in x or y: clipping it in double would lose
-    // the precision conservative coverage needs, so it is skipped (as an occluder, safely).
+    // Reaching more than 2^28 times its nearest w (or near_w) in x, y or w: clipping it in double
+    // would lose the precision conservative coverage needs, so it is skipped (as an occluder, safely).
     std::uint64_t too_large = 0;
     std::uint64_t backface_culled = 0;
     std::uint64_t degenerate = 0;         // zero area after projection

@@ -51,7 +51,8 @@ struct Scene {
 
     // Checks that every object names a mesh and every index names a vertex (throws
     // homcull::Error naming the source, the mesh and the bad index), then computes every
-    // object's world_bounds. Importers and generators call it last.
+    // object's world_bounds, and makes names and extras valid UTF-8 (invalid bytes become U+FFFD:
+    // they reach glTF and JSON). Importers and generators call it last.
     void finalize();
 };
 
