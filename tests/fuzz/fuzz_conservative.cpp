@@ -45,7 +45,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::vector<float> positions;
     const int triangles = 1 + int(in.below(8));
     if (in.flag()) {
-        const float h = std::ldexp(1.0f + float(in.below(1u << 20)) * 0x1.0p-20f, int(in.below(100)));
+        // h within the transform's guaranteed range (docs/occlusion-buffer.md): 2h <= 2^60 near_w.
+        const float h = std::ldexp(1.0f + float(in.below(1u << 20)) * 0x1.0p-20f, int(in.below(52)));
         tri.model_to_clip = {1, 1, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -h, -h, 0, 1};
         for (int v = 0; v < 3 * triangles; ++v) positions.insert(positions.end(), {h, finite(in), finite(in)});
     } else {
