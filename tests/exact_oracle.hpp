@@ -46,10 +46,8 @@ bool exact_hit(const ExactTriangle& tri, const ExactSample& s, const mpq_class& 
 // decided in double with an error bound.
 bool hit_at_or_nearer(const ExactTriangle& tri, const ExactSample& s, const mpq_class& inverse_near_w, double inverse_near_d, float d);
 
-// An input's triangles that a render would draw (not culled as back faces by the input's
-// Backface rule, not invalid), ready for hits.
-std::vector<ExactTriangle> exact_occluders(const TriangleInput& in);
-// All of an input's valid triangles, whatever their facing (occludee triangles count either way).
+// All of an input's valid triangles, whatever their facing: an occluder's claim is right when any
+// surface backs it, and occludee triangles count either way.
 std::vector<ExactTriangle> exact_triangles(const TriangleInput& in);
 
 // The largest exact 1/w of the triangles at the sample (0 where none covers it at w >= near_w).

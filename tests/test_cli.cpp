@@ -287,6 +287,22 @@ TEST(Cli, OutputsThatCannotBeWrittenAreErrors) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/missing"));
 }
 
+// accuracy --random views from free space, with the culler's scene moved by --offset and judged
+// against the unmoved truth; the options are refused where they mean nothing.
+TEST(Cli, AccuracyOnAMovedSceneFromRandomViews) {
+    const CliRun r = run_cli("accuracy --scene gen:city:seed=2,blocks=3 --random 3 --seed 4 --resolution 160x90 --offset 1e5,0,1e5 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["views"], 3);
+    EXPECT_EQ(j["offset"][0], 1e5);
+    EXPECT_EQ(j["false_culls"], 0);
+    EXPECT_GT(j["hidden_in_frustum"].get<int>(), 0);
+    expect_refused("accuracy --random 3", 1, "--random needs --scene");
+    expect_refused("accuracy --scene gen:city:seed=2,blocks=3 --random 2 --walk 2", kUsageError, "excludes");
+    expect_refused("accuracy --scene gen:city:seed=2,blocks=3 --random 2 --offset 1,2", 1, "--offset");
+    expect_refused("accuracy --scene gen:city:seed=2,blocks=3 --random 2 --offset 1e39,0,0", 1, "beyond the float range");
+}
+
 // A node matrix that takes finite vertices to infinity is said, not silent.
 TEST(Cli, InfiniteWorldVerticesAreReported) {
     const std::string dir = test::temp_dir("cli_infinite");

@@ -294,7 +294,7 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         if (n < kBatch) {
             result.deciding_triangle = t;
             glm::dvec4 model[3], clip[3];
-            if (!detail::fetch_clip_triangle(in, t, model, clip)) return visible();  // nothing to reason with: never cull
+            if (!detail::fetch_clip_triangle(in, t, model, clip, /*plain=*/true)) return visible();  // nothing to reason with: never cull
             if (shows(model, clip)) return visible();
             ++n;
             t = t + 1 == in.triangle_count ? 0 : t + 1;
@@ -302,7 +302,7 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         }
         const std::size_t count = std::min({kBatch, in.triangle_count - t, in.triangle_count - n});  // up to the wrap
         detail::gather_triangle_batch(in, t, int(count), batch);
-        kernels.transform_batch(in, batch);
+        kernels.transform_batch_plain(in, batch);
         // Lanes beyond a side plane (valid and finite) cannot show the occludee: shows() would
         // pass over them first thing. Decided for the whole batch in SIMD lanes: most lanes on
         // a walk (the castle's: 88 %). The others are taken in order, as before.

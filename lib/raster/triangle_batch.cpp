@@ -112,13 +112,20 @@ std::size_t gather_cached_batch(const TriangleInput& in, const VertexClip& cache
     return with_typed_indices(in, [&](const auto* indices) { return gather_cached(indices, in, cache, first, end, batch, stats); });
 }
 
-void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch) {
+namespace {
+template <bool kPlain>
+void transform_batch_with(const TriangleInput& in, TriangleBatch& batch) {
     for (int t = 0; t < TriangleBatch::kSize; ++t)
         for (int k = 0; k < 3; ++k) {
-            const glm::dvec4 c = transform_to_clip(in.model_to_clip, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t]);
+            const glm::dvec4 c = kPlain ? transform_to_clip_plain(in.model_to_clip, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t])
+                                        : transform_to_clip(in.model_to_clip, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t]);
             batch.cx[k][t] = c.x, batch.cy[k][t] = c.y, batch.cz[k][t] = c.z, batch.cw[k][t] = c.w;
         }
 }
+}  // namespace
+
+void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch) { transform_batch_with<false>(in, batch); }
+void transform_batch_plain_reference(const TriangleInput& in, TriangleBatch& batch) { transform_batch_with<true>(in, batch); }
 
 std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count) {
     std::uint32_t bits = 0;

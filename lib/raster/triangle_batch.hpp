@@ -145,7 +145,10 @@ struct FrontEndKernels {
     // every vertex (finite_clip) and all three vertices beyond one side plane
     // (outside_side_plane), as bits (lane t: bit t).
     std::uint32_t (*beyond_side_plane)(const TriangleBatch& batch, int count);
+    // transform_batch with transform_to_clip_plain: the occludee tests' (they bound its error).
+    TransformBatchKernel transform_batch_plain;
 };
+void transform_batch_plain_reference(const TriangleInput& in, TriangleBatch& batch);
 std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count);
 
 // Whether triangles [first, first + TriangleBatch::kSize) of the input are consecutive

@@ -32,10 +32,13 @@ HWY_INLINE V TwoSumError(V a, V b, V s) {
     return hn::Add(hn::Sub(a, hn::Sub(s, b_virtual)), hn::Sub(b, b_virtual));
 }
 
-// transform_to_clip's row r: accurate_sum4(m[r] x, m[4 + r] y, m[8 + r] z, m[12 + r] w).
+// transform_to_clip's row r: accurate_sum4(m[r] x, m[4 + r] y, m[8 + r] z, m[12 + r] w); with
+// kPlain, transform_to_clip_plain's ((m[r] x + m[4 + r] y) + m[8 + r] z) + m[12 + r] w.
+template <bool kPlain = false>
 HWY_INLINE V ClipRow(D d, const std::array<float, 16>& m, int r, V x, V y, V z, V w) {
     const V p0 = hn::Mul(hn::Set(d, double(m[r])), x), p1 = hn::Mul(hn::Set(d, double(m[4 + r])), y);
     const V p2 = hn::Mul(hn::Set(d, double(m[8 + r])), z), p3 = hn::Mul(hn::Set(d, double(m[12 + r])), w);
+    if (kPlain) return hn::Add(hn::Add(hn::Add(p0, p1), p2), p3);
     const V s1 = hn::Add(p0, p1);
     V error = TwoSumError(p0, p1, s1);
     const V s2 = hn::Add(s1, p2);
@@ -143,7 +146,8 @@ void GatherDirectBatch(const TriangleInput& in, std::size_t first, const std::ui
     batch.indices_valid = (1u << kSize) - 1u;
 }
 
-void TransformBatch(const TriangleInput& in, TriangleBatch& batch) {
+template <bool kPlain>
+HWY_INLINE void TransformBatchWith(const TriangleInput& in, TriangleBatch& batch) {
     const D d;
     const int lanes = int(hn::Lanes(d));
     if (is_identity(in.model_to_clip)) {
@@ -171,12 +175,15 @@ void TransformBatch(const TriangleInput& in, TriangleBatch& batch) {
         for (int k = 0; k < 3; ++k) {
             const V px = hn::Load(d, batch.px[k] + g), py = hn::Load(d, batch.py[k] + g), pz = hn::Load(d, batch.pz[k] + g),
                     pw = hn::Load(d, batch.pw[k] + g);
-            hn::Store(ClipRow(d, in.model_to_clip, 0, px, py, pz, pw), d, batch.cx[k] + g);
-            hn::Store(ClipRow(d, in.model_to_clip, 1, px, py, pz, pw), d, batch.cy[k] + g);
-            hn::Store(ClipRow(d, in.model_to_clip, 2, px, py, pz, pw), d, batch.cz[k] + g);
-            hn::Store(ClipRow(d, in.model_to_clip, 3, px, py, pz, pw), d, batch.cw[k] + g);
+            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 0, px, py, pz, pw), d, batch.cx[k] + g);
+            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 1, px, py, pz, pw), d, batch.cy[k] + g);
+            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 2, px, py, pz, pw), d, batch.cz[k] + g);
+            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 3, px, py, pz, pw), d, batch.cw[k] + g);
         }
 }
+
+void TransformBatch(const TriangleInput& in, TriangleBatch& batch) { TransformBatchWith<false>(in, batch); }
+void TransformBatchPlain(const TriangleInput& in, TriangleBatch& batch) { TransformBatchWith<true>(in, batch); }
 
 void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, RasterStats& stats) {
     const D d;
@@ -393,6 +400,7 @@ namespace homcull::detail {
 
 HWY_EXPORT(TransformVertices);
 HWY_EXPORT(TransformBatch);
+HWY_EXPORT(TransformBatchPlain);
 HWY_EXPORT(GatherDirectBatch);
 HWY_EXPORT(ClassifyBatch);
 HWY_EXPORT(SetupPlanes);
@@ -402,10 +410,10 @@ HWY_EXPORT(BeyondSidePlane);
 FrontEndKernels selected_front_end_kernels() {
     if (scalar_reference_selected())
         return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr, nullptr,
-                &beyond_side_plane_reference};
+                &beyond_side_plane_reference, &transform_batch_plain_reference};
     return {HOMCULL_RESOLVED_KERNEL(TransformVertices), HOMCULL_RESOLVED_KERNEL(TransformBatch), HOMCULL_RESOLVED_KERNEL(ClassifyBatch),
             HOMCULL_RESOLVED_KERNEL(SetupPlanes), HOMCULL_RESOLVED_KERNEL(SetupEdges),
-            HOMCULL_RESOLVED_KERNEL(GatherDirectBatch), HOMCULL_RESOLVED_KERNEL(BeyondSidePlane)};
+            HOMCULL_RESOLVED_KERNEL(GatherDirectBatch), HOMCULL_RESOLVED_KERNEL(BeyondSidePlane), HOMCULL_RESOLVED_KERNEL(TransformBatchPlain)};
 }
 
 }  // namespace homcull::detail

@@ -23,7 +23,7 @@ void check_triangle_input(const TriangleInput& in, const char* caller) {
         fail("without indices, at most 2^32 / 3 triangles per call (vertex numbers are 32-bit, as indices)");
 }
 
-bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3]) {
+bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3], bool plain) {
     std::uint32_t index[3];
     for (int k = 0; k < 3; ++k) index[k] = vertex_index(in, t, k);
     if (index[0] >= in.vertex_count || index[1] >= in.vertex_count || index[2] >= in.vertex_count) return false;
@@ -32,7 +32,8 @@ bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 mode
         float p[4];
         read_position(in, index[k], p);
         model[k] = {p[0], p[1], p[2], p[3]};
-        clip[k] = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
+        clip[k] = plain ? transform_to_clip_plain(in.model_to_clip, p[0], p[1], p[2], p[3])
+                        : transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
         valid = valid && finite_clip(clip[k]);
     }
     return valid;

@@ -48,6 +48,17 @@ inline glm::dvec4 transform_to_clip(const std::array<float, 16>& m, double x, do
     return r;
 }
 
+// The plain sum of the same products, ((m x + m y) + m z) + m w: off by up to 3 * 2^-53 of
+// the terms' magnitudes. For the occludee tests, which pad every vertex by 2^-22 of that
+// magnitude anyway (clip_error in core/occludee_triangles.cpp) and so need no more; their
+// transform is most of what they cost (castle C0's occludee tests: about 15 % slower with Sum2).
+inline glm::dvec4 transform_to_clip_plain(const std::array<float, 16>& m, double x, double y, double z, double w) {
+    glm::dvec4 r;
+    for (int row = 0; row < 4; ++row)
+        r[row] = double(m[row]) * x + double(m[4 + row]) * y + double(m[8 + row]) * z + double(m[12 + row]) * w;
+    return r;
+}
+
 // Whether m is the identity (a -0 counts as 0): transform_to_clip then returns the position,
 // but for the sign of a zero and for a position with a coordinate that is not finite (all NaN).
 inline bool is_identity(const std::array<float, 16>& m) {
@@ -96,7 +107,8 @@ inline void read_position(const TriangleInput& in, std::uint32_t v, float p[4]) 
 
 // Triangle t's vertices as given (x, y, z, w with w = 1 for 3 components) and in clip space.
 // False when an index is out of range or a clip coordinate is not finite.
-bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3]);
+// plain: with transform_to_clip_plain (the occludee tests) instead of transform_to_clip.
+bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3], bool plain = false);
 
 // Whether all three vertices lie outside one side plane of the view frustum (|x| or |y| > w):
 // then so does the whole triangle.

@@ -21,6 +21,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <memory>
 
 namespace homcull::cli {
@@ -52,6 +53,9 @@ void run_scene_accuracy(const Options& o) {
     // by object id and model space, so they serve both).
     const Scene moved = offset == glm::dvec3(0.0) ? Scene{} : translated_scene(scene, offset);
     const Scene& culled_scene = offset == glm::dvec3(0.0) ? scene : moved;
+    if (const Aabb b = culled_scene.bounds(); !b.empty() && !(std::isfinite(b.min.x) && std::isfinite(b.min.y) && std::isfinite(b.min.z) &&
+                                                            std::isfinite(b.max.x) && std::isfinite(b.max.y) && std::isfinite(b.max.z)))
+        throw Error("--offset " + o.offset + " moves the scene beyond the float range");
     SceneCuller culler(culled_scene, resources.occluders, config);
     const Resolution display = config.display;
     const BufferConfig& buffer = culler.buffer().config();
