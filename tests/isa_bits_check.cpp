@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
         in.occluders = street.occluders;
         in.clusters = build_occluder_clusters(in.occluders.positions.data(), 3 * sizeof(float), in.occluders.positions.size() / 3,
                                               in.occluders.indices.data(), in.occluders.triangle_count(),
-                                              in.occluders.shared_edges.data(), ClusterLimits{});
+                                              in.occluders.shared_edges.data(), in.occluders.edge_apexes.data(), ClusterLimits{});
         in.clip = street.clip(157.0 / 93.0);
         in.rects = test::random_screen_rects(3, 2000);
         for (std::uint32_t id = 0; id < in.city.objects.size(); ++id) {

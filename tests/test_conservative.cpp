@@ -11,10 +11,13 @@
 #include "raster/rasterize.hpp"
 #include "raster/triangle_setup.hpp"
 
+#include <homcull/error.hpp>
+#include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <limits>
 #include <random>
@@ -36,6 +39,10 @@ struct Case {
     float origin[3] = {0, 0, 0};
     std::uint32_t seed = 0;
     std::string kind;
+    Backface backface = Backface::none;
+    // With closed meshes among the triangles: the soup's shared edges (compute_shared_edges).
+    std::vector<std::uint8_t> shared;
+    std::vector<std::uint32_t> apexes;
 
     TriangleInput input() const {
         TriangleInput in;
@@ -45,7 +52,8 @@ struct Case {
         in.vertex_count = positions.size() / 3;
         in.triangle_count = in.vertex_count / 3;
         in.model_to_clip = translated_projection(origin);
-        in.backface = Backface::none;
+        in.backface = backface;
+        if (!shared.empty()) in.shared_edges = shared.data(), in.edge_apexes = apexes.data();
         return in;
     }
 };
@@ -79,11 +87,24 @@ Case make_case(std::uint32_t seed) {
         const float scale = origin_kind == 1 ? 1e3f : 1e6f;
         for (float& o : c.origin) o = make.uniform(-scale, scale);
     }
-    const int kinds = 6;
+    const int kinds = 7;
     const int triangles = 1 + int(rng() % 14);
+    bool closed = false;
     for (int t = 0; t < triangles; ++t) {
         float x[3], y[3], w[3];
         const int kind = int(rng() % kinds);
+        if (kind == 6) {  // a closed mesh (an octahedron), its equator on sample centres: silhouettes
+            closed = true;
+            const float w0 = make.uniform(near_w * 1.5f, 10.0f), r = make.uniform(0.05f, 0.9f) * w0, rz = make.uniform(0.0f, 1.0f) * w0;
+            const float cx = make.uniform(-1.0f, 1.0f) * w0, cy = make.uniform(-1.0f, 1.0f) * w0;
+            float v[6][3] = {{cx + r, cy, w0}, {cx - r, cy, w0}, {cx, cy + r, w0}, {cx, cy - r, w0}, {cx, cy, w0 + rz}, {cx, cy, w0 - rz}};
+            for (int k = 0; k < 4; ++k)
+                if (rng() % 2) make.on_sample_centre(v[k][2], v[k][0], v[k][1]);
+            const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+            for (const auto& f : faces)
+                for (int k : f) c.positions.insert(c.positions.end(), {v[k][0] + c.origin[0], v[k][1] + c.origin[1], v[k][2] + c.origin[2]});
+            continue;
+        }
         const float cx = make.uniform(-1.3f, 1.3f), cy = make.uniform(-1.3f, 1.3f), r = make.uniform(0.01f, 1.5f);
         for (int k = 0; k < 3; ++k) {
             w[k] = make.uniform(near_w, 20.0f);
@@ -123,7 +144,16 @@ Case make_case(std::uint32_t seed) {
         }
         for (int k = 0; k < 3; ++k) c.positions.insert(c.positions.end(), {x[k] + c.origin[0], y[k] + c.origin[1], w[k] + c.origin[2]});
     }
-    c.kind = "seed " + std::to_string(seed) + ", " + std::to_string(c.config.width) + "x" + std::to_string(c.config.height) + " S" +
+    if (closed) {
+        const std::size_t count = c.positions.size() / 9;
+        c.shared.resize(count);
+        c.apexes.resize(3 * count);
+        compute_shared_edges(c.positions.data(), 12, 3 * count, nullptr, count, c.shared.data(), c.apexes.data());
+        const Backface modes[3] = {Backface::none, Backface::cw, Backface::ccw};
+        c.backface = modes[rng() % 3];
+    }
+    c.kind = "seed " + std::to_string(seed) + (closed ? ", closed, backface " + std::to_string(int(c.backface)) : std::string()) + ", " +
+             std::to_string(c.config.width) + "x" + std::to_string(c.config.height) + " S" +
              std::to_string(c.config.samples) + (c.config.sample_depth ? " sample depth" : "") + ", origin " +
              std::to_string(c.origin[0]);
     return c;
@@ -191,6 +221,7 @@ TEST(Conservative, ClaimsAndAnswersHoldAtEverySampleCentreAgainstExactArithmetic
             for (const auto& f : faces)
                 for (int v : f) box.insert(box.end(), corner[v], corner[v] + 3);
             TriangleInput box_in = in;
+            box_in.shared_edges = nullptr, box_in.edge_apexes = nullptr;
             box_in.positions = box.data();
             box_in.vertex_count = 36;
             box_in.triangle_count = 12;
@@ -205,6 +236,7 @@ TEST(Conservative, ClaimsAndAnswersHoldAtEverySampleCentreAgainstExactArithmetic
                 tri.insert(tri.end(), {(cx + r * float(v == 1)) * wv + c.origin[0], (cy + r * float(v == 2)) * wv + c.origin[1], wv + c.origin[2]});
             }
             TriangleInput occludee = in;
+            occludee.shared_edges = nullptr, occludee.edge_apexes = nullptr;
             occludee.positions = tri.data();
             occludee.vertex_count = 3;
             occludee.triangle_count = 1;
@@ -317,6 +349,127 @@ TEST(Conservative, NanBoundsGiveEmptySpansAndRows) {
     edges.ox[1] = nan;
     detail::sample_row_interval(edges, 3, 0, 63, row_first, row_last);
     EXPECT_GT(row_first, row_last);
+}
+
+// Depths below float's normal range (w beyond 2^126, 1/w subnormal): float roundings there err by
+// up to 2^-150 however small the value, which the plane's relative error bound did not cover; a
+// triangle at w = 3.4e38 claimed 76 samples nearer than it is (fuzz_conservative's find, kept
+// as the seed subnormal_depth_plane). The plane now falls back to the smallest vertex depth.
+TEST(Conservative, SubnormalDepthsClaimNoSampleNearerThanTheOccluder) {
+    const std::vector<float> tri = {0x1.20fefep+7f, 0x1.400084p+68f, 0x1.fep+127f,  0x1.fefefep+127f, 0x1.fefefep+127f, 0x1.fefefep+127f,
+                                    0x1.fefefep+127f, 0x1.fefefep-1f, 0x1.fefefep+127f};
+    const float origin[3] = {0, 0, 0};
+    TriangleInput in;
+    in.positions = tri.data();
+    in.vertex_count = 3;
+    in.triangle_count = 1;
+    in.model_to_clip = translated_projection(origin);
+    in.backface = Backface::none;
+    const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        for (const int samples : {1, 4}) {
+            OcclusionBuffer buffer(test::buffer_config(16, 16, samples, 1.99f));
+            buffer.render_frame(in);
+            EXPECT_EQ(buffer.stats().rasterized, 1u) << isa;
+            std::vector<float> claims = test::claimed_inverse_w(buffer);
+            EXPECT_GT(std::count_if(claims.begin(), claims.end(), [](float d) { return d > 0.0f; }), 10) << isa;
+            EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << isa << ", S = " << samples;
+        }
+    }
+    select_isa("best");
+}
+
+// Shared edges decided per view (neighbour_across_edge). A triangle T = (a, b, c) whose edge a -> b
+// runs at NDC y = 2^-100, just above the sample row at y = 0 (an odd sample height puts a row
+// there): (1 - y) * 0.5 * height rounds the row onto the edge, so without its margin the edge
+// claims the whole row, which T does not cover. That is right only when the neighbour across the
+// edge covers the row: one below it (a closed mesh's far side, facing as T does) keeps the flag;
+// one folded back above it (the view silhouette of a closed mesh: it faces away), a degenerate
+// one (its apex on the edge's line) or a missing apex drops it. Drawn as a soup, indexed (with a
+// vertex cache), as clusters, with back faces drawn or culled, on every instruction set.
+TEST(Conservative, SharedEdgesAtViewSilhouettesKeepTheirMargin) {
+    const float e = 0x1.0p-100f;
+    const BufferConfig config = test::buffer_config(16, 15, 1, 0.1f);
+    struct Neighbour {
+        const char* name;
+        float apex[3];  // clip (x, y, w)
+        bool covers_row;
+    };
+    const Neighbour neighbours[] = {{"below (across the edge)", {0.0f, -0.5f, 1.0f}, true},
+                                    {"folded above (a view silhouette)", {0.1f, 0.5f, 2.0f}, false},
+                                    {"degenerate (apex on the edge's line)", {0.3f, e, 1.0f}, false}};
+    const std::array<float, 16> matrix = translated_projection(std::array<float, 3>{0, 0, 0}.data());
+    long row_claims_kept = 0;
+    for (const Neighbour& n : neighbours)
+        for (const Backface backface : {Backface::none, Backface::cw})
+            for (const std::string& isa : available_isas()) {
+                select_isa(isa);
+                const std::string where = std::string(n.name) + ", backface " + std::to_string(int(backface)) + ", " + isa;
+                // T = (a, b, c), N = (b, a, apex); as a soup of 6 vertices and as 4 indexed ones.
+                const std::vector<float> soup = {-0.8f, e, 1, 0.8f, e, 1, 0, 0.8f, 1, 0.8f, e, 1, -0.8f, e, 1, n.apex[0], n.apex[1], n.apex[2]};
+                const std::vector<float> vertices = {-0.8f, e, 1, 0.8f, e, 1, 0, 0.8f, 1, n.apex[0], n.apex[1], n.apex[2]};
+                const std::vector<std::uint32_t> indices = {0, 1, 2, 1, 0, 3};
+                std::uint8_t soup_flags[2], flags[2];
+                std::uint32_t soup_apexes[6], apexes[6];
+                compute_shared_edges(soup.data(), 12, 6, nullptr, 2, soup_flags, soup_apexes);
+                compute_shared_edges(vertices.data(), 12, 4, indices.data(), 2, flags, apexes);
+                ASSERT_EQ(soup_flags[0], 1u) << where;  // the flag is the mesh's: only the view can drop it
+                TriangleInput as_soup;
+                as_soup.positions = soup.data();
+                as_soup.vertex_count = 6;
+                as_soup.triangle_count = 2;
+                as_soup.model_to_clip = matrix;
+                as_soup.backface = backface;
+                as_soup.shared_edges = soup_flags;
+                as_soup.edge_apexes = soup_apexes;
+                TriangleInput indexed = as_soup;
+                indexed.positions = vertices.data();
+                indexed.vertex_count = 4;
+                indexed.indices = indices.data();
+                indexed.shared_edges = flags;
+                indexed.edge_apexes = apexes;
+                const OccluderClusters clusters = build_occluder_clusters(vertices.data(), 12, 4, indices.data(), 2, flags, apexes);
+                const std::vector<test::ExactTriangle> occluders = test::exact_triangles(as_soup);
+                OcclusionBuffer from_soup(config), from_indices(config), from_clusters(config);
+                from_soup.render_frame(as_soup);
+                from_indices.render_frame(indexed);
+                from_clusters.render_frame(ClusteredInput{&clusters, matrix, backface});
+                ASSERT_TRUE(test::same_subtiles(from_soup, from_indices)) << where;
+                ASSERT_TRUE(test::same_subtiles(from_soup, from_clusters)) << where;
+                EXPECT_EQ(test::unbacked_claims(from_soup, occluders), 0) << where;
+                // The row at y = 0 (sample row 7) is claimed exactly when the neighbour covers it.
+                const std::vector<float> claims = test::claimed_inverse_w(from_soup);
+                int row_claims = 0;
+                for (int i = 0; i < from_soup.sample_width(); ++i) row_claims += claims[std::size_t(7 * from_soup.sample_width() + i)] > 0.0f;
+                if (n.covers_row) EXPECT_GT(row_claims, 10) << where;
+                else EXPECT_EQ(row_claims, 0) << where;
+                row_claims_kept += row_claims;
+                // Without its apex, the flag is dropped.
+                std::uint32_t no_apexes[6] = {kNoApex, kNoApex, kNoApex, kNoApex, kNoApex, kNoApex};
+                TriangleInput without = as_soup;
+                without.edge_apexes = no_apexes;
+                OcclusionBuffer margin(config);
+                margin.render_frame(without);
+                const std::vector<float> margin_claims = test::claimed_inverse_w(margin);
+                for (int i = 0; i < margin.sample_width(); ++i) EXPECT_EQ(margin_claims[std::size_t(7 * margin.sample_width() + i)], 0.0f) << where;
+            }
+    select_isa("best");
+    EXPECT_GT(row_claims_kept, 0);
+}
+
+// Flags without apexes cannot be decided per view: render refuses them.
+TEST(Conservative, SharedEdgesWithoutApexesAreRefused) {
+    const std::vector<float> soup = {-0.8f, 0, 1, 0.8f, 0, 1, 0, 0.8f, 1};
+    const std::uint8_t flags[1] = {1};
+    TriangleInput in;
+    in.positions = soup.data();
+    in.vertex_count = 3;
+    in.triangle_count = 1;
+    in.model_to_clip = translated_projection(std::array<float, 3>{0, 0, 0}.data());
+    in.shared_edges = flags;
+    OcclusionBuffer buffer(test::buffer_config(8, 8, 1, 0.1f));
+    EXPECT_THROW(buffer.render(in), Error);
 }
 
 }  // namespace

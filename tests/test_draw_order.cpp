@@ -29,6 +29,7 @@ struct Input {
     std::vector<std::uint32_t> indices32;
     std::vector<std::uint16_t> indices16;
     std::vector<std::uint8_t> shared;
+    std::vector<std::uint32_t> apexes;
     TriangleInput in;
 };
 
@@ -69,6 +70,8 @@ Input make_input(Kind kind, std::size_t n, std::mt19937_64& rng, bool bad, bool 
     }
     r.shared.resize(n);
     for (std::uint8_t& s : r.shared) s = std::uint8_t(rng() % 8);
+    r.apexes.resize(3 * n);
+    for (std::uint32_t& a : r.apexes) a = std::uint32_t(rng() % (vertices + 2));  // sometimes no vertex
     TriangleInput& in = r.in;
     in.positions = r.positions.data();
     in.position_components = int(components);
@@ -78,6 +81,7 @@ Input make_input(Kind kind, std::size_t n, std::mt19937_64& rng, bool bad, bool 
     if (kind == Kind::indexed32) in.indices = r.indices32.data();
     if (kind == Kind::indexed16) in.indices = r.indices16.data(), in.indices_16bit = true;
     in.shared_edges = r.shared.data();
+    in.edge_apexes = r.apexes.data();
     in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0};  // clip w = 2 z
     return r;
 }
@@ -100,6 +104,21 @@ std::vector<std::uint32_t> triangle_words(const TriangleInput& in, std::size_t t
         }
     }
     words.push_back(in.shared_edges ? in.shared_edges[t] : 0xFFu);
+    // The apexes, as the vertex they name: its number with indices, else its position's bits (a
+    // sorted soup numbers its vertices anew); kNoApex past the triangles' vertices.
+    for (int k = 0; in.edge_apexes && k < 3; ++k) {
+        const std::uint32_t apex = in.edge_apexes[3 * t + std::size_t(k)];
+        if (in.indices) {
+            words.push_back(apex);
+        } else if (apex >= 3 * in.triangle_count) {
+            words.push_back(kNoApex);
+        } else {
+            std::uint32_t bits[4] = {};
+            std::memcpy(bits, static_cast<const unsigned char*>(in.positions) + std::size_t(apex) * in.position_stride,
+                        std::size_t(in.position_components) * sizeof(float));
+            words.insert(words.end(), bits, bits + in.position_components);
+        }
+    }
     return words;
 }
 

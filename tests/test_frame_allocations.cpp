@@ -87,7 +87,7 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
     const WorldTriangles& occluders = street.occluders;
     const OccluderClusters clusters =
         build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3, occluders.indices.data(),
-                                occluders.triangle_count(), occluders.shared_edges.data(), ClusterLimits{});
+                                occluders.triangle_count(), occluders.shared_edges.data(), occluders.edge_apexes.data(), ClusterLimits{});
     const std::array<float, 16> clip = street.clip(320.0 / 180.0);
     const TriangleInput city_input = occluders.input(clip);
     const ClusteredInput clustered{&clusters, clip, Backface::none};

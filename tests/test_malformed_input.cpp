@@ -174,13 +174,16 @@ TEST(MalformedInput, CameraPathFiles) {
 // Engine-side input to the occlusion buffer: missing arrays and counts that would overflow.
 TEST(MalformedInput, OccluderArraysAndCounts) {
     std::uint8_t flags[2] = {};
+    std::uint32_t apexes[6] = {};
     const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-    EXPECT_THROW(compute_shared_edges(nullptr, 12, 3, nullptr, 1, flags), Error);
-    EXPECT_THROW(compute_shared_edges(positions, 8, 3, nullptr, 1, flags), Error);
-    EXPECT_THROW(compute_shared_edges(positions, 12, 3, nullptr, 1, nullptr), Error);
-    EXPECT_NO_THROW(compute_shared_edges(nullptr, 12, 0, nullptr, 0, nullptr));  // nothing to do
-    compute_shared_edges(positions, 12, 3, nullptr, 1, flags);
+    EXPECT_THROW(compute_shared_edges(nullptr, 12, 3, nullptr, 1, flags, apexes), Error);
+    EXPECT_THROW(compute_shared_edges(positions, 8, 3, nullptr, 1, flags, apexes), Error);
+    EXPECT_THROW(compute_shared_edges(positions, 12, 3, nullptr, 1, nullptr, apexes), Error);
+    EXPECT_THROW(compute_shared_edges(positions, 12, 3, nullptr, 1, flags, nullptr), Error);
+    EXPECT_NO_THROW(compute_shared_edges(nullptr, 12, 0, nullptr, 0, nullptr, nullptr));  // nothing to do
+    compute_shared_edges(positions, 12, 3, nullptr, 1, flags, apexes);
     EXPECT_EQ(flags[0], 0u);
+    EXPECT_EQ(apexes[0], kNoApex);
 
     BufferConfig c;
     c.width = c.height = 8;

@@ -27,13 +27,14 @@ namespace {
 
 OccluderClusters cluster_world(const WorldTriangles& w, const ClusterLimits& limits = {}) {
     return build_occluder_clusters(w.positions.data(), 3 * sizeof(float), w.positions.size() / 3, w.indices.data(), w.triangle_count(),
-                                   w.shared_edges.data(), limits);
+                                   w.shared_edges.data(), w.edge_apexes.data(), limits);
 }
 
 // Appends a cluster made by hand: the given vertices and triangles (local indices, with their
-// shared-edge flags).
+// shared-edge flags and apexes, 3 per triangle; none: kNoApex).
 void append_cluster(OccluderClusters& clusters, const std::vector<glm::vec3>& vertices, const std::vector<std::uint16_t>& indices,
-                    const std::vector<std::uint8_t>& flags) {
+                    const std::vector<std::uint8_t>& flags, std::vector<std::uint32_t> apexes = {}) {
+    if (apexes.empty()) apexes.assign(3 * flags.size(), kNoApex);
     OccluderCluster c;
     c.first_vertex = std::uint32_t(clusters.positions.size() / 3);
     c.vertex_count = std::uint32_t(vertices.size());
@@ -46,6 +47,7 @@ void append_cluster(OccluderClusters& clusters, const std::vector<glm::vec3>& ve
     }
     clusters.indices.insert(clusters.indices.end(), indices.begin(), indices.end());
     clusters.shared_edges.insert(clusters.shared_edges.end(), flags.begin(), flags.end());
+    clusters.edge_apexes.insert(clusters.edge_apexes.end(), apexes.begin(), apexes.end());
     clusters.max_cluster_vertices = std::max(clusters.max_cluster_vertices, c.vertex_count);
     clusters.clusters.push_back(c);
 }
@@ -53,7 +55,7 @@ void append_cluster(OccluderClusters& clusters, const std::vector<glm::vec3>& ve
 // A quad a, b, c, d (counter-clockwise from the side it faces) as a cluster of two triangles
 // sharing the diagonal a-c.
 void append_quad(OccluderClusters& clusters, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-    append_cluster(clusters, {a, b, c, d}, {0, 1, 2, 0, 2, 3}, {0b100, 0b001});
+    append_cluster(clusters, {a, b, c, d}, {0, 1, 2, 0, 2, 3}, {0b100, 0b001}, {kNoApex, kNoApex, 3, 1, kNoApex, kNoApex});
 }
 
 // A triangle as its three positions and flags, to compare meshes whatever their order.
@@ -83,14 +85,14 @@ TEST(OccluderClusters, KeepEveryTriangleWithItsVerticesAndFlags) {
         std::uint32_t largest = 0;
         for (const OccluderCluster& c : clusters.clusters) {
             EXPECT_LE(c.triangle_count, max_triangles);
-            EXPECT_LE(c.vertex_count, limits.max_vertices);
+            EXPECT_LE(c.vertex_count, limits.max_vertices + 3 * c.triangle_count);  // its own, then apexes of other clusters' triangles
             EXPECT_TRUE(c.bounded);
             largest = std::max(largest, c.vertex_count);
             for (std::uint32_t t = c.first_triangle; t < c.first_triangle + c.triangle_count; ++t) {
                 const float* p[3];
                 for (int k = 0; k < 3; ++k) {
                     const std::uint16_t local = clusters.indices[3 * t + std::size_t(k)];
-                    ASSERT_LT(local, c.vertex_count);
+                    ASSERT_LT(local, limits.max_vertices);
                     p[k] = &clusters.positions[3 * (std::size_t(c.first_vertex) + local)];
                     for (int axis = 0; axis < 3; ++axis) {  // inside the cluster's box
                         EXPECT_GE(p[k][axis], c.bounds.min[axis]);
@@ -98,6 +100,16 @@ TEST(OccluderClusters, KeepEveryTriangleWithItsVerticesAndFlags) {
                     }
                 }
                 after.push_back(record(p[0], p[1], p[2], clusters.shared_edges[t]));
+                // Each flagged edge's apex: a vertex of the cluster at the source triangle's apex.
+                const std::uint32_t source = clusters.source_triangles[t];
+                for (std::size_t k = 0; k < 3; ++k) {
+                    if (!((clusters.shared_edges[t] >> k) & 1u)) continue;
+                    const std::uint32_t apex = clusters.edge_apexes[3 * t + k];
+                    ASSERT_LT(apex, c.vertex_count);
+                    const float* at = &clusters.positions[3 * (std::size_t(c.first_vertex) + apex)];
+                    const float* expected = &world.positions[3 * std::size_t(world.edge_apexes[3 * source + k])];
+                    EXPECT_TRUE(std::equal(at, at + 3, expected));
+                }
             }
         }
         EXPECT_EQ(largest, clusters.max_cluster_vertices);
@@ -116,7 +128,8 @@ TEST(OccluderClusters, RepeatedTrianglesAreEachKeptOnce) {
     const std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 2, 0, 0};
     const std::vector<std::uint32_t> indices = {0, 1, 2, 1, 3, 2, 0, 1, 2, 1, 4, 3, 0, 1, 2};
     const std::vector<std::uint8_t> flags = {1, 2, 3, 4, 5};
-    const OccluderClusters clusters = build_occluder_clusters(positions.data(), 3 * sizeof(float), 5, indices.data(), 5, flags.data());
+    const std::vector<std::uint32_t> apexes(15, 4);
+    const OccluderClusters clusters = build_occluder_clusters(positions.data(), 3 * sizeof(float), 5, indices.data(), 5, flags.data(), apexes.data());
     std::vector<std::uint32_t> sources = clusters.source_triangles;
     std::sort(sources.begin(), sources.end());
     EXPECT_EQ(sources, (std::vector<std::uint32_t>{0, 1, 2, 3, 4}));
@@ -127,22 +140,24 @@ TEST(OccluderClusters, RepeatedTrianglesAreEachKeptOnce) {
 TEST(OccluderClusters, BadInputIsAnErrorOrADefinedResult) {
     const std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
     const std::vector<std::uint32_t> indices = {0, 1, 2, 2, 1, 3};
-    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 3, indices.data(), 2, nullptr), Error);  // index 3 of 3 vertices
-    EXPECT_THROW(build_occluder_clusters(positions.data(), 8, 4, indices.data(), 2, nullptr), Error);
-    EXPECT_THROW(build_occluder_clusters(nullptr, 12, 4, indices.data(), 2, nullptr), Error);
-    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, {64, 6}), Error);    // not a multiple of 4
-    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, {300, 64}), Error);  // over 255 vertices
-    EXPECT_TRUE(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 0, nullptr).clusters.empty());
+    const std::uint8_t flags[2] = {1, 0};
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 3, indices.data(), 2, nullptr, nullptr), Error);  // index 3 of 3 vertices
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 8, 4, indices.data(), 2, nullptr, nullptr), Error);
+    EXPECT_THROW(build_occluder_clusters(nullptr, 12, 4, indices.data(), 2, nullptr, nullptr), Error);
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, flags, nullptr), Error);  // flags without apexes
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, nullptr, {64, 6}), Error);    // not a multiple of 4
+    EXPECT_THROW(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 2, nullptr, nullptr, {300, 64}), Error);  // over 255 vertices
+    EXPECT_TRUE(build_occluder_clusters(positions.data(), 12, 4, indices.data(), 0, nullptr, nullptr).clusters.empty());
     // A triangle with a repeated vertex is kept, and counted degenerate when drawn.
     const std::vector<std::uint32_t> with_repeat = {0, 1, 2, 1, 1, 3, 2, 1, 3};
-    const OccluderClusters kept = build_occluder_clusters(positions.data(), 12, 4, with_repeat.data(), 3, nullptr);
+    const OccluderClusters kept = build_occluder_clusters(positions.data(), 12, 4, with_repeat.data(), 3, nullptr, nullptr);
     EXPECT_EQ(kept.triangle_count(), 3u);
 
     // A vertex that is not a number: its cluster has no box, is always drawn, and the
     // triangle pipeline counts its triangle invalid.
     std::vector<float> bad = positions;
     bad[4] = std::numeric_limits<float>::quiet_NaN();
-    const OccluderClusters clusters = build_occluder_clusters(bad.data(), 12, 4, indices.data(), 2, nullptr);
+    const OccluderClusters clusters = build_occluder_clusters(bad.data(), 12, 4, indices.data(), 2, nullptr, nullptr);
     ASSERT_EQ(clusters.clusters.size(), 1u);
     EXPECT_FALSE(clusters.clusters[0].bounded);
     OcclusionBuffer buffer(test::buffer_config(64, 48, 1, 0.1f));
@@ -230,6 +245,7 @@ TEST(ClusteredRender, ASubsetAndOtherFlagsAreThatMesh) {
     shared.render_frame(ClusteredInput{&square, identity, Backface::none});
     ClusteredInput without{&square, identity, Backface::none};
     without.shared_edges = none.data();
+    without.edge_apexes = square.edge_apexes.data();
     margin.render_frame(without);
     std::vector<std::uint8_t> covered_shared, covered_margin;
     shared.read_coverage(covered_shared);

@@ -240,8 +240,10 @@ TEST(OcclusionBuffer, BackfaceModesIndicesAndStride) {
             in.backface = mode;
             std::vector<std::uint32_t> indices32(indices->begin(), indices->end());
             std::uint8_t shared[2];
-            compute_shared_edges(interleaved.data(), 5 * sizeof(float), 4, indices32.data(), 2, shared);
+            std::uint32_t apexes[6];
+            compute_shared_edges(interleaved.data(), 5 * sizeof(float), 4, indices32.data(), 2, shared, apexes);
             in.shared_edges = shared;
+            in.edge_apexes = apexes;
             buffer.render(in);
             const bool culled = (mode == Backface::cw && indices == &cw) || (mode == Backface::ccw && indices == &ccw);
             EXPECT_EQ(buffer.stats().backface_culled, culled ? 2u : 0u);
@@ -256,7 +258,8 @@ TEST(OcclusionBuffer, SharedEdgesLeaveNoCracks) {
     const std::vector<float> quad = {-10, -10, 5, 10, -10, 5, 10, 10, 5, -10, 10, 5};
     const std::vector<std::uint32_t> indices = {0, 1, 2, 0, 2, 3};
     std::uint8_t shared[2];
-    compute_shared_edges(quad.data(), 12, 4, indices.data(), 2, shared);
+    std::uint32_t apexes[6];
+    compute_shared_edges(quad.data(), 12, 4, indices.data(), 2, shared, apexes);
     EXPECT_EQ(shared[0], 4u);  // edge 2 -> 0 of the first triangle
     EXPECT_EQ(shared[1], 1u);  // edge 0 -> 2 of the second
     for (bool with_flags : {false, true}) {
@@ -268,6 +271,7 @@ TEST(OcclusionBuffer, SharedEdgesLeaveNoCracks) {
         in.triangle_count = 2;
         in.model_to_clip = xyw_to_clip();
         in.shared_edges = with_flags ? shared : nullptr;
+        in.edge_apexes = apexes;
         buffer.render(in);
         std::vector<std::uint8_t> covered;
         buffer.read_coverage(covered);
@@ -296,7 +300,8 @@ TEST(OcclusionBuffer, FineMeshWithSharedEdgesLeavesNoCracksEvenWhenClipped) {
             indices.insert(indices.end(), {a, b, c, a, c, d});
         }
     std::vector<std::uint8_t> shared(indices.size() / 3);
-    compute_shared_edges(grid.data(), 12, grid.size() / 3, indices.data(), shared.size(), shared.data());
+    std::vector<std::uint32_t> apexes(indices.size());
+    compute_shared_edges(grid.data(), 12, grid.size() / 3, indices.data(), shared.size(), shared.data(), apexes.data());
     OcclusionBuffer buffer = make_buffer(97, 61, 2);
     TriangleInput in;
     in.positions = grid.data();
@@ -305,6 +310,7 @@ TEST(OcclusionBuffer, FineMeshWithSharedEdgesLeavesNoCracksEvenWhenClipped) {
     in.triangle_count = shared.size();
     in.model_to_clip = xyw_to_clip();
     in.shared_edges = shared.data();
+    in.edge_apexes = apexes.data();
     buffer.render(in);
     EXPECT_GT(buffer.stats().near_clipped, 0u);
     std::vector<std::uint8_t> covered;
@@ -341,8 +347,10 @@ TEST(OcclusionBuffer, AabbTestsUseTheCornersAndTheNearPlane) {
     in.triangle_count = 2;
     in.model_to_clip = clip;
     std::uint8_t shared[2];
-    compute_shared_edges(wall.data(), 12, 6, nullptr, 2, shared);
+    std::uint32_t apexes[6];
+    compute_shared_edges(wall.data(), 12, 6, nullptr, 2, shared, apexes);
     in.shared_edges = shared;
+    in.edge_apexes = apexes;
     buffer.render(in);
     const float behind_min[3] = {-1, -1, -15}, behind_max[3] = {1, 1, -12};
     const float front_min[3] = {-1, -1, -8}, front_max[3] = {1, 1, -6};

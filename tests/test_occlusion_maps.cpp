@@ -20,6 +20,7 @@ struct Occluders {
     int width, height;  // buffer pixels
     std::vector<float> xyzw;
     std::vector<std::uint8_t> shared;
+    std::vector<std::uint32_t> apexes;
     void add(double x0, double y0, double x1, double y1, float w) {
         auto vertex = [&](double px, double py) {
             const float x = float(px / width * 2.0 - 1.0), y = float(1.0 - py / height * 2.0);
@@ -29,10 +30,13 @@ struct Occluders {
         vertex(x0, y0), vertex(x1, y1), vertex(x0, y1);  // edge 0 (x0,y0 -> x1,y1) is the diagonal
         shared.push_back(4u);
         shared.push_back(1u);
+        const auto base = std::uint32_t(xyzw.size() / 4 - 6);  // across each diagonal: the other triangle's third vertex
+        apexes.insert(apexes.end(), {kNoApex, kNoApex, base + 5, base + 1, kNoApex, kNoApex});
     }
     TriangleInput input() const {
         TriangleInput in = test::clip_space_input(xyzw);
         in.shared_edges = shared.data();
+        in.edge_apexes = apexes.data();
         return in;
     }
 };
@@ -68,7 +72,7 @@ OverlapExit exit_of(const OccludeeAnswer& a) { return OverlapExit(a.overlap_exit
 TEST(OcclusionMaps, OpacityPyramidCountsCoveredSamplesOnOddSizes) {
     for (int s : {1, 2, 4}) {
         const int width = 37, height = 23;  // odd at every level
-        Occluders o{width, height, {}, {}};
+        Occluders o{width, height, {}, {}, {}};
         o.add(3.25, 2.5, 30.0, 9.75, 5.0f);
         o.add(10.0, 12.0, 36.5, 22.0, 7.0f);
         const OcclusionBuffer buffer = buffer_of(width, height, s, o);
@@ -192,7 +196,7 @@ TEST(OcclusionMaps, MakeOnlyTheDepthPyramidTheirTestReads) {
 }
 
 TEST(OcclusionMaps, ThresholdsFollowZhang) {
-    const OcclusionBuffer buffer = buffer_of(64, 64, 1, Occluders{64, 64, {}, {}});
+    const OcclusionBuffer buffer = buffer_of(64, 64, 1, Occluders{64, 64, {}, {}, {}});
     OcclusionMapsConfig c = maps_config(buffer);
     const OcclusionMaps conservative(buffer, c);
     for (int k = 0; k < conservative.levels(); ++k) {
@@ -215,7 +219,7 @@ TEST(OcclusionMaps, ThresholdsFollowZhang) {
 
 // 64 x 64 pixels, everything covered at w = 4 except pixel (10, 10).
 TEST(OcclusionMaps, OverlapPassesAndConservativeRejection) {
-    Occluders o{64, 64, {}, {}};
+    Occluders o{64, 64, {}, {}, {}};
     o.add(0, 0, 64, 10, 4.0f);
     o.add(0, 11, 64, 64, 4.0f);
     o.add(0, 10, 10, 11, 4.0f);
@@ -244,7 +248,7 @@ TEST(OcclusionMaps, OverlapPassesAndConservativeRejection) {
 }
 
 TEST(OcclusionMaps, PredictiveRejectionAndTransparentCells) {
-    Occluders o{64, 64, {}, {}};
+    Occluders o{64, 64, {}, {}, {}};
     o.add(0, 0, 10, 10, 4.0f);  // 100 of the 256 pixels of the 16 x 16 cell (0, 0)
     const OcclusionBuffer buffer = buffer_of(64, 64, 1, o);
     OcclusionMaps maps(buffer, maps_config(buffer));
@@ -265,7 +269,7 @@ TEST(OcclusionMaps, PredictiveRejectionAndTransparentCells) {
 TEST(OcclusionMaps, SamplesDecideWithinAPixel) {
     // S = 4: the sample rows above 22 are covered, so pixel row 5 is half covered (its top two
     // sample rows).
-    Occluders o{16, 16, {}, {}};
+    Occluders o{16, 16, {}, {}, {}};
     o.add(0, 0, 16, 5.5, 4.0f);
     const OcclusionBuffer buffer = buffer_of(16, 16, 4, o);
     OcclusionMaps maps(buffer, maps_config(buffer));
@@ -281,7 +285,7 @@ TEST(OcclusionMaps, SamplesDecideWithinAPixel) {
 }
 
 TEST(OcclusionMaps, FinestActiveLevelChargesItsHoles) {
-    Occluders o{64, 64, {}, {}};
+    Occluders o{64, 64, {}, {}, {}};
     o.add(0, 0, 10, 64, 4.0f);  // columns 0..9 covered
     const OcclusionBuffer buffer = buffer_of(64, 64, 1, o);
     OcclusionMapsConfig c = maps_config(buffer);
@@ -303,7 +307,7 @@ TEST(OcclusionMaps, FinestActiveLevelChargesItsHoles) {
 TEST(OcclusionMaps, ApproximateCullingToleratesHolesUpToL) {
     for (DepthTest depth : {DepthTest::masked, DepthTest::hzb, DepthTest::nbz, DepthTest::plane, DepthTest::deb})
         for (int hole : {0, 1, 4, 5, 8}) {
-            Occluders o{128, 128, {}, {}};
+            Occluders o{128, 128, {}, {}, {}};
             const int h0 = 50, h1 = 50 + hole;
             o.add(0, 0, 128, h0, 4.0f);
             o.add(0, h1, 128, 128, 4.0f);
@@ -332,7 +336,7 @@ TEST(OcclusionMaps, ApproximateCullingToleratesHolesUpToL) {
 // One occludee tested as several rectangles (SceneCuller tests an object's triangles) shares one
 // hole budget: two holes of 16 pixels hide it with L = 32, not with L = 16, however it is cut.
 TEST(OcclusionMaps, RectanglesOfOneOccludeeShareTheHoleBudget) {
-    Occluders o{128, 128, {}, {}};
+    Occluders o{128, 128, {}, {}, {}};
     o.add(0, 0, 128, 40, 4.0f);  // a wall at w = 4 with 4 x 4 holes at (40, 40) and (80, 40)
     o.add(0, 44, 128, 128, 4.0f);
     o.add(0, 40, 40, 44, 4.0f);
@@ -361,7 +365,7 @@ TEST(OcclusionMaps, RectanglesOfOneOccludeeShareTheHoleBudget) {
 // a working layer in front of it; drawn nearest first, the wall fills the panel's layer and it
 // becomes one layer at the wall's depth, which no depth test could misread.
 TEST(OcclusionMaps, NearestDepthZBufferIsNotConservativeWithPartialCoverage) {
-    Occluders o{16, 16, {}, {}};
+    Occluders o{16, 16, {}, {}, {}};
     o.add(0, 0, 16, 16, 10.0f);
     o.add(0, 0, 8.5, 16, 2.0f);
     const OcclusionBuffer buffer = buffer_of(16, 16, 4, o, DrawOrder::as_given);
@@ -415,7 +419,7 @@ TEST(OcclusionMaps, ConservativeOverlapIsExactOnRandomInput) {
 }
 
 TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
-    const OcclusionBuffer buffer = buffer_of(32, 32, 1, Occluders{32, 32, {}, {}});
+    const OcclusionBuffer buffer = buffer_of(32, 32, 1, Occluders{32, 32, {}, {}, {}});
     auto make = [&](auto change) {
         OcclusionMapsConfig c = maps_config(buffer);
         change(c);
@@ -437,7 +441,7 @@ TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
         EXPECT_THROW(unbuilt.test_rect({-1, -1, 1, 1, 5.0f}), Error);
     }
     // A 1 x 1 buffer is a one-level pyramid.
-    const OcclusionBuffer tiny = buffer_of(1, 1, 4, Occluders{1, 1, {}, {}});
+    const OcclusionBuffer tiny = buffer_of(1, 1, 4, Occluders{1, 1, {}, {}, {}});
     OcclusionMaps maps(tiny, maps_config(tiny));
     maps.build(tiny);
     EXPECT_EQ(maps.levels(), 1);

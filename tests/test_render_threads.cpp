@@ -178,6 +178,7 @@ bool pyramid_matches_subtiles(const OcclusionBuffer& buffer) {
 TEST(RenderThreads, ARenderFailingPartWayLeavesAMatchingConservativeBuffer) {
     const std::vector<float> last = test::random_clip_triangles(31, 3000, 0.4f, 0.5f), frame = test::random_clip_triangles(32, 30000, 0.3f);
     const std::vector<std::uint8_t> no_shared_edges(frame.size() / 12, 0);
+    const std::vector<std::uint32_t> no_apexes(frame.size() / 4, kNoApex);
     BufferConfig config;
     config.width = 301;
     config.height = 277;
@@ -185,7 +186,7 @@ TEST(RenderThreads, ARenderFailingPartWayLeavesAMatchingConservativeBuffer) {
     config.near_w = 1.0f;
     for (const bool in_parts : {true, false}) {
         TriangleInput in = test::clip_space_input(frame);
-        if (!in_parts) in.shared_edges = no_shared_edges.data();
+        if (!in_parts) in.shared_edges = no_shared_edges.data(), in.edge_apexes = no_apexes.data();
         OcclusionBuffer whole(config);
         whole.render(test::clip_space_input(last));
         whole.render_frame(in);

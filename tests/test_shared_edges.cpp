@@ -48,6 +48,32 @@ std::vector<std::uint8_t> shared_edges_by_pairs(const std::vector<Position>& pos
     return shared;
 }
 
+// Whether every flagged edge's apex is the third vertex of a triangle that has the edge the other
+// way round, and every other edge's apex is kNoApex.
+bool apexes_name_neighbours(const std::vector<Position>& positions, const std::vector<std::uint32_t>& indices,
+                            const std::vector<std::uint8_t>& shared, const std::vector<std::uint32_t>& apexes) {
+    const std::size_t triangles = indices.size() / 3;
+    for (std::size_t t = 0; t < triangles; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t apex = apexes[3 * t + std::size_t(k)];
+            if (!((shared[t] >> k) & 1u)) {
+                if (apex != homcull::kNoApex) return false;
+                continue;
+            }
+            const Position& a = positions[indices[3 * t + std::size_t(k)]];
+            const Position& b = positions[indices[3 * t + std::size_t((k + 1) % 3)]];
+            bool found = false;
+            for (std::size_t u = 0; u < triangles && !found; ++u) {
+                const std::uint32_t* v = &indices[3 * u];
+                if (v[0] >= positions.size() || v[1] >= positions.size() || v[2] >= positions.size()) continue;
+                for (int j = 0; j < 3 && !found; ++j)
+                    found = positions[v[j]] == b && positions[v[(j + 1) % 3]] == a && v[(j + 2) % 3] == apex;
+            }
+            if (!found) return false;
+        }
+    return true;
+}
+
 // A random mesh over few distinct positions, so that edges repeat in both directions, in the
 // same direction, and around non-manifold fans; with -0 beside +0, degenerate triangles, a few
 // non-finite positions and indices out of range.
@@ -81,9 +107,12 @@ TEST(SharedEdges, MatchTheirDefinitionOnRandomMeshes) {
         random_mesh(rng, positions, indices);
         const std::size_t triangles = indices.size() / 3;
         std::vector<std::uint8_t> shared(triangles, 0xFF);
-        homcull::compute_shared_edges(positions[0].data(), sizeof(Position), positions.size(), indices.data(), triangles, shared.data());
+        std::vector<std::uint32_t> apexes(3 * triangles, 7);
+        homcull::compute_shared_edges(positions[0].data(), sizeof(Position), positions.size(), indices.data(), triangles, shared.data(),
+                                      apexes.data());
         const std::vector<std::uint8_t> expected = shared_edges_by_pairs(positions, indices);
         ASSERT_EQ(shared, expected) << "trial " << trial;
+        ASSERT_TRUE(apexes_name_neighbours(positions, indices, shared, apexes)) << "trial " << trial;
         for (std::uint8_t bits : expected) shared_bits += std::bitset<8>(bits).count();
         checked += triangles;
     }
@@ -111,7 +140,10 @@ TEST(SharedEdges, MatchTheirDefinitionOnALargeMesh) {
         }
     const std::size_t triangles = indices.size() / 3;
     std::vector<std::uint8_t> shared(triangles, 0xFF);
-    homcull::compute_shared_edges(positions[0].data(), sizeof(Position), positions.size(), indices.data(), triangles, shared.data());
+    std::vector<std::uint32_t> apexes(3 * triangles);
+    homcull::compute_shared_edges(positions[0].data(), sizeof(Position), positions.size(), indices.data(), triangles, shared.data(),
+                                  apexes.data());
+    EXPECT_TRUE(apexes_name_neighbours(positions, indices, shared, apexes));
 
     struct Edge {
         std::array<float, 6> key;  // lower position first
@@ -150,17 +182,28 @@ TEST(SharedEdges, ClosedAndOpenMeshes) {
     const std::vector<Position> tetrahedron = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     const std::vector<std::uint32_t> closed = {0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2};
     std::vector<std::uint8_t> shared(4, 0);
-    homcull::compute_shared_edges(tetrahedron[0].data(), sizeof(Position), 4, closed.data(), 4, shared.data());
+    std::vector<std::uint32_t> apexes(12);
+    homcull::compute_shared_edges(tetrahedron[0].data(), sizeof(Position), 4, closed.data(), 4, shared.data(), apexes.data());
     EXPECT_EQ(shared, std::vector<std::uint8_t>(4, 7));
-    homcull::compute_shared_edges(tetrahedron[0].data(), sizeof(Position), 4, closed.data(), 3, shared.data());
+    // Each edge's neighbour is the face across it: its apex is the vertex this face lacks.
+    for (std::size_t t = 0; t < 4; ++t)
+        for (std::size_t k = 0; k < 3; ++k) {
+            const std::uint32_t* face = &closed[3 * t];
+            EXPECT_TRUE(std::find(face, face + 3, apexes[3 * t + k]) == face + 3) << t << " " << k;
+        }
+    homcull::compute_shared_edges(tetrahedron[0].data(), sizeof(Position), 4, closed.data(), 3, shared.data(), apexes.data());
     EXPECT_EQ(shared_edges_by_pairs(tetrahedron, std::vector<std::uint32_t>(closed.begin(), closed.begin() + 9)),
               std::vector<std::uint8_t>(shared.begin(), shared.begin() + 3));
 
     const std::vector<Position> soup = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}};
     std::uint8_t soup_shared[2] = {0, 0};
-    homcull::compute_shared_edges(soup[0].data(), sizeof(Position), soup.size(), nullptr, 2, soup_shared);
+    std::uint32_t soup_apexes[6];
+    homcull::compute_shared_edges(soup[0].data(), sizeof(Position), soup.size(), nullptr, 2, soup_shared, soup_apexes);
     EXPECT_EQ(soup_shared[0], 2u);  // edge 1 -> 2 of the first triangle
     EXPECT_EQ(soup_shared[1], 1u);  // edge 0 -> 1 of the second
+    EXPECT_EQ(soup_apexes[1], 5u);  // across it: the second triangle's vertex 2 (vertex 3 + 2)
+    EXPECT_EQ(soup_apexes[3], 0u);  // and the first's vertex 0
+    EXPECT_EQ(soup_apexes[0], homcull::kNoApex);
 }
 
 }  // namespace

@@ -35,6 +35,7 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
     t.model_to_clip = in.model_to_clip;
     t.backface = in.backface;
     t.shared_edges = (in.shared_edges ? in.shared_edges : clusters.shared_edges.data()) + c.first_triangle;
+    t.edge_apexes = (in.shared_edges ? in.edge_apexes : clusters.edge_apexes.data()) + 3 * std::size_t(c.first_triangle);
     return t;
 }
 
@@ -73,6 +74,9 @@ void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFo
 void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
     const OccluderClusters& clusters = *in.clusters;
+    if (in.shared_edges && !in.edge_apexes) throw Error("render: ClusteredInput::shared_edges needs edge_apexes");
+    if (clusters.edge_apexes.size() != 3 * clusters.shared_edges.size())
+        throw Error("render: OccluderClusters::edge_apexes must hold three per triangle (build_occluder_clusters makes them)");
 
     // Every cluster is checked before anything is drawn (a render that throws changes nothing).
     const std::size_t count = in.cluster_ids ? in.cluster_count : clusters.clusters.size();

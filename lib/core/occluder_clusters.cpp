@@ -1,5 +1,6 @@
 #include <homcull/error.hpp>
 #include <homcull/occluder_clusters.hpp>
+#include <homcull/occlusion_buffer.hpp>
 
 #include "core/float_mode.hpp"
 
@@ -37,7 +38,7 @@ void check_cluster_limits(const ClusterLimits& limits, const std::string& caller
 
 OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                                          const std::uint32_t* indices, std::size_t triangle_count, const std::uint8_t* shared_edges,
-                                         const ClusterLimits& limits) {
+                                         const std::uint32_t* edge_apexes, const ClusterLimits& limits) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     const auto fail = [](const std::string& why) { throw Error("build_occluder_clusters: " + why); };
     check_cluster_limits(limits);
@@ -45,6 +46,7 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
     if (triangle_count == 0) return out;
     if (!positions || !indices) fail("positions or indices missing");
     if (position_stride < 3 * sizeof(float)) fail("position stride smaller than one position (12 bytes)");
+    if (shared_edges && !edge_apexes) fail("shared_edges without edge_apexes (compute_shared_edges writes both)");
     for (std::size_t i = 0; i < 3 * triangle_count; ++i)
         if (indices[i] >= vertex_count)
             fail("index " + std::to_string(indices[i]) + " of triangle " + std::to_string(i / 3) + " is not below vertex_count " +
@@ -84,9 +86,10 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
     out.shared_edges.reserve(triangle_count);
     out.source_triangles.reserve(triangle_count);
     out.clusters.reserve(meshlets.size());
+    out.edge_apexes.reserve(index_count);
     // Appends a cluster of the given input vertices and triangles (vertex numbers local to it;
-    // `originals` the input triangles, for their flags).
-    const auto append = [&](const std::vector<std::uint32_t>& vertices, const std::vector<std::uint8_t>& local,
+    // `originals` the input triangles, for their flags), then the apexes its flags need.
+    const auto append = [&](std::vector<std::uint32_t>& vertices, const std::vector<std::uint8_t>& local,
                             const std::vector<std::uint32_t>& originals) {
         OccluderCluster c;
         c.first_vertex = std::uint32_t(out.positions.size() / 3);
@@ -101,7 +104,25 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
             c.bounds.extend(glm::vec3(p[0], p[1], p[2]));
         }
         out.indices.insert(out.indices.end(), local.begin(), local.end());
-        for (const std::uint32_t t : originals) out.shared_edges.push_back(shared_edges ? shared_edges[t] : 0);
+        for (const std::uint32_t t : originals) {
+            const std::uint8_t flags = shared_edges ? shared_edges[t] : 0;
+            out.shared_edges.push_back(flags);
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t apex = (flags >> k) & 1u ? edge_apexes[3 * std::size_t(t) + std::size_t(k)] : kNoApex;
+                if (apex >= vertex_count) {  // none, or out of range: the render drops the flag
+                    out.edge_apexes.push_back(kNoApex);
+                    continue;
+                }
+                // The cluster's copy of the apex: one of its vertices, or a copy appended after them.
+                const auto found = std::find(vertices.begin(), vertices.end(), apex);
+                out.edge_apexes.push_back(std::uint32_t(found - vertices.begin()));
+                if (found != vertices.end()) continue;
+                vertices.push_back(apex);
+                const float* p = &packed[3 * std::size_t(apex)];
+                out.positions.insert(out.positions.end(), p, p + 3);
+            }
+        }
+        c.vertex_count = std::uint32_t(vertices.size());
         out.source_triangles.insert(out.source_triangles.end(), originals.begin(), originals.end());
         out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
         out.clusters.push_back(c);

@@ -242,6 +242,9 @@ void OcclusionBuffer::render_frame(const TriangleInput& in, const ParallelFor& p
 void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first) {
     detail::check_triangle_input(in, "render");
     detail::check_draw_order(in);
+    if (in.shared_edges && !in.edge_apexes)
+        throw Error("render: shared_edges needs edge_apexes (compute_shared_edges writes both): each flag is kept only where its "
+                    "neighbour lies across the edge in this view");
     if (clear_first) stats_ = RasterStats{};
     detail::VertexClip storage;
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;

@@ -173,7 +173,7 @@ void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bu
 
 void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
                  const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges,
-                 const CellRecord* noted, ListedNote* listed_notes) {
+                 std::uint32_t* edge_apexes, std::uint32_t* placed_at, const CellRecord* noted, ListedNote* listed_notes) {
     if (listed && noted) {  // the notes with the triangles' numbers: the list of a noted soup
         place_triangles(begin, end, bucket, class_of, start, some_skipped,
                         [&](std::size_t t, std::size_t p) { listed_notes[p] = {noted[t], std::uint32_t(t)}; });
@@ -185,10 +185,12 @@ void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::s
         return;
     }
     const auto place = [&](auto&& copy) {
-        if (shared_edges) {
+        if (shared_edges) {  // the flags and their apexes follow their triangles (soups: remap_soup_apexes after)
             place_triangles(begin, end, bucket, class_of, start, some_skipped, [&](std::size_t t, std::size_t p) {
                 copy(t, p);
                 shared_edges[p] = in.shared_edges[t];
+                std::memcpy(edge_apexes + 3 * p, in.edge_apexes + 3 * t, 3 * sizeof(std::uint32_t));
+                if (placed_at) placed_at[t] = std::uint32_t(p);
             });
         } else {
             place_triangles(begin, end, bucket, class_of, start, some_skipped, copy);
@@ -217,6 +219,16 @@ void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::s
         soup(std::integral_constant<std::size_t, 4>{});
     } else {
         soup(std::integral_constant<std::size_t, 3>{});
+    }
+}
+
+// A sorted copy of a soup numbers its vertices anew (3p + k for the triangle placed at p): its
+// apexes, copied as the input numbers them, are renumbered so. An apex that is no triangle's
+// vertex in the copy becomes kNoApex (its flag is then dropped at render).
+void remap_soup_apexes(std::uint32_t* edge_apexes, const std::uint32_t* placed_at, std::size_t count) {
+    for (std::size_t i = 0; i < 3 * count; ++i) {
+        const std::uint32_t v = edge_apexes[i];
+        edge_apexes[i] = v < 3 * count ? 3 * placed_at[v / 3] + v % 3 : kNoApex;
     }
 }
 
@@ -259,7 +271,10 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
                                            : 3 * n * std::size_t(in.position_components);
     if (scratch.bucket.size() < n) scratch.bucket.resize(n);
     if (scratch.data.size() < words) scratch.data.resize(words);
-    if (in.shared_edges && !listed && scratch.shared_edges.size() < n) scratch.shared_edges.resize(n);
+    const bool copies_flags = in.shared_edges && !listed;
+    if (copies_flags && scratch.shared_edges.size() < n) scratch.shared_edges.resize(n);
+    if (copies_flags && scratch.edge_apexes.size() < 3 * n) scratch.edge_apexes.resize(3 * n);
+    if (copies_flags && !in.indices && scratch.placed_at.size() < n) scratch.placed_at.resize(n);
     if (scratch.count.size() < tasks * kDrawOrderBuckets) scratch.count.resize(tasks * kDrawOrderBuckets);
     if (scratch.excluded.size() < tasks * kDrawOrderBuckets) scratch.excluded.resize(tasks * kDrawOrderBuckets);
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
@@ -337,9 +352,11 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         DrawOrderScratch& s = *j.scratch;
         place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
                     s.bucket.data(), s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
-                    j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr, j.records ? s.noted.data() : nullptr,
+                    j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr, s.edge_apexes.data(),
+                    j.in->shared_edges && !j.listed && !j.in->indices ? s.placed_at.data() : nullptr, j.records ? s.noted.data() : nullptr,
                     s.listed_notes.data());
     });
+    if (copies_flags && !in.indices) remap_soup_apexes(scratch.edge_apexes.data(), scratch.placed_at.data(), n);
 
     sorted = in;
     sorted.order = DrawOrder::as_given;
@@ -350,6 +367,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         return true;
     }
     sorted.shared_edges = in.shared_edges ? scratch.shared_edges.data() : nullptr;
+    sorted.edge_apexes = in.shared_edges ? scratch.edge_apexes.data() : nullptr;
     if (in.indices) {
         sorted.indices = scratch.data.data();
     } else {

@@ -32,7 +32,7 @@ constexpr std::size_t kDrawOrderTask = 8192;
 // Scratch of sort_nearest_first, kept by the buffer and grown to the largest input, so that a
 // render allocates nothing after the first: 2 bytes per triangle, 8 KB and a RasterStats per
 // task, 4 bytes per vertex of a vertex cache, and the sorted copy (the indices, 6 or 12 bytes
-// per triangle; without indices the positions, 36 or 48; and a byte of shared-edge flags) or,
+// per triangle; without indices the positions, 36 or 48; and a byte of shared-edge flags with 12 of apexes) or,
 // on one thread for a soup of 4 floats per vertex, the list of numbers (4 bytes per triangle),
 // or for a clip-space soup the cell notes (8 bytes per triangle) and the list of notes (12,
 // with or without a job system).
@@ -46,6 +46,8 @@ struct DrawOrderScratch {
     std::uint8_t class_of[kDrawOrderBuckets];
     std::vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
     std::vector<std::uint8_t> shared_edges;
+    std::vector<std::uint32_t> edge_apexes;  // 3 per triangle, with the flags
+    std::vector<std::uint32_t> placed_at;    // a soup's: each input triangle's place in the copy (its apexes are renumbered)
     std::vector<CellRecord> noted;  // with the list of a clip-space soup: each triangle's cell record
     std::vector<ListedNote> listed_notes;  // the list of a noted soup: the notes in order, with the triangles' numbers
 };
@@ -71,7 +73,8 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // classes by the smallest clip w of their three vertices, each class in input order, and
 // returns true with `sorted` the same triangles in that order: the same positions with sorted
 // indices, or without indices sorted copies of each triangle's positions (3 or 4 components,
-// packed); shared-edge flags follow their triangles, and `sorted` draws as given.
+// packed); shared-edge flags and their apexes follow their triangles (a soup's apexes renumbered
+// as its copy numbers its vertices), and `sorted` draws as given.
 //
 // The clip w comes from `cache` (double) when there is one; else it is computed in float lanes
 // (bucket_packed_soup, bucket_indexed) when the positions are float-aligned (address and

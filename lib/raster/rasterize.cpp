@@ -47,14 +47,18 @@ std::uint32_t valid_sample_mask(int tx, int ty, int sample_width, int sample_hei
 // by at most 2^-24 for each of the 5 roundings (a, dzdy, dzdx, two products, two sums) times the
 // magnitudes involved, that is less than 2^-21 (|a| + |dzdx| width + |dzdy| height); the
 // subtraction of `error` rounds by less than 2^-25 of the same; `error` = 2^-20 of it covers
-// both, plus the double rounding of a (2^-40 of its terms is far more than it needs).
+// both, plus the double rounding of a (2^-40 of its terms is far more than it needs). That
+// relative bound holds for normal floats only: a rounding into the subnormal range (depths below
+// 2^-126, w beyond 2^126) errs by up to 2^-150 however small the value, and dzdx, dzdy are
+// multiplied by columns and rows below 2^23. 2^-126 more covers all of it: such planes are then
+// no bound at all, and the smallest vertex depth (rounded down) is used alone.
 DepthPlaneTerms depth_plane_terms(const glm::dvec2 p[3], const double d[3], double area2, int width, int height) {
     DepthPlaneTerms t;
     t.dzdx = ((d[1] - d[0]) * (p[2].y - p[0].y) - (d[2] - d[0]) * (p[1].y - p[0].y)) / area2;
     t.dzdy = ((d[2] - d[0]) * (p[1].x - p[0].x) - (d[1] - d[0]) * (p[2].x - p[0].x)) / area2;
     t.a = d[0] - t.dzdx * p[0].x - t.dzdy * p[0].y;
     t.magnitude = std::abs(t.a) + std::abs(t.dzdx) * width + std::abs(t.dzdy) * height;
-    t.error = 0x1.0p-20 * t.magnitude + 0x1.0p-40 * (std::abs(d[0]) + std::abs(t.dzdx * p[0].x) + std::abs(t.dzdy * p[0].y));
+    t.error = (0x1.0p-20 * t.magnitude + 0x1.0p-40 * (std::abs(d[0]) + std::abs(t.dzdx * p[0].x) + std::abs(t.dzdy * p[0].y))) + 0x1.0p-126;
     return t;
 }
 

@@ -41,17 +41,21 @@ std::uint64_t hash(const EdgeKey& key) {
 // culler runs this over every occluder of a scene at load time, and sorting sponza's 786,000
 // edges was most of its setup.
 void compute_shared_edges(const float* positions, std::size_t stride, std::size_t vertex_count,
-                          const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges) {
+                          const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges,
+                          std::uint32_t* edge_apexes) {
     if (triangle_count == 0) return;
-    if (!positions || !shared_edges || stride < 3 * sizeof(float))
-        throw Error("compute_shared_edges: positions or output missing, or stride smaller than one position");
+    if (!positions || !shared_edges || !edge_apexes || stride < 3 * sizeof(float))
+        throw Error("compute_shared_edges: positions or an output missing, or stride smaller than one position");
     struct Edge {
         EdgeKey key;
         std::uint32_t triangle;
+        std::uint32_t apex;  // the vertex number of the triangle's third vertex (opposite this edge)
         std::uint8_t bit;
         bool reversed;   // the triangle runs from its higher position to its lower one
         std::uint8_t directions = 0;  // on the first edge of each key: 1 forward seen, 2 reversed seen
         std::uint32_t first = 0;      // the first edge with this key
+        // On the first edge of each key: the apex of the first edge seen in each direction.
+        std::uint32_t apex_of[2] = {kNoApex, kNoApex};
     };
     if (triangle_count > 0xFFFFFFFFull / 3)
         throw Error("compute_shared_edges: more than 2^32 / 3 triangles");
@@ -64,6 +68,7 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
     edges.reserve(triangle_count * 3);
     for (std::size_t t = 0; t < triangle_count; ++t) {
         shared_edges[t] = 0;
+        for (int k = 0; k < 3; ++k) edge_apexes[3 * t + std::size_t(k)] = kNoApex;
         std::size_t v[3];
         for (int k = 0; k < 3; ++k) v[k] = indices ? indices[3 * t + std::size_t(k)] : 3 * t + std::size_t(k);
         if (v[0] >= vertex_count || v[1] >= vertex_count || v[2] >= vertex_count) continue;
@@ -78,7 +83,7 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
             const auto& lo = reversed ? b : a;
             const auto& hi = reversed ? a : b;
             Edge e{{{float_key(lo[0]), float_key(lo[1]), float_key(lo[2]), float_key(hi[0]), float_key(hi[1]), float_key(hi[2])}},
-                   std::uint32_t(t), std::uint8_t(1u << k), reversed};
+                   std::uint32_t(t), std::uint32_t(v[(k + 2) % 3]), std::uint8_t(1u << k), reversed};
             edges.push_back(e);
         }
     }
@@ -100,11 +105,19 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
                 break;
             }
         }
-        edges[e.first].directions |= e.reversed ? 2u : 1u;
+        Edge& first = edges[e.first];
+        first.directions |= e.reversed ? 2u : 1u;
+        if (first.apex_of[e.reversed] == kNoApex) first.apex_of[e.reversed] = e.apex;
     }
-    // An edge is shared when its key was seen in the opposite direction too.
-    for (const Edge& e : edges)
-        if (edges[e.first].directions == 3u) shared_edges[e.triangle] |= e.bit;
+    // An edge is shared when its key was seen in the opposite direction too; its neighbour is
+    // the first triangle seen the other way (on a non-manifold edge, any one of them will do: the
+    // render keeps the flag only where that neighbour lies across the edge).
+    for (const Edge& e : edges) {
+        const Edge& first = edges[e.first];
+        if (first.directions != 3u) continue;
+        shared_edges[e.triangle] |= e.bit;
+        edge_apexes[3 * std::size_t(e.triangle) + std::size_t(__builtin_ctz(e.bit))] = first.apex_of[!e.reversed];
+    }
 }
 
 }  // namespace homcull

@@ -193,6 +193,35 @@ inline bool hidden_in_target(const BatchSetup& setup, int t, const RasterTarget&
     return !subtile_rows_within(setup.j0[t], setup.j1[t], target.row_begin, target.row_end, ty0, ty1) || hidden_test(target.planes, setup.i0[t] / kW, setup.i1[t] / kW, ty0, ty1, setup.nearest[t]);
 }
 
+// Vertex v of the input in clip space, as the setup computes it (from the cache when there is
+// one); false when v is not below vertex_count.
+inline bool vertex_clip(const TriangleInput& in, const VertexClip* cache, std::uint32_t v, glm::dvec4& out) {
+    if (v >= in.vertex_count) return false;
+    if (cache) {
+        out = {cache->x[v], cache->y[v], cache->z[v], cache->w[v]};
+    } else {
+        float p[4];
+        read_position(in, v, p);
+        out = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
+    }
+    return true;
+}
+
+// Of lane t's shared-edge bits `flags` (input order), those whose neighbour lies across the
+// edge in this view (neighbour_across_edge, from TriangleInput::edge_apexes). The same scalar
+// code on every instruction set, from the same clip coordinates: the same bits.
+inline std::uint8_t edges_across(const TriangleInput& in, const VertexClip* cache, const TriangleBatch& batch, int t, std::uint8_t flags) {
+    const glm::dvec4 own[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
+    const std::uint32_t* apexes = in.edge_apexes + 3 * batch.triangle[t];
+    std::uint8_t kept = 0;
+    for (int k = 0; k < 3; ++k) {
+        glm::dvec4 apex;
+        if (((flags >> k) & 1u) && vertex_clip(in, cache, apexes[k], apex) && neighbour_across_edge(own, k, apex))
+            kept |= std::uint8_t(1u << k);
+    }
+    return kept;
+}
+
 // Sets up triangles [begin, end) of the input in batches and hands every triangle of their
 // clipped fans that covers a sample's bounding box to emit(const RasterTriangle&), in input
 // order; the statistics are those of fetch_clip_triangle and setup_clip_triangle, triangle
@@ -238,7 +267,8 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             first += std::size_t(batch.count);
         }
         kernels.classify(in.backface, near_w, batch, stats);
-        // Each lane's shared-edge bits, read once. The float row rule needs three silhouette
+        // Each lane's shared-edge bits, read once and kept only where the neighbour lies across
+        // the edge in this view (edges_across). The float row rule needs three silhouette
         // edges: the setup skips it for groups of lanes that all have a shared edge (most of
         // a closed mesh's).
         std::uint8_t lane_shared[TriangleBatch::kSize] = {};
@@ -246,7 +276,9 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
         if (in.shared_edges)
             for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
                 const int t = __builtin_ctz(bits);
-                lane_shared[t] = in.shared_edges[batch.triangle[t]];
+                const std::uint8_t flags = in.shared_edges[batch.triangle[t]];
+                if (flags == 0) continue;
+                lane_shared[t] = edges_across(in, cache, batch, t, flags);
                 if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
             }
         std::uint32_t emitted = batch.simple;  // the simple lanes that go on to assembly

@@ -320,7 +320,7 @@ void SetupPlanes(const TriangleBatch& batch, int sample_width, int sample_height
         const V a = hn::Sub(hn::Sub(d0, hn::Mul(dzdx, x0)), hn::Mul(dzdy, y0));
         const V magnitude = hn::Add(hn::Add(hn::Abs(a), hn::Mul(hn::Abs(dzdx), width)), hn::Mul(hn::Abs(dzdy), height));
         const V terms = hn::Add(hn::Add(hn::Abs(d0), hn::Abs(hn::Mul(dzdx, x0))), hn::Abs(hn::Mul(dzdy, y0)));
-        const V error = hn::Add(hn::Mul(hn::Set(d, 0x1.0p-20), magnitude), hn::Mul(hn::Set(d, 0x1.0p-40), terms));
+        const V error = hn::Add(hn::Add(hn::Mul(hn::Set(d, 0x1.0p-20), magnitude), hn::Mul(hn::Set(d, 0x1.0p-40), terms)), hn::Set(d, 0x1.0p-126));
         // finish_depth_plane: the plane in float where it is usable, else none.
         const M usable = hn::And(hn::Lt(hn::Abs(error), hn::Set(d, HUGE_VAL)), hn::Lt(magnitude, hn::Set(d, 0x1.0p100)));
         const auto usable_f = FloatLaneMask(D(), usable);

@@ -92,11 +92,13 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
         first_triangle_.push_back(first_triangle_.back() + std::uint32_t(scene.triangle_count(scene.objects[occluders[k]])));
     }
     own_shared_edges_.resize(occluders_.triangle_count());
+    own_edge_apexes_.resize(3 * occluders_.triangle_count());
     for (std::size_t k = 0; k < occluders.size(); ++k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
         if (count == 0) continue;
         compute_shared_edges(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
-                             occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first);
+                             occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first,
+                             own_edge_apexes_.data() + 3 * first);
     }
     // The boxes the buffer and the maps test, relative to the anchor as the triangles are.
     object_boxes_.reserve(scene.objects.size());
@@ -109,6 +111,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
     frame_occluders_.reserve(occluders.size());
     frame_indices_.reserve(occluders_.indices.size());
     frame_shared_.reserve(occluders_.triangle_count());
+    frame_apexes_.reserve(3 * occluders_.triangle_count());
     last_visibility_.assign(scene.objects.size(), Visibility::visible);
 
     if (resolved_occludee_shape(config) != OccludeeShape::samples) return;
@@ -142,11 +145,11 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
     frame_occluders_.clear();
     frame_indices_.clear();
     frame_shared_.clear();
+    frame_apexes_.clear();
     frame_rendered_ = 0;  // the buffer is cleared by the frame's first render (render_frame), or by build_maps
     frame_clusters_.clear();
     frame_clusters_rendered_ = 0;
     frame_cluster_triangles_waiting_ = 0;
-    frame_clusters_own_flags_ = false;
     frame_started_ = false;
 
     // one_pass (and temporal's first frame): the candidates in the frustum. temporal: those not
@@ -218,20 +221,23 @@ void SceneCuller::gather_lods() {
         lod_first_[k + 1] += std::uint32_t(lod->mesh.triangle_count());
     }
     lod_shared_edges_.resize(lod_indices_.size() / 3);
+    lod_edge_apexes_.resize(lod_indices_.size());
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         const std::size_t first = lod_first_[k], count = lod_first_[k + 1] - first;
         if (count == 0) continue;
         compute_shared_edges(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
-                             lod_indices_.data() + 3 * first, count, lod_shared_edges_.data() + first);
+                             lod_indices_.data() + 3 * first, count, lod_shared_edges_.data() + first, lod_edge_apexes_.data() + 3 * first);
     }
 }
 
 // config_.occluder_clusters: each candidate's triangles split into clusters of their own (so
-// that a frame draws the clusters of the candidates it picks), one after the other in clusters_.
+// that a frame draws the clusters of the candidates it picks), one after the other in clusters_,
+// with the flags within each object (own_shared_edges_): a cluster's apexes are then among its
+// candidate's vertices, so right whichever candidates a frame draws.
 void SceneCuller::build_clusters() {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
-    std::vector<std::uint32_t> local;  // the candidate's indices, relative to its first vertex
+    std::vector<std::uint32_t> local, local_apexes;  // the candidate's indices and apexes, relative to its first vertex
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
         // Each object's vertices are together in occluders_.positions: the build sees only
@@ -240,9 +246,11 @@ void SceneCuller::build_clusters() {
         const std::uint32_t base = count ? *std::min_element(begin, end) : 0, top = count ? *std::max_element(begin, end) : 0;
         local.assign(begin, end);
         for (std::uint32_t& v : local) v -= base;
+        local_apexes.assign(own_edge_apexes_.begin() + std::ptrdiff_t(3 * first), own_edge_apexes_.begin() + std::ptrdiff_t(3 * (first + count)));
+        for (std::uint32_t& v : local_apexes) v = v == kNoApex ? kNoApex : v - base;
         const OccluderClusters part = build_occluder_clusters(occluders_.positions.data() + 3 * std::size_t(base), 3 * sizeof(float),
                                                               count ? std::size_t(top - base) + 1 : 0, local.data(), count,
-                                                              occluders_.shared_edges.data() + first);
+                                                              own_shared_edges_.data() + first, local_apexes.data());
         const auto vertex_base = std::uint32_t(clusters_.positions.size() / 3), triangle_base = std::uint32_t(clusters_.shared_edges.size());
         for (OccluderCluster c : part.clusters) {
             c.first_vertex += vertex_base;
@@ -252,10 +260,8 @@ void SceneCuller::build_clusters() {
         clusters_.positions.insert(clusters_.positions.end(), part.positions.begin(), part.positions.end());
         clusters_.indices.insert(clusters_.indices.end(), part.indices.begin(), part.indices.end());
         clusters_.shared_edges.insert(clusters_.shared_edges.end(), part.shared_edges.begin(), part.shared_edges.end());
-        for (const std::uint32_t t : part.source_triangles) {
-            clusters_.source_triangles.push_back(std::uint32_t(first) + t);
-            own_cluster_shared_edges_.push_back(own_shared_edges_[first + t]);
-        }
+        clusters_.edge_apexes.insert(clusters_.edge_apexes.end(), part.edge_apexes.begin(), part.edge_apexes.end());
+        for (const std::uint32_t t : part.source_triangles) clusters_.source_triangles.push_back(std::uint32_t(first) + t);
         clusters_.max_cluster_vertices = std::max(clusters_.max_cluster_vertices, part.max_cluster_vertices);
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
@@ -273,6 +279,7 @@ void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, EdgeFl
     const bool own = edge_flags == EdgeFlags::own_object;
     const std::vector<std::uint32_t>& indices = lod ? lod_indices_ : occluders_.indices;
     const std::vector<std::uint8_t>& flags = lod ? lod_shared_edges_ : own ? own_shared_edges_ : occluders_.shared_edges;
+    const std::vector<std::uint32_t>& apexes = lod ? lod_edge_apexes_ : own ? own_edge_apexes_ : occluders_.edge_apexes;
     const std::uint32_t first = lod ? lod_first_[k] : first_triangle_[k], last = lod ? lod_first_[k + 1] : first_triangle_[k + 1];
     frame_occluders_.push_back(id);
     drawn_[k] = 1;
@@ -282,12 +289,11 @@ void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, EdgeFl
     if (config_.occluder_clusters && !lod) {
         for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) frame_clusters_.push_back(c);
         frame_cluster_triangles_waiting_ += last - first;
-        // Flags across objects only when every waiting cluster may have them (else each object's own).
-        frame_clusters_own_flags_ = frame_clusters_own_flags_ || own;
         return;
     }
     frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::size_t(first), indices.begin() + 3 * std::size_t(last));
     frame_shared_.insert(frame_shared_.end(), flags.begin() + first, flags.begin() + last);
+    frame_apexes_.insert(frame_apexes_.end(), apexes.begin() + 3 * std::ptrdiff_t(first), apexes.begin() + 3 * std::ptrdiff_t(last));
 }
 
 // temporal's second pass. Last frame's answers leave out the candidates that were hidden; one
@@ -339,13 +345,11 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
         ClusteredInput in{&clusters_, frame.clip, config_.backface};
         in.cluster_ids = frame_clusters_.data() + frame_clusters_rendered_;
         in.cluster_count = clusters;
-        if (frame_clusters_own_flags_) in.shared_edges = own_cluster_shared_edges_.data();
         if (!frame_started_) buffer_.render_frame(in, parallel);
         else buffer_.render(in, parallel);
         frame_started_ = true;
         frame_clusters_rendered_ += clusters;
         frame_cluster_triangles_waiting_ = 0;
-        frame_clusters_own_flags_ = false;
         ++work_.renders;
     }
     if (count > 0) {
@@ -353,6 +357,7 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
         in.indices = frame_indices_.data() + 3 * frame_rendered_;
         in.triangle_count = count;
         in.shared_edges = frame_shared_.data() + frame_rendered_;
+        in.edge_apexes = frame_apexes_.data() + 3 * frame_rendered_;
         if (!frame_started_) buffer_.render_frame(in, parallel);
         else buffer_.render(in, parallel);
         frame_started_ = true;

@@ -13,6 +13,7 @@ TriangleInput WorldTriangles::input(const std::array<float, 16>& clip_from_world
     in.model_to_clip = clip_from_world;
     in.backface = backface;
     in.shared_edges = shared_edges.data();
+    in.edge_apexes = edge_apexes.data();
     return in;
 }
 
@@ -34,8 +35,9 @@ WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std:
         for (std::uint32_t index : mesh.indices) out.indices.push_back(base + index);
     }
     out.shared_edges.resize(out.triangle_count());
+    out.edge_apexes.resize(out.indices.size());
     compute_shared_edges(out.positions.data(), 3 * sizeof(float), out.positions.size() / 3, out.indices.data(),
-                         out.triangle_count(), out.shared_edges.data());
+                         out.triangle_count(), out.shared_edges.data(), out.edge_apexes.data());
     return out;
 }
 

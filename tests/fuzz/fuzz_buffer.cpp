@@ -64,6 +64,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         indices16.push_back(std::uint16_t(v));
     }
     for (std::size_t t = 0; flags && t < triangles; ++t) shared.push_back(in.take<std::uint8_t>());
+    std::vector<std::uint32_t> apexes;  // any vertex, sometimes none
+    for (std::size_t i = 0; flags && i < 3 * triangles; ++i) apexes.push_back(in.below(std::uint32_t(vertex_count) + 2));
     // Positions: the rest of the bytes, repeated to fill what the input needs.
     const std::size_t stride = std::max<std::size_t>(tri.position_stride, 4);
     std::vector<unsigned char> positions(std::max<std::size_t>(1, vertex_count) * stride + 16, 0);
@@ -74,6 +76,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     tri.indices = !indexed ? nullptr : sixteen ? static_cast<const void*>(indices16.data()) : static_cast<const void*>(indices32.data());
     tri.indices_16bit = sixteen;
     tri.shared_edges = flags ? shared.data() : nullptr;
+    tri.edge_apexes = flags ? apexes.data() : nullptr;
 
     try {
         OcclusionBuffer serial(config), threaded(config);

@@ -1,7 +1,7 @@
 // libFuzzer target: the conservativeness property against the exact oracle (exact_oracle.hpp).
 // The bytes give a small buffer and a few occluder triangles (float positions, any finite value,
-// under a matrix that may translate large model coordinates back near the eye), queries, and the
-// instruction set. Every claimed sample must be backed by an occluder at or nearer than the claim,
+// under a matrix that may translate large model coordinates back near the eye), sometimes a
+// closed mesh with its shared-edge flags and a backface rule, queries, and the instruction set. Every claimed sample must be backed by an occluder at or nearer than the claim,
 // and every rectangle and occludee triangle answered occluded must be hidden at every sample
 // centre, exactly; any violation traps.
 #include "../exact_oracle.hpp"
@@ -10,7 +10,9 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -57,10 +59,41 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             positions.insert(positions.end(), {x + origin[0], y + origin[1], w + origin[2]});
         }
     }
+    // Sometimes a closed mesh as well: an octahedron of 6 vertices from the bytes, its 8 faces
+    // consistently wound, its shared edges flagged (compute_shared_edges) and drawn with any
+    // backface rule, so that silhouettes, folds and degenerate neighbours meet the flags.
+    std::vector<std::uint8_t> shared;
+    std::vector<std::uint32_t> apexes;
+    const Backface backfaces[3] = {Backface::none, Backface::cw, Backface::ccw};
+    tri.backface = Backface::none;
+    const bool closed = in.flag();
+    if (closed) {
+        float v[6][3];
+        for (auto& p : v) {
+            const bool on_vertex = in.flag();  // a repeated vertex: degenerate faces and neighbours
+            for (int k = 0; k < 3; ++k) p[k] = finite(in);
+            if (on_vertex) std::copy(std::begin(v[0]), std::end(v[0]), p);
+        }
+        const float* origin = &tri.model_to_clip[12];
+        const bool cancelling = tri.model_to_clip[4] == 1.0f;  // the (h, a, b) form: x = a, y = b, w = 1
+        const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+        for (const auto& f : faces)
+            for (int k : f) {
+                if (cancelling) positions.insert(positions.end(), {-origin[0], v[k][0], v[k][1]});
+                else positions.insert(positions.end(), {v[k][0] - origin[0], v[k][1] - origin[1], v[k][2] - origin[3]});
+            }
+        tri.backface = backfaces[in.below(3)];
+    }
     tri.positions = positions.data();
     tri.vertex_count = positions.size() / 3;
-    tri.triangle_count = std::size_t(triangles);
-    tri.backface = Backface::none;
+    tri.triangle_count = positions.size() / 9;
+    if (closed) {
+        shared.resize(tri.triangle_count);
+        apexes.resize(3 * tri.triangle_count);
+        compute_shared_edges(positions.data(), 12, tri.vertex_count, nullptr, tri.triangle_count, shared.data(), apexes.data());
+        tri.shared_edges = shared.data();
+        tri.edge_apexes = apexes.data();
+    }
 
     OcclusionBuffer buffer(config);
     buffer.render_frame(tri);
@@ -75,6 +108,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     if (in.left() >= 36) {
         TriangleInput occludee = tri;
+        occludee.shared_edges = nullptr, occludee.edge_apexes = nullptr;
         std::vector<float> p;
         for (int k = 0; k < 9; ++k) p.push_back(finite(in));
         occludee.positions = p.data();

@@ -181,7 +181,7 @@ void run_bench(const BenchOptions& o) {
         if (o.clusters > 0) {
             const long long start = now_ns();
             clustered = build_occluder_clusters(occluders->positions.data(), 3 * sizeof(float), occluders->positions.size() / 3,
-                                                occluders->indices.data(), occluders->triangle_count(), occluders->shared_edges.data(),
+                                                occluders->indices.data(), occluders->triangle_count(), occluders->shared_edges.data(), occluders->edge_apexes.data(),
                                                 limits);
             out["cluster_build_ms"] = elapsed_ms(start);
             out["clusters"] = clustered.clusters.size();

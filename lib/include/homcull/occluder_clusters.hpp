@@ -31,6 +31,10 @@ struct OccluderClusters {
     std::vector<float> positions;            // x, y, z per vertex; each cluster's vertices together
     std::vector<std::uint16_t> indices;      // 3 per triangle, relative to its cluster's first vertex
     std::vector<std::uint8_t> shared_edges;  // one per triangle, as TriangleInput::shared_edges
+    // Three per triangle, as TriangleInput::edge_apexes, numbered within the triangle's cluster
+    // (from its first_vertex): a cluster's vertices end with copies of the apexes its triangles
+    // need that none of them uses (never part of its box).
+    std::vector<std::uint32_t> edge_apexes;
     std::vector<std::uint32_t> source_triangles;  // one per triangle: its number in the input mesh
     std::vector<OccluderCluster> clusters;
     std::uint32_t max_cluster_vertices = 0;  // the largest vertex_count (information: render does not rely on it)
@@ -48,13 +52,14 @@ struct ClusterLimits {
 void check_cluster_limits(const ClusterLimits& limits, const std::string& caller = "build_occluder_clusters");
 
 // Splits an indexed triangle mesh (x, y, z floats every position_stride bytes; 32-bit indices)
-// into clusters. Each triangle keeps its vertices in order and its shared-edge bits (null:
-// none shared); triangles and vertices are reordered cluster by cluster, and a vertex used by
-// several clusters is copied into each. Meant for load time: it allocates. Throws
+// into clusters. Each triangle keeps its vertices in order and its shared-edge bits and their
+// apexes (compute_shared_edges'; both null: none shared); triangles and vertices are reordered
+// cluster by cluster, and a vertex used by several clusters (or the apex of a neighbour in
+// another cluster) is copied into each. Meant for load time: it allocates. Throws
 // homcull::Error on an index out of range, a stride smaller than a position, or limits that
 // meshopt_buildMeshlets does not accept.
 OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
                                          const std::uint32_t* indices, std::size_t triangle_count, const std::uint8_t* shared_edges,
-                                         const ClusterLimits& limits = {});
+                                         const std::uint32_t* edge_apexes, const ClusterLimits& limits = {});
 
 }  // namespace homcull

@@ -141,27 +141,34 @@ struct TriangleInput {
     std::array<float, 16> model_to_clip{};  // column-major, as glm and OpenGL
     Backface backface = Backface::cw;
     // Optional, one byte per triangle: bit k set when the edge from its vertex k to vertex
-    // k + 1 is shared with another triangle drawn into the same buffer (compute_shared_edges
-    // finds them once per mesh). Samples on a shared edge are covered by one of the two
-    // triangles, so the coverage margin, which keeps silhouettes conservative, is not applied
-    // there and meshes leave no cracks. Without flags every edge is treated as a silhouette.
-    // Known gap: the flag assumes the neighbour is drawn on the other side of the edge. At a
-    // view silhouette of a closed mesh (front and back face meet there, or the back face is
-    // culled) or next to a skipped neighbour the edge is a silhouette without its margin, so
-    // a sample within rounding of it may be covered. Deciding "shared" per view needs the
-    // neighbour's orientation at render time (planned).
+    // k + 1 is shared with another triangle of the occluders (compute_shared_edges finds them
+    // once per mesh), with edge_apexes saying which. A silhouette edge keeps a coverage margin,
+    // which keeps coverage conservative; an edge whose neighbour lies on the other side of it
+    // in this view needs none (a sample on it is covered by one of the two), so meshes leave no
+    // cracks. Whether the neighbour lies on the other side is decided per render from its
+    // third vertex (docs/occlusion-buffer.md, "Why it never hides what is visible"): at a view
+    // silhouette of a closed mesh, next to a degenerate neighbour or one whose facing cannot be
+    // told, the edge keeps its margin. Without flags every edge keeps its margin.
     const std::uint8_t* shared_edges = nullptr;
+    // Required with shared_edges, three per triangle: the vertex number (as the indices number
+    // vertices, or 3t + k without indices) of the third vertex of the neighbour across edge k,
+    // read only where the edge's bit is set. A number not below vertex_count drops the flag.
+    const std::uint32_t* edge_apexes = nullptr;
     DrawOrder order = DrawOrder::nearest_first;
 };
 
 // Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
 // in opposite order as consistently wound neighbours have them) and writes the
-// TriangleInput::shared_edges bits. `indices` may be null (vertices 3k, 3k+1, 3k+2). Meant
-// for load time: it allocates the edges and a hash table of them (about 150 bytes per
-// triangle). Throws homcull::Error when positions or the output are missing, the stride is
-// below one position (12 bytes), or there are 2^32 / 3 triangles or more.
+// TriangleInput::shared_edges bits and, for each shared edge, the apex of one neighbour across
+// it (TriangleInput::edge_apexes: 3 per triangle; kNoApex where the edge is not shared).
+// `indices` may be null (vertices 3k, 3k+1, 3k+2). Meant for load time: it allocates the edges
+// and a hash table of them (about 150 bytes per triangle). Throws homcull::Error when positions
+// or an output are missing, the stride is below one position (12 bytes), or there are 2^32 / 3
+// triangles or more.
+constexpr std::uint32_t kNoApex = 0xFFFFFFFFu;
 void compute_shared_edges(const float* positions, std::size_t position_stride, std::size_t vertex_count,
-                          const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges);
+                          const std::uint32_t* indices, std::size_t triangle_count, std::uint8_t* shared_edges,
+                          std::uint32_t* edge_apexes);
 
 struct OccluderClusters;
 struct OccluderCluster;
@@ -176,9 +183,11 @@ struct ClusteredInput {
     // null: all of them.
     const std::uint32_t* cluster_ids = nullptr;
     std::size_t cluster_count = 0;
-    // Optional: shared-edge flags to use instead of clusters->shared_edges, one per clustered
-    // triangle in the same order (for example flags computed within each object only).
+    // Optional: shared-edge flags and their apexes to use instead of clusters->shared_edges and
+    // clusters->edge_apexes, one (three) per clustered triangle in the same order (for example
+    // flags computed within each object only); the apexes number OccluderClusters::positions.
     const std::uint8_t* shared_edges = nullptr;
+    const std::uint32_t* edge_apexes = nullptr;
 };
 
 // The caller's job system, for render(): run(user, count, task, task_data) must call

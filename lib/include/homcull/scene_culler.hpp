@@ -154,17 +154,17 @@ private:
     // Shared-edge flags within each object only: right for any subset of the candidates (an edge
     // shared with an object that is not drawn is a silhouette and needs its margin).
     std::vector<std::uint8_t> own_shared_edges_;
+    std::vector<std::uint32_t> own_edge_apexes_;  // their apexes (3 per triangle, into occluders_.positions)
     // Per candidate k: its LOD's triangles (indices into occluders_.positions, which hold the
     // LODs' vertices after the originals') are lod_indices_[3 * lod_first_[k] .. 3 * lod_first_[k + 1]),
     // with shared-edge flags within the LOD; an empty range when it has none.
     std::vector<std::uint32_t> lod_first_, lod_indices_;
     std::vector<std::uint8_t> lod_shared_edges_;
+    std::vector<std::uint32_t> lod_edge_apexes_;
     // config_.occluder_clusters: candidate k's clusters are [cluster_first_[k], cluster_first_[k + 1])
-    // of clusters_, whose flags are occluders_.shared_edges'; own_cluster_shared_edges_ the
-    // own_shared_edges_ of the same triangles.
+    // of clusters_, whose flags are own_shared_edges_' (a cluster's apexes are in its own vertices).
     OccluderClusters clusters_;
     std::vector<std::uint32_t> cluster_first_;
-    std::vector<std::uint8_t> own_cluster_shared_edges_;
     ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
@@ -175,12 +175,12 @@ private:
     // Per-frame state and scratch (reused, grown only).
     std::vector<std::uint32_t> frame_occluders_;  // object ids drawn this frame
     std::vector<std::uint32_t> frame_indices_;    // their triangles' indices into occluders_
-    std::vector<std::uint8_t> frame_shared_;      // and their own_shared_edges_
+    std::vector<std::uint8_t> frame_shared_;      // and their shared-edge flags
+    std::vector<std::uint32_t> frame_apexes_;     // and the flags' apexes
     std::size_t frame_rendered_ = 0;              // triangles of frame_indices_ already rendered
     std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
     std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
     std::size_t frame_cluster_triangles_waiting_ = 0;
-    bool frame_clusters_own_flags_ = false;       // the waiting clusters need own_cluster_shared_edges_
     bool frame_started_ = false;                  // something was rendered this frame (the buffer is cleared)
     std::vector<std::uint32_t> temporal_pool_;    // temporal: the candidates not occluded last frame
     std::vector<std::uint32_t> ranked_;           // rank_occluders' choice

@@ -15,6 +15,7 @@ struct WorldTriangles {
     std::vector<float> positions;  // x, y, z per vertex
     std::vector<std::uint32_t> indices;
     std::vector<std::uint8_t> shared_edges;
+    std::vector<std::uint32_t> edge_apexes;  // 3 per triangle (compute_shared_edges)
 
     std::size_t triangle_count() const { return indices.size() / 3; }
     TriangleInput input(const std::array<float, 16>& clip_from_world, Backface backface = Backface::cw) const;
