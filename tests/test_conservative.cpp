@@ -380,6 +380,41 @@ TEST(Conservative, SubnormalDepthsClaimNoSampleNearerThanTheOccluder) {
     select_isa("best");
 }
 
+// Occludee triangles whose rounding hides part of them (fuzz_conservative's finds):
+// - a sliver 3e-21 wide through sample centres, from model coordinates that the matrix cancels
+//   (x = (h + a) - h): collinear in double, it was dropped as degenerate and the occludee answered
+//   occluded in an empty buffer. It is now tested as its padded bounding box;
+// - a triangle whose rounded x lies beyond w while its exact x does not (x = (2^51 + a) - 2^51
+//   rounds to a multiple of 0.5, w = 0.78 exactly): it was passed over as beyond the side plane
+//   and the occludee answered view_culled, though it covers the buffer's last column. The side
+//   plane now takes the transform's rounding bound into account.
+TEST(Conservative, OccludeeTrianglesHiddenByTheirRoundingAreTested) {
+    const float h = 0x1.77777p+15f, t = 0x1.20202p-95f;
+    TriangleInput sliver;
+    const std::vector<float> sliver_positions = {0x1.9a9a9ap+27f, 0x1.20209ap-95f, t, t, t, t, t, t, 0x1.f6202p-69f};
+    sliver.positions = sliver_positions.data();
+    sliver.vertex_count = 3;
+    sliver.triangle_count = 1;
+    sliver.model_to_clip = cancelling_matrix(h);
+    const float big = 0x1.0p51f;
+    TriangleInput beside;
+    const std::vector<float> beside_positions = {big, 0.77f, -0.5f, big, 0.76f, 0.5f, big, 0.77f, 0.5f};
+    beside.positions = beside_positions.data();
+    beside.vertex_count = 3;
+    beside.triangle_count = 1;
+    beside.model_to_clip = {1, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -big, 0, 0, 0.78f};
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        const OcclusionBuffer empty(test::buffer_config(1, 5, 4, 0.72f, true));
+        ASSERT_FALSE(test::triangles_truly_hidden({}, test::exact_triangles(sliver), empty.sample_width(), empty.sample_height(), 0.72f));
+        EXPECT_EQ(empty.test_triangles(sliver).visibility, Visibility::visible) << isa;
+        const OcclusionBuffer wide(test::buffer_config(16, 8, 4, 0.1f));
+        ASSERT_FALSE(test::triangles_truly_hidden({}, test::exact_triangles(beside), wide.sample_width(), wide.sample_height(), 0.1f));
+        EXPECT_EQ(wide.test_triangles(beside).visibility, Visibility::visible) << isa;
+    }
+    select_isa("best");
+}
+
 // Shared edges decided per view (neighbour_across_edge). A triangle T = (a, b, c) whose edge a -> b
 // runs at NDC y = 2^-100, just above the sample row at y = 0 (an odd sample height puts a row
 // there): (1 - y) * 0.5 * height rounds the row onto the edge, so without its margin the edge
@@ -456,6 +491,54 @@ TEST(Conservative, SharedEdgesAtViewSilhouettesKeepTheirMargin) {
             }
     select_isa("best");
     EXPECT_GT(row_claims_kept, 0);
+}
+
+// The ends of margin-free edges (margin_free_edges). Both cases put the sample centre at NDC (0, 0)
+// (odd sample counts) a hair outside a triangle T whose margin-free edge the projection rounds
+// onto it, with the neighbour across that edge facing as T does, so that the per-edge rule alone
+// keeps the flag:
+// - a neighbour too thin to cover the sample: N's apex 2^-102 below the edge at y = 2^-100;
+// - a corner on the outline: T's vertex at (1e-30, 1e-30), both of its edges there shared with
+//   neighbours across them, the sample in the vertical angle of T's corner, which no triangle
+//   covers.
+// Each must claim no sample the exact geometry leaves open, on every instruction set.
+TEST(Conservative, MarginFreeEdgesClaimNothingPastThinNeighboursOrOutlineCorners) {
+    const float e = 0x1.0p-100f, tiny = 1e-30f;
+    struct Mesh {
+        const char* name;
+        std::vector<float> soup;  // clip (x, y, w), 3 vertices a triangle
+    };
+    const Mesh meshes[] = {
+        {"thin neighbour", {-0.5f, e, 1, 0.5f, e, 1, 0, 0.5f, 1, 0.5f, e, 1, -0.5f, e, 1, 0.4f, e - 0x1.0p-102f, 1}},
+        {"corner on the outline",
+         {tiny, tiny, 1, 0.5f, 0.15f, 1, 0.15f, 0.5f, 1, 0.5f, 0.15f, 1, tiny, tiny, 1, 0.5f, -0.4f, 1, tiny, tiny, 1, 0.15f, 0.5f, 1, -0.4f, 0.5f, 1}},
+    };
+    const std::array<float, 16> matrix = translated_projection(std::array<float, 3>{0, 0, 0}.data());
+    for (const Mesh& m : meshes) {
+        const std::size_t triangles = m.soup.size() / 9;
+        std::vector<std::uint8_t> flags(triangles);
+        std::vector<std::uint32_t> apexes(3 * triangles);
+        compute_shared_edges(m.soup.data(), 12, 3 * triangles, nullptr, triangles, flags.data(), apexes.data());
+        ASSERT_NE(flags[0], 0u) << m.name;
+        TriangleInput in;
+        in.positions = m.soup.data();
+        in.vertex_count = 3 * triangles;
+        in.triangle_count = triangles;
+        in.model_to_clip = matrix;
+        in.backface = Backface::none;
+        in.shared_edges = flags.data();
+        in.edge_apexes = apexes.data();
+        const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
+        for (const std::string& isa : available_isas()) {
+            select_isa(isa);
+            OcclusionBuffer buffer(test::buffer_config(15, 15, 1, 0.1f));
+            buffer.render_frame(in);
+            std::vector<float> claims = test::claimed_inverse_w(buffer);
+            EXPECT_GT(std::count_if(claims.begin(), claims.end(), [](float d) { return d > 0.0f; }), 5) << m.name << ", " << isa;
+            EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << m.name << ", " << isa;
+        }
+    }
+    select_isa("best");
 }
 
 // Flags without apexes cannot be decided per view: render refuses them.

@@ -375,6 +375,12 @@ TEST(OcclusionBuffer, InvalidConfigurationsAreRejected) {
     c.samples = 1;
     c.near_w = 0.0f;
     EXPECT_THROW(OcclusionBuffer{c}, Error);
+    // A subnormal near_w: 1/near_w overflows float depths, and threaded renders drew apart from
+    // serial ones (fuzz_buffer's find).
+    c.near_w = 8.8e-44f;
+    EXPECT_THROW(OcclusionBuffer{c}, Error);
+    c.near_w = 0x1.0p-126f;
+    EXPECT_NO_THROW(OcclusionBuffer{c});
     c.near_w = 0.1f;
     EXPECT_NO_THROW(OcclusionBuffer{c});
     c.width = 1;

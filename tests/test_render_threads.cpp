@@ -397,13 +397,14 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
         config.sample_depth = true;
         out.emplace_back(config);
         out.back().render(occluders.input(clip_from_world(street, 777.0 / 333.0), Backface::none));
-        // Depths 1/w about the largest float (w from 1e-40): the float bounds of the depth plane
-        // (float_down, float_up) beyond the float range, and planes too steep for float.
+        // Depths 1/w near the largest float (w from 1e-37, near_w the smallest it may be, 2^-126):
+        // the float bounds of the depth plane (float_down, float_up) at the float range's end,
+        // and planes too steep for float.
         std::vector<float> tiny_w = xyzw;
-        for (float& v : tiny_w) v *= 1e-40f;
+        for (float& v : tiny_w) v *= 1e-37f;
         config.width = 301;
         config.height = 173;
-        config.near_w = 1e-41f;
+        config.near_w = 0x1.0p-126f;
         out.emplace_back(config);
         out.back().render(test::clip_space_input(tiny_w));
     };

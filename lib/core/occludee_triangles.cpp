@@ -58,6 +58,22 @@ ClipError clip_error(const std::array<float, 16>& m, const glm::dvec4 model[3]) 
     return e;
 }
 
+// Whether all three vertices lie beyond one side plane by more than the rounding of the plain
+// transform (clip_error's bound, taken without products: each term |m p| is at most |m| times
+// the largest |p|), so that the exact triangle lies beyond it too. The rounded coordinates alone
+// are not enough where the terms cancel (model coordinates far larger than the clip coordinates
+// they give: 2^-22 of them can exceed half a sample). row_x, row_y, row_w: 2^-22 times the sum
+// of the magnitudes of the matrix's row.
+bool beyond_side_plane_exactly(const glm::dvec4 model[3], const glm::dvec4 clip[3], double row_x, double row_y, double row_w) {
+    double p = 0.0;
+    for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 4; ++i) p = std::max(p, std::abs(model[k][i]));
+    const double ex = (row_x + row_w) * p, ey = (row_y + row_w) * p;
+    auto all = [&](auto beyond) { return beyond(clip[0]) && beyond(clip[1]) && beyond(clip[2]); };
+    return all([&](const glm::dvec4& c) { return c.x - c.w > ex; }) || all([&](const glm::dvec4& c) { return -c.x - c.w > ex; }) ||
+           all([&](const glm::dvec4& c) { return c.y - c.w > ey; }) || all([&](const glm::dvec4& c) { return -c.y - c.w > ey; });
+}
+
 // The same in samples for a projected triangle (corners with d = 1/w), per vertex: NDC x =
 // x / w is off by (ex + |x / w| ew) / w; w is off by a relative ew d, and so d by d (ew d).
 // Their largest over the vertices pad the coverage and raise the plane-error bound; the
@@ -258,11 +274,18 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         result.visible_samples = counts.visible;
         return result;
     };
+    // 2^-22 times each matrix row's magnitudes, for beyond_side_plane_exactly.
+    double rows[4] = {0.0, 0.0, 0.0, 0.0};
+    for (int row = 0; row < 4; ++row)
+        for (int i = 0; i < 4; ++i) rows[row] += 0x1.0p-22 * std::abs(double(in.model_to_clip[std::size_t(4 * i + row)]));
+    const auto beyond_exactly = [&](const glm::dvec4 model[3], const glm::dvec4 clip[3]) {
+        return beyond_side_plane_exactly(model, clip, rows[0], rows[1], rows[3]);
+    };
     // One triangle: true when it makes the occludee visible.
     auto shows = [&](const glm::dvec4 model[3], const glm::dvec4 clip[3]) {
-        // Outside a side plane first: that needs no rounding bound, and it is the fate of most
-        // triangles tested (castle walk: 88 % of them, the parts of partly seen objects).
-        if (detail::outside_side_plane(clip)) return false;
+        // Outside a side plane first, beyond the transform's rounding: the fate of most triangles
+        // tested (castle walk: 88 % of them, the parts of partly seen objects).
+        if (beyond_exactly(model, clip)) return false;
         // Ground truth sees surfaces from the near plane on: the part before it is clipped
         // away, at a plane moved towards the eye by the rounding bound of w.
         const ClipError error = clip_error(in.model_to_clip, model);
@@ -272,7 +295,7 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         if (!(near_clip > 0.0)) return true;  // coordinates too large to place the near plane
         RasterStats stats;
         const detail::SetupResult setup =
-            detail::setup_clip_triangle(clip, 0, Backface::none, near_clip, sample_width_, sample_height_, stats);
+            detail::setup_clip_triangle(clip, 0, Backface::none, near_clip, sample_width_, sample_height_, stats, /*occludee=*/true);
         if (stats.too_large) return true;  // not clipped precisely enough to reason with
         const PlaneError depth_error = plane_error(clip, error);
         for (int k = 0; k < setup.count; ++k) {
@@ -306,18 +329,20 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
         // Lanes beyond a side plane (valid and finite) cannot show the occludee: shows() would
         // pass over them first thing. Decided for the whole batch in SIMD lanes: most lanes on
         // a walk (the castle's: 88 %). The others are taken in order, as before.
+        // The kernel judges the rounded coordinates; a lane it passes over is confirmed beyond
+        // the rounding (beyond_exactly), else taken in order with the others.
         const std::uint32_t passed_over = kernels.beyond_side_plane(batch, int(count));
         for (std::size_t k = 0; k < count; ++k) {
-            if ((passed_over >> k) & 1u) continue;
-            result.deciding_triangle = t + k;
-            if (!((batch.indices_valid >> k) & 1u)) return visible();  // as fetch_clip_triangle
             glm::dvec4 model[3], clip[3];
-            bool finite = true;
             for (int v = 0; v < 3; ++v) {
                 model[v] = {batch.px[v][k], batch.py[v][k], batch.pz[v][k], batch.pw[v][k]};
                 clip[v] = batch.clip(int(k), v);
-                finite = finite && detail::finite_clip(clip[v]);
             }
+            if (((passed_over >> k) & 1u) && beyond_exactly(model, clip)) continue;
+            result.deciding_triangle = t + k;
+            if (!((batch.indices_valid >> k) & 1u)) return visible();  // as fetch_clip_triangle
+            bool finite = true;
+            for (int v = 0; v < 3; ++v) finite = finite && detail::finite_clip(clip[v]);
             if (!finite) return visible();
             if (shows(model, clip)) return visible();
         }

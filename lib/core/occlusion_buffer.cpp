@@ -68,7 +68,10 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     validate_resolution({config.width, config.height});
     if (config.samples != 1 && config.samples != 2 && config.samples != 4)
         throw Error("occlusion buffer: samples per pixel axis must be 1, 2 or 4, got " + std::to_string(config.samples));
-    if (!(config.near_w > 0.0f) || !std::isfinite(config.near_w)) throw Error("occlusion buffer: near_w must be a positive number");
+    // Depths are stored as float 1/w: below 2^-126 (subnormal) 1/near_w overflows float, and the
+    // draw order's and the cells' float depths stop agreeing with the setup's double ones.
+    if (!(config.near_w >= 0x1.0p-126f) || !std::isfinite(config.near_w))
+        throw Error("occlusion buffer: near_w must be a positive number of at least 2^-126 (1.2e-38), got " + std::to_string(config.near_w));
     if (!(config.edge_margin >= 0.0 && config.edge_margin < 0.5)) throw Error("occlusion buffer: edge margin must be in [0, 0.5) samples");
     sample_width_ = config.width * config.samples;
     sample_height_ = config.height * config.samples;

@@ -14,6 +14,7 @@
 // triangle is rejected as invalid or outside from its three outcodes before anything is
 // fetched (MOC's TransformVertices, and Blinn and Newell's outcodes).
 #include "raster/reference_cells.hpp"
+#include "raster/shared_edge_rule.hpp"
 #include "raster/triangle_setup.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -207,19 +208,18 @@ inline bool vertex_clip(const TriangleInput& in, const VertexClip* cache, std::u
     return true;
 }
 
-// Of lane t's shared-edge bits `flags` (input order), those whose neighbour lies across the
-// edge in this view (neighbour_across_edge, from TriangleInput::edge_apexes). The same scalar
+// Of lane t's shared-edge bits `flags` (input order), those that may go without their margin in
+// this view (margin_free_edges, from the apexes of TriangleInput::edge_apexes). The same scalar
 // code on every instruction set, from the same clip coordinates: the same bits.
-inline std::uint8_t edges_across(const TriangleInput& in, const VertexClip* cache, const TriangleBatch& batch, int t, std::uint8_t flags) {
+inline std::uint8_t edges_across(const TriangleInput& in, const VertexClip* cache, const TriangleBatch& batch, int t, std::uint8_t flags,
+                                 double near_w, double edge_margin, int sample_width, int sample_height) {
     const glm::dvec4 own[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
     const std::uint32_t* apexes = in.edge_apexes + 3 * batch.triangle[t];
-    std::uint8_t kept = 0;
-    for (int k = 0; k < 3; ++k) {
-        glm::dvec4 apex;
-        if (((flags >> k) & 1u) && vertex_clip(in, cache, apexes[k], apex) && neighbour_across_edge(own, k, apex))
-            kept |= std::uint8_t(1u << k);
-    }
-    return kept;
+    glm::dvec4 apex[3];
+    std::uint8_t apex_valid = 0;
+    for (int k = 0; k < 3; ++k)
+        if (((flags >> k) & 1u) && vertex_clip(in, cache, apexes[k], apex[k])) apex_valid |= std::uint8_t(1u << k);
+    return margin_free_edges(own, apex, apex_valid, flags, near_w, edge_margin, sample_width, sample_height);
 }
 
 // Sets up triangles [begin, end) of the input in batches and hands every triangle of their
@@ -267,8 +267,8 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             first += std::size_t(batch.count);
         }
         kernels.classify(in.backface, near_w, batch, stats);
-        // Each lane's shared-edge bits, read once and kept only where the neighbour lies across
-        // the edge in this view (edges_across). The float row rule needs three silhouette
+        // Each lane's shared-edge bits, read once and kept only where they may go without their
+        // margin in this view (edges_across). The float row rule needs three silhouette
         // edges: the setup skips it for groups of lanes that all have a shared edge (most of
         // a closed mesh's).
         std::uint8_t lane_shared[TriangleBatch::kSize] = {};
@@ -278,7 +278,7 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
                 const int t = __builtin_ctz(bits);
                 const std::uint8_t flags = in.shared_edges[batch.triangle[t]];
                 if (flags == 0) continue;
-                lane_shared[t] = edges_across(in, cache, batch, t, flags);
+                lane_shared[t] = edges_across(in, cache, batch, t, flags, near_w, edge_margin, sample_width, sample_height);
                 if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
             }
         std::uint32_t emitted = batch.simple;  // the simple lanes that go on to assembly

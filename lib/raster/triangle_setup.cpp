@@ -76,10 +76,10 @@ TriangleFate unclipped_fate(const glm::dvec4 clip[3], Backface backface, double 
 }
 
 SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
-                                int sample_height, RasterStats& stats) {
+                                int sample_height, RasterStats& stats, bool occludee) {
     SetupResult result;
     // Entirely outside one plane of the view frustum (or behind the near plane)?
-    if (outside_frustum(clip, near_w)) {
+    if (occludee ? clip[0].w < near_w && clip[1].w < near_w && clip[2].w < near_w : outside_frustum(clip, near_w)) {
         ++stats.outside;
         return result;
     }
@@ -112,11 +112,11 @@ SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bi
     // may leave three consecutive vertices on one line.
     double det = 0.0;
     for (int k = 1; k + 1 < poly.count; ++k) det += homogeneous_det(poly.v[0], poly.v[k], poly.v[k + 1]);
-    if (det == 0.0) {
+    if (det == 0.0 && !occludee) {
         ++stats.degenerate;
         return result;
     }
-    if (facing_away(det, backface)) {
+    if (det != 0.0 && facing_away(det, backface)) {
         ++stats.backface_culled;
         return result;
     }

@@ -143,31 +143,6 @@ inline double homogeneous_det(const V& a, const V& b, const V& c) {
     return a.x * (b.y * w(c) - w(b) * c.y) - a.y * (b.x * w(c) - w(b) * c.x) + w(a) * (b.x * c.y - b.y * c.x);
 }
 
-// Whether the neighbour across edge k of a triangle (own, in clip space, as given) certainly lies
-// on the other side of that edge in this view, so that the edge may go without its coverage
-// margin (TriangleInput::shared_edges). The neighbour runs from own[k + 1] to own[k] to `apex`:
-// it lies across the edge when it has the triangle's orientation (its homogeneous determinant
-// the triangle's sign: both face the eye, or both face away). Both determinants must exceed
-// 2^-40 of the sum of their six terms' magnitudes, which bounds their rounding (about 2^-50 of
-// it, with the clip coordinates' own 2^-52) far below, so the signs are the exact geometry's and
-// neither triangle is a sliver at the precision of its coordinates. A view silhouette (the
-// neighbour faces the other way), a degenerate neighbour, and an apex that is not finite all
-// answer false. Clipping keeps the answer: clipped polygons are positive combinations of the
-// vertices, with the same signs. docs/occlusion-buffer.md, "Why it never hides what is visible".
-inline bool certain_sign(double det, double magnitude) { return std::abs(det) > 0x1.0p-40 * magnitude; }
-template <typename V>
-inline double homogeneous_det_magnitude(const V& a, const V& b, const V& c) {
-    return std::abs(a.x * b.y * c.w) + std::abs(a.x * b.w * c.y) + std::abs(a.y * b.x * c.w) + std::abs(a.y * b.w * c.x) +
-           std::abs(a.w * b.x * c.y) + std::abs(a.w * b.y * c.x);
-}
-inline bool neighbour_across_edge(const glm::dvec4 own[3], int k, const glm::dvec4& apex) {
-    const double own_det = homogeneous_det(own[0], own[1], own[2]);
-    const glm::dvec4 &a = own[k], &b = own[(k + 1) % 3];
-    const double det = homogeneous_det(b, a, apex);
-    return (own_det > 0.0) == (det > 0.0) && certain_sign(own_det, homogeneous_det_magnitude(own[0], own[1], own[2])) &&
-           certain_sign(det, homogeneous_det_magnitude(b, a, apex));
-}
-
 // Whether a triangle of determinant det (homogeneous_det, non-zero) is culled by the backface mode.
 inline bool facing_away(double det, Backface backface) {
     const bool ccw_in_ndc = det > 0.0;
@@ -188,7 +163,11 @@ struct SetupResult {
 // Sets up a triangle already fetched and in clip space (fetch_clip_triangle), with its shared-edge
 // bits: clipping, backface culling, projection to the sample grid of sample_width x sample_height.
 // Counts the setup statistics but triangles_in, invalid and subtiles_updated.
+// occludee: the triangle is an occludee's, whose exact triangle may reach samples its rounded
+// coordinates miss (the caller pads its coverage by the rounding): it is not rejected beyond a
+// side plane (the caller rejects those beyond the rounding), and a polygon whose determinant is 0
+// in double is projected anyway, as zero-area triangles, rather than dropped as degenerate.
 SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
-                                int sample_height, RasterStats& stats);
+                                int sample_height, RasterStats& stats, bool occludee = false);
 
 }  // namespace homcull::detail

@@ -3,7 +3,7 @@
 // under a matrix that may translate large model coordinates back near the eye), sometimes a
 // closed mesh with its shared-edge flags and a backface rule, queries, and the instruction set. Every claimed sample must be backed by an occluder at or nearer than the claim,
 // and every rectangle and occludee triangle answered occluded must be hidden at every sample
-// centre, exactly; any violation traps.
+// centre, and one answered view_culled seen at none, exactly; any violation traps.
 #include "../exact_oracle.hpp"
 #include "fuzz_input.hpp"
 
@@ -102,9 +102,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const int sw = buffer.sample_width(), sh = buffer.sample_height();
     for (int q = 0; q < 4 && in.left() >= 20; ++q) {
         const ScreenRect r{finite(in), finite(in), finite(in), finite(in), finite(in)};
-        if (buffer.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min) == Visibility::occluded &&
-            !test::rect_truly_hidden(occluders, r, sw, sh, config.near_w))
-            __builtin_trap();
+        const Visibility v = buffer.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
+        // occluded: hidden at every sample centre; view_culled: no sample centre at all
+        if (v == Visibility::occluded && !test::rect_truly_hidden(occluders, r, sw, sh, config.near_w)) __builtin_trap();
+        if (v == Visibility::view_culled && !test::rect_truly_hidden({}, r, sw, sh, config.near_w)) __builtin_trap();
     }
     if (in.left() >= 36) {
         TriangleInput occludee = tri;
@@ -114,9 +115,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         occludee.positions = p.data();
         occludee.vertex_count = 3;
         occludee.triangle_count = 1;
-        if (buffer.test_triangles(occludee).visibility == Visibility::occluded &&
-            !test::triangles_truly_hidden(occluders, test::exact_triangles(occludee), sw, sh, config.near_w))
-            __builtin_trap();
+        const Visibility v = buffer.test_triangles(occludee).visibility;
+        const std::vector<test::ExactTriangle> exact = test::exact_triangles(occludee);
+        if (v == Visibility::occluded && !test::triangles_truly_hidden(occluders, exact, sw, sh, config.near_w)) __builtin_trap();
+        if (v == Visibility::view_culled && !test::triangles_truly_hidden({}, exact, sw, sh, config.near_w)) __builtin_trap();
     }
     return 0;
 }

@@ -60,7 +60,7 @@ struct BufferConfig {
     int width = 0, height = 0;  // pixels, >= 1
     int samples = 1;            // S: S x S samples per pixel, 1, 2 or 4 (SceneCuller picks it from its display)
     // Triangles are clipped at clip w >= near_w (the camera's near distance for a standard
-    // perspective projection). Occludees reaching w < near_w are visible.
+    // perspective projection). Occludees reaching w < near_w are visible. At least 2^-126.
     float near_w = 0.1f;
     // Inner margin of coverage, in samples: see "Conservative" above.
     double edge_margin = 1.0 / 1024.0;
