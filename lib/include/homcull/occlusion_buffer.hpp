@@ -15,9 +15,11 @@
 //
 // Conservative. A sample is marked covered only when it lies inside the triangle by a margin
 // (edge_margin samples) on every silhouette edge, which absorbs the rounding between this
-// rasterizer and an exact ray cast (edges shared by two drawn triangles need none); a triangle's depth enters the buffer as a lower bound of 1/w over the samples it
-// covers, lowered by a relative 2^-20. So the buffer never claims an occluder where there is
-// none, nor nearer than it is, and occludee tests never hide what is visible at the samples.
+// rasterizer and an exact ray cast (a shared edge whose neighbour lies across it in the view
+// needs none: TriangleInput::shared_edges); a triangle's depth enters the buffer as a lower
+// bound of 1/w over the samples it covers, lowered by a relative 2^-20. So the buffer never
+// claims an occluder where there is none, nor nearer than it is, and occludee tests never hide
+// what is visible at the samples.
 #include <homcull/aabb.hpp>
 #include <homcull/camera.hpp>
 
