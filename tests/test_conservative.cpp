@@ -541,6 +541,31 @@ TEST(Conservative, MarginFreeEdgesClaimNothingPastThinNeighboursOrOutlineCorners
     select_isa("best");
 }
 
+// A clipped sliver (fuzz_conservative's find): a triangle from w = 2.2e8 back past the near plane,
+// about 1e-8 NDC wide, along the diagonal of sample centres. Its clipped polygon is drawn as a fan
+// whose diagonals went without margin, though the fan triangle across them was far thinner than
+// their rounding: 29 samples claimed on the diagonal, outside the exact sliver. Fan diagonals now
+// pass margin_free_edges like shared edges.
+TEST(Conservative, ClippedSliversClaimNoSampleAlongTheirFanDiagonals) {
+    const std::vector<float> sliver = {-0x1.d70a3p-4f, -0x1.d70a38p-4f, 0x1.9a9a9ap+27f, 0x1.9a9a9ap+27f, 0x1.9a9a9ap+27f, 0x1.de267p-92f,
+                                       -0x1p-67f, -0x1.d86948p-26f, -0x1.758b0ap-19f};
+    TriangleInput in;
+    in.positions = sliver.data();
+    in.vertex_count = 3;
+    in.triangle_count = 1;
+    in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, -0x1.e9a31cp-112f, 0x1.da3008p-26f, 0, -0x1.84637ap-119f};
+    in.backface = Backface::none;
+    const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        OcclusionBuffer buffer(test::buffer_config(16, 16, 4, 1.99f));
+        buffer.render_frame(in);
+        EXPECT_EQ(buffer.stats().near_clipped, 1u) << isa;
+        EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << isa;
+    }
+    select_isa("best");
+}
+
 // Flags without apexes cannot be decided per view: render refuses them.
 TEST(Conservative, SharedEdgesWithoutApexesAreRefused) {
     const std::vector<float> soup = {-0.8f, 0, 1, 0.8f, 0, 1, 0, 0.8f, 1};

@@ -24,13 +24,16 @@ void clip_against(ClipPolygon& poly, const glm::dvec3& plane, double constant) {
         const double da = glm::dot(plane, a) + constant, db = glm::dot(plane, b) + constant;
         if (da >= 0.0) {
             out.v[out.count] = a;
+            out.source[out.count] = poly.source[i];
             out.shared[out.count++] = poly.shared[i];
             if (db < 0.0) {  // leaving: the next edge runs along the clip plane
                 out.v[out.count] = cut(a, da, b, db);
+                out.source[out.count] = ClipPolygon::kClipEdge;
                 out.shared[out.count++] = 0;
             }
         } else if (db >= 0.0) {  // entering: the rest of edge ab
             out.v[out.count] = cut(a, da, b, db);
+            out.source[out.count] = poly.source[i];
             out.shared[out.count++] = poly.shared[i];
         }
     }
@@ -44,6 +47,7 @@ ClipPolygon clip_triangle(const ClipVertex (&v)[3], std::uint8_t shared_bits, do
     for (int k = 0; k < 3; ++k) {
         poly.v[k] = v[k];
         poly.shared[k] = (shared_bits >> k) & 1u;
+        poly.source[k] = std::uint8_t(k);
     }
     poly.count = 3;
     clip_against(poly, {0, 0, 1}, -near_w);  // w - near_w >= 0

@@ -14,7 +14,9 @@ struct ClipPolygon {
     static constexpr int kMax = 3 + 5;  // a triangle gains at most one vertex per plane
     ClipVertex v[kMax];
     std::uint8_t shared[kMax];  // whether the edge from v[i] to v[i + 1] is shared
+    std::uint8_t source[kMax];  // the triangle's edge it lies on (0, 1, 2), or kClipEdge
     int count = 0;
+    static constexpr std::uint8_t kClipEdge = 3;
 };
 
 // Clips against w >= near_w and the guard band |x|, |y| <= guard * w. Returns the polygon

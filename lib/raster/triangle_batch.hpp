@@ -303,7 +303,11 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
                 continue;
             }
             const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
-            const SetupResult setup = setup_clip_triangle(clip, shared, in.backface, near_w, sample_width, sample_height, stats);
+            glm::dvec4 apexes[3] = {};  // of the flags kept (edges_across read them: each is valid)
+            for (int k = 0; k < 3; ++k)
+                if ((shared >> k) & 1u) vertex_clip(in, cache, in.edge_apexes[3 * batch.triangle[t] + std::size_t(k)], apexes[k]);
+            const SetupResult setup = setup_clip_triangle(clip, shared, in.backface, near_w, sample_width, sample_height, stats,
+                                                          /*occludee=*/false, SetupEdgeRule{apexes, edge_margin});
             for (int k = 0; k < setup.count; ++k) {
                 RasterTriangle tri;
                 if (setup_raster_triangle(setup.triangles[k], edge_margin, sample_width, sample_height, tri)) emit(tri);

@@ -1,6 +1,7 @@
 #include "raster/triangle_setup.hpp"
 
 #include "raster/clip_polygon.hpp"
+#include "raster/shared_edge_rule.hpp"
 
 #include <homcull/error.hpp>
 
@@ -76,7 +77,7 @@ TriangleFate unclipped_fate(const glm::dvec4 clip[3], Backface backface, double 
 }
 
 SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
-                                int sample_height, RasterStats& stats, bool occludee) {
+                                int sample_height, RasterStats& stats, bool occludee, SetupEdgeRule rule) {
     SetupResult result;
     // Entirely outside one plane of the view frustum (or behind the near plane)?
     if (occludee ? clip[0].w < near_w && clip[1].w < near_w && clip[2].w < near_w : outside_frustum(clip, near_w)) {
@@ -128,11 +129,32 @@ SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bi
         screen[k] = {(poly.v[k].x * inv_w + 1.0) * 0.5 * sample_width, (1.0 - poly.v[k].y * inv_w) * 0.5 * sample_height};
         depth[k] = inv_w;
     }
-    // Fan triangles (0, k, k + 1): their diagonals are shared with each other.
+    // Fan triangles (0, k, k + 1): their diagonals are shared with each other. A clipped
+    // polygon's fan keeps its margin-free edges only as margin_free_edges allows (an unclipped
+    // triangle's flags were decided so already, edges_across).
+    const auto vertex = [&](int i) { return glm::dvec4(poly.v[i].x, poly.v[i].y, 0.0, poly.v[i].z); };
     for (int k = 1; k + 1 < poly.count; ++k) {
         const bool first = k == 1, last = k + 2 == poly.count;
-        const std::uint8_t bits = std::uint8_t((first ? poly.shared[0] : 1u) | (poly.shared[k] << 1) |
-                                               ((last ? poly.shared[k + 1] : 1u) << 2));
+        std::uint8_t bits = std::uint8_t((first ? poly.shared[0] : 1u) | (poly.shared[k] << 1) |
+                                         ((last ? poly.shared[k + 1] : 1u) << 2));
+        if (needs_clip && bits != 0) {
+            const glm::dvec4 own[3] = {vertex(0), vertex(k), vertex(k + 1)};
+            // Across each edge: the next fan triangle's far vertex, or the triangle's neighbour's apex.
+            const int polygon_edge[3] = {first ? 0 : -1, k, last ? k + 1 : -1};
+            const int across_diagonal[3] = {k - 1, -1, k + 2};
+            glm::dvec4 apex[3];
+            std::uint8_t apex_valid = 0;
+            for (int e = 0; e < 3; ++e) {
+                if (polygon_edge[e] < 0) {
+                    apex[e] = vertex(across_diagonal[e]);
+                    apex_valid |= std::uint8_t(1u << e);
+                } else if (rule.apexes && poly.source[polygon_edge[e]] != ClipPolygon::kClipEdge) {
+                    apex[e] = rule.apexes[poly.source[polygon_edge[e]]];
+                    apex_valid |= std::uint8_t(1u << e);
+                }
+            }
+            bits = margin_free_edges(own, apex, apex_valid, bits, near_w, rule.edge_margin, sample_width, sample_height);
+        }
         result.triangles[result.count++] = {{screen[0], screen[k], screen[k + 1]}, {depth[0], depth[k], depth[k + 1]}, bits};
     }
     if (result.count > 0) ++stats.rasterized;

@@ -167,7 +167,17 @@ struct SetupResult {
 // coordinates miss (the caller pads its coverage by the rounding): it is not rejected beyond a
 // side plane (the caller rejects those beyond the rounding), and a polygon whose determinant is 0
 // in double is projected anyway, as zero-area triangles, rather than dropped as degenerate.
+//
+// A clipped polygon is drawn as a fan, whose diagonals are shared between its triangles. Each fan
+// triangle keeps a margin-free edge (a diagonal, or a part of a shared edge of the triangle, whose
+// neighbour's third vertex is apexes[k] for edge k) only as margin_free_edges allows: a clipped
+// sliver's fan triangles can be far thinner than the rounding of their diagonals. apexes may be
+// null when shared_bits is 0; edge_margin is the buffer's.
+struct SetupEdgeRule {
+    const glm::dvec4* apexes = nullptr;
+    double edge_margin = 0.0;
+};
 SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bits, Backface backface, double near_w, int sample_width,
-                                int sample_height, RasterStats& stats, bool occludee = false);
+                                int sample_height, RasterStats& stats, bool occludee = false, SetupEdgeRule rule = {});
 
 }  // namespace homcull::detail
