@@ -43,17 +43,16 @@ inline double homogeneous_det_magnitude(const V& a, const V& b, const V& c) {
            std::abs(a.w * b.x * c.y) + std::abs(a.w * b.y * c.x);
 }
 
-// Whether the neighbour across edge k of a triangle (own, in clip space, as given) certainly lies
-// on the other side of that edge in this view. The neighbour runs from own[k + 1] to own[k] to
-// `apex`: it lies across the edge when it has the triangle's orientation (its homogeneous
-// determinant the triangle's sign: both face the eye, or both face away), both signs certain.
-// Clipping keeps the answer: clipped polygons are positive combinations of the vertices.
-inline bool neighbour_across_edge(const glm::dvec4 own[3], int k, const glm::dvec4& apex) {
-    const double own_det = homogeneous_det(own[0], own[1], own[2]);
+// Whether the neighbour across edge k of a triangle (own, in clip space, as given, whose
+// homogeneous determinant own_det has a certain sign) certainly lies on the other side of that
+// edge in this view. The neighbour runs from own[k + 1] to own[k] to `apex`: it lies across the
+// edge when it has the triangle's orientation (its determinant the triangle's sign: both face the
+// eye, or both face away), its sign certain too. Clipping keeps the answer: clipped polygons are
+// positive combinations of the vertices.
+inline bool neighbour_across_edge(const glm::dvec4 own[3], double own_det, int k, const glm::dvec4& apex) {
     const glm::dvec4 &a = own[k], &b = own[(k + 1) % 3];
     const double det = homogeneous_det(b, a, apex);
-    return (own_det > 0.0) == (det > 0.0) && certain_sign(own_det, homogeneous_det_magnitude(own[0], own[1], own[2])) &&
-           certain_sign(det, homogeneous_det_magnitude(b, a, apex));
+    return (own_det > 0.0) == (det > 0.0) && certain_sign(det, homogeneous_det_magnitude(b, a, apex));
 }
 
 // The direction in which the projected segment from v towards p leaves v, in sample units (up
@@ -62,23 +61,29 @@ inline bool neighbour_across_edge(const glm::dvec4 own[3], int k, const glm::dve
 inline glm::dvec2 screen_direction(const glm::dvec4& v, const glm::dvec4& p, int sample_width, int sample_height) {
     return {(p.x * v.w - v.x * p.w) * sample_width, (p.y * v.w - v.y * p.w) * sample_height};
 }
-// The squared sine of the angle between two directions (NaN when one is zero).
-inline double sine_squared(const glm::dvec2& a, const glm::dvec2& b) {
-    const double cross = a.x * b.y - a.y * b.x;
-    return cross * cross / (glm::dot(a, a) * glm::dot(b, b));
-}
-
 // Of the triangle's shared-edge bits `flags` (bit k: the edge own[k] -> own[k + 1]), those that
 // may go without their margin in this view; apex[k] is the third vertex of the neighbour across
-// edge k (read where its bit is set; false in apex_valid: none). edge_margin as the buffer's.
+// edge k (read where its bit is set in apex_valid: none elsewhere). edge_margin as the buffer's.
 inline std::uint8_t margin_free_edges(const glm::dvec4 own[3], const glm::dvec4 apex[3], std::uint8_t apex_valid, std::uint8_t flags,
                                       double near_w, double edge_margin, int sample_width, int sample_height) {
+    flags &= apex_valid;
+    if (flags == 0) return 0;
+    const double own_det = homogeneous_det(own[0], own[1], own[2]);
+    if (!certain_sign(own_det, homogeneous_det_magnitude(own[0], own[1], own[2]))) return 0;
     std::uint8_t kept = 0;
     for (int k = 0; k < 3; ++k)
-        if (((flags & apex_valid) >> k) & 1u && neighbour_across_edge(own, k, apex[k])) kept |= std::uint8_t(1u << k);
+        if ((flags >> k) & 1u && neighbour_across_edge(own, own_det, k, apex[k])) kept |= std::uint8_t(1u << k);
     if (kept == 0) return 0;
     const double delta = 0x1.0p-36 * double(sample_width + sample_height);
     const double thin_end = 4.0 * delta / edge_margin;  // sines at an end whose other edge keeps its margin
+    // The edges' screen directions, each once: from its end k + 1 back to k it is the opposite
+    // (screen_direction(b, a) is exactly -screen_direction(a, b)).
+    glm::dvec2 edge[3];
+    double edge_length2[3];
+    for (int k = 0; k < 3; ++k) {
+        edge[k] = screen_direction(own[k], own[(k + 1) % 3], sample_width, sample_height);
+        edge_length2[k] = glm::dot(edge[k], edge[k]);
+    }
     // Each corner k (between edge k - 1, coming in, and edge k, going out), until nothing changes:
     // dropping an edge at one corner can leave the next corner with one margin-free edge.
     for (bool changed = true; changed;) {
@@ -89,23 +94,27 @@ inline std::uint8_t margin_free_edges(const glm::dvec4 own[3], const glm::dvec4 
             if (!keeps_out && !keeps_in) continue;
             const glm::dvec4& v = own[k];
             if (!(v.w >= near_w) || !(std::abs(v.x) <= kGuardBand * v.w) || !(std::abs(v.y) <= kGuardBand * v.w)) continue;  // clipped away
-            const glm::dvec2 to_next = screen_direction(v, own[(k + 1) % 3], sample_width, sample_height);
-            const glm::dvec2 to_prev = screen_direction(v, own[in], sample_width, sample_height);
-            double sine2 = sine_squared(to_next, to_prev);  // the triangle's angle at the corner
-            if (keeps_out) sine2 = std::min(sine2, sine_squared(to_next, screen_direction(v, apex[out], sample_width, sample_height)));
-            if (keeps_in) sine2 = std::min(sine2, sine_squared(to_prev, screen_direction(v, apex[in], sample_width, sample_height)));
-            bool keep;
-            if (keeps_out != keeps_in) {
-                keep = sine2 > thin_end * thin_end;
-            } else {
-                // No sample centre within 3 delta / sine of the corner: its distance from the
-                // nearest centre, on the farther axis, is beyond that.
+            // bound2: what every squared sine at the corner must exceed. One margin-free edge:
+            // (4 delta / m)^2. Two: the corner must be clear of sample centres by 3 delta / sine,
+            // so sine^2 > (3 delta / clearance)^2, with clearance the distance from the nearest
+            // centre on the farther axis.
+            double bound2 = thin_end * thin_end;
+            if (keeps_out && keeps_in) {
                 const double inv_w = 1.0 / v.w;
                 const double x = (v.x * inv_w + 1.0) * 0.5 * sample_width, y = (1.0 - v.y * inv_w) * 0.5 * sample_height;
-                const double dx = x - (std::floor(x) + 0.5), dy = y - (std::floor(y) + 0.5);
-                const double clearance = std::max(std::abs(dx), std::abs(dy));
-                keep = clearance * clearance * sine2 > 9.0 * delta * delta;
+                const double clearance = std::max(std::abs(x - (std::floor(x) + 0.5)), std::abs(y - (std::floor(y) + 0.5)));
+                bound2 = 9.0 * delta * delta / (clearance * clearance);  // inf (or NaN) when on a centre: dropped
             }
+            // Squared sines as cross^2 against bound2 |a|^2 |b|^2 (no division): the triangle's
+            // angle between edge k and edge k - 1, and each neighbour's between its edge and the
+            // direction to its apex.
+            const auto above = [&](const glm::dvec2& a, double a_length2, const glm::dvec2& b) {
+                const double cross = a.x * b.y - a.y * b.x;
+                return cross * cross > bound2 * (a_length2 * glm::dot(b, b));
+            };
+            bool keep = above(edge[out], edge_length2[out], edge[in]);
+            if (keep && keeps_out) keep = above(edge[out], edge_length2[out], screen_direction(v, apex[out], sample_width, sample_height));
+            if (keep && keeps_in) keep = above(edge[in], edge_length2[in], screen_direction(v, apex[in], sample_width, sample_height));
             if (!keep) {
                 kept &= std::uint8_t(~((1u << out) | (1u << in)));
                 changed = true;

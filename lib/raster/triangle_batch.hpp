@@ -267,20 +267,6 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
             first += std::size_t(batch.count);
         }
         kernels.classify(in.backface, near_w, batch, stats);
-        // Each lane's shared-edge bits, read once and kept only where they may go without their
-        // margin in this view (edges_across). The float row rule needs three silhouette
-        // edges: the setup skips it for groups of lanes that all have a shared edge (most of
-        // a closed mesh's).
-        std::uint8_t lane_shared[TriangleBatch::kSize] = {};
-        std::uint32_t silhouette_only = batch.needs_setup;
-        if (in.shared_edges)
-            for (std::uint32_t bits = batch.needs_setup; bits != 0; bits &= bits - 1) {
-                const int t = __builtin_ctz(bits);
-                const std::uint8_t flags = in.shared_edges[batch.triangle[t]];
-                if (flags == 0) continue;
-                lane_shared[t] = edges_across(in, cache, batch, t, flags, near_w, edge_margin, sample_width, sample_height);
-                if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
-            }
         std::uint32_t emitted = batch.simple;  // the simple lanes that go on to assembly
         if (batch.simple) {
             kernels.setup_planes(batch, sample_width, sample_height, simple);
@@ -289,12 +275,28 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
                     const int t = __builtin_ctz(bits);
                     if (hidden_in_target(simple, t, *drawn_into, hidden_test)) emitted &= ~(1u << t);
                 }
-            if (emitted) kernels.setup_edges(batch.count, edge_margin, silhouette_only & emitted, emitted, simple);
         }
+        // The shared-edge bits of each lane that is drawn, read once and kept only where they may
+        // go without their margin in this view (edges_across; not for lanes already found hidden,
+        // about two in three of the castle's). The float row rule needs three silhouette edges:
+        // the setup skips it for groups of lanes that all have a shared edge (most of a closed
+        // mesh's).
+        const std::uint32_t drawn = emitted | (batch.needs_setup & ~batch.simple);
+        std::uint8_t lane_shared[TriangleBatch::kSize] = {};
+        std::uint32_t silhouette_only = drawn;
+        if (in.shared_edges)
+            for (std::uint32_t bits = drawn; bits != 0; bits &= bits - 1) {
+                const int t = __builtin_ctz(bits);
+                const std::uint8_t flags = in.shared_edges[batch.triangle[t]];
+                if (flags == 0) continue;
+                lane_shared[t] = edges_across(in, cache, batch, t, flags, near_w, edge_margin, sample_width, sample_height);
+                if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
+            }
+        if (emitted) kernels.setup_edges(batch.count, edge_margin, silhouette_only & emitted, emitted, simple);
         // Every simple lane counts as rasterized (what setup_clip_triangle counts for it); the
         // loop visits those emitted and the lanes left to the one-triangle setup, in order.
         stats.rasterized += std::uint64_t(__builtin_popcount(batch.simple));
-        for (std::uint32_t bits = emitted | (batch.needs_setup & ~batch.simple); bits != 0; bits &= bits - 1) {
+        for (std::uint32_t bits = drawn; bits != 0; bits &= bits - 1) {
             const int t = __builtin_ctz(bits);
             const std::uint8_t shared = lane_shared[t];
             if ((batch.simple >> t) & 1u) {
