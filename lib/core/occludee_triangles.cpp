@@ -68,10 +68,7 @@ bool beyond_side_plane_exactly(const glm::dvec4 model[3], const glm::dvec4 clip[
     double p = 0.0;
     for (int k = 0; k < 3; ++k)
         for (int i = 0; i < 4; ++i) p = std::max(p, std::abs(model[k][i]));
-    const double ex = (row_x + row_w) * p, ey = (row_y + row_w) * p;
-    auto all = [&](auto beyond) { return beyond(clip[0]) && beyond(clip[1]) && beyond(clip[2]); };
-    return all([&](const glm::dvec4& c) { return c.x - c.w > ex; }) || all([&](const glm::dvec4& c) { return -c.x - c.w > ex; }) ||
-           all([&](const glm::dvec4& c) { return c.y - c.w > ey; }) || all([&](const glm::dvec4& c) { return -c.y - c.w > ey; });
+    return detail::outside_side_plane(clip, (row_x + row_w) * p, (row_y + row_w) * p);
 }
 
 // The same in samples for a projected triangle (corners with d = 1/w), per vertex: NDC x =

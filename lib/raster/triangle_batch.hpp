@@ -209,13 +209,13 @@ inline bool vertex_clip(const TriangleInput& in, const VertexClip* cache, std::u
 }
 
 // Of lane t's shared-edge bits `flags` (input order), those that may go without their margin in
-// this view (margin_free_edges, from the apexes of TriangleInput::edge_apexes). The same scalar
-// code on every instruction set, from the same clip coordinates: the same bits.
+// this view (margin_free_edges, from the apexes of TriangleInput::edge_apexes, read into apex:
+// the clipped setup needs them again). The same scalar code on every instruction set, from the
+// same clip coordinates: the same bits.
 inline std::uint8_t edges_across(const TriangleInput& in, const VertexClip* cache, const TriangleBatch& batch, int t, std::uint8_t flags,
-                                 double near_w, double edge_margin, int sample_width, int sample_height) {
+                                 double near_w, double edge_margin, int sample_width, int sample_height, glm::dvec4 (&apex)[3]) {
     const glm::dvec4 own[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
     const std::uint32_t* apexes = in.edge_apexes + 3 * batch.triangle[t];
-    glm::dvec4 apex[3];
     std::uint8_t apex_valid = 0;
     for (int k = 0; k < 3; ++k)
         if (((flags >> k) & 1u) && vertex_clip(in, cache, apexes[k], apex[k])) apex_valid |= std::uint8_t(1u << k);
@@ -283,13 +283,14 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
         // mesh's).
         const std::uint32_t drawn = emitted | (batch.needs_setup & ~batch.simple);
         std::uint8_t lane_shared[TriangleBatch::kSize] = {};
+        glm::dvec4 lane_apexes[TriangleBatch::kSize][3];  // read where a lane keeps a flag
         std::uint32_t silhouette_only = drawn;
         if (in.shared_edges)
             for (std::uint32_t bits = drawn; bits != 0; bits &= bits - 1) {
                 const int t = __builtin_ctz(bits);
                 const std::uint8_t flags = in.shared_edges[batch.triangle[t]];
                 if (flags == 0) continue;
-                lane_shared[t] = edges_across(in, cache, batch, t, flags, near_w, edge_margin, sample_width, sample_height);
+                lane_shared[t] = edges_across(in, cache, batch, t, flags, near_w, edge_margin, sample_width, sample_height, lane_apexes[t]);
                 if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
             }
         if (emitted) kernels.setup_edges(batch.count, edge_margin, silhouette_only & emitted, emitted, simple);
@@ -305,11 +306,8 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
                 continue;
             }
             const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
-            glm::dvec4 apexes[3] = {};  // of the flags kept (edges_across read them: each is valid)
-            for (int k = 0; k < 3; ++k)
-                if ((shared >> k) & 1u) vertex_clip(in, cache, in.edge_apexes[3 * batch.triangle[t] + std::size_t(k)], apexes[k]);
             const SetupResult setup = setup_clip_triangle(clip, shared, in.backface, near_w, sample_width, sample_height, stats,
-                                                          /*occludee=*/false, SetupEdgeRule{apexes, edge_margin});
+                                                          /*occludee=*/false, SetupEdgeRule{lane_apexes[t], edge_margin});
             for (int k = 0; k < setup.count; ++k) {
                 RasterTriangle tri;
                 if (setup_raster_triangle(setup.triangles[k], edge_margin, sample_width, sample_height, tri)) emit(tri);

@@ -46,6 +46,12 @@ bool outside_side_plane(const glm::dvec4 clip[3]) {
            all([](const glm::dvec4& c) { return c.y > c.w; }) || all([](const glm::dvec4& c) { return c.y < -c.w; });
 }
 
+bool outside_side_plane(const glm::dvec4 clip[3], double margin_x, double margin_y) {
+    auto all = [&](auto beyond) { return beyond(clip[0]) && beyond(clip[1]) && beyond(clip[2]); };
+    return all([&](const glm::dvec4& c) { return c.x - c.w > margin_x; }) || all([&](const glm::dvec4& c) { return -c.x - c.w > margin_x; }) ||
+           all([&](const glm::dvec4& c) { return c.y - c.w > margin_y; }) || all([&](const glm::dvec4& c) { return -c.y - c.w > margin_y; });
+}
+
 bool outside_frustum(const glm::dvec4 clip[3], double near_w) {
     return (clip[0].w < near_w && clip[1].w < near_w && clip[2].w < near_w) || outside_side_plane(clip);
 }
@@ -148,7 +154,7 @@ SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bi
                 if (polygon_edge[e] < 0) {
                     apex[e] = vertex(across_diagonal[e]);
                     apex_valid |= std::uint8_t(1u << e);
-                } else if (rule.apexes && poly.source[polygon_edge[e]] != ClipPolygon::kClipEdge) {
+                } else if (rule.apexes && poly.shared[polygon_edge[e]] && poly.source[polygon_edge[e]] != ClipPolygon::kClipEdge) {
                     apex[e] = rule.apexes[poly.source[polygon_edge[e]]];
                     apex_valid |= std::uint8_t(1u << e);
                 }

@@ -113,6 +113,9 @@ bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 mode
 // Whether all three vertices lie outside one side plane of the view frustum (|x| or |y| > w):
 // then so does the whole triangle.
 bool outside_side_plane(const glm::dvec4 clip[3]);
+// The same with every vertex beyond the plane by more than a margin (in clip units: x - w >
+// margin_x, ...): for coordinates known only to within a rounding bound.
+bool outside_side_plane(const glm::dvec4 clip[3], double margin_x, double margin_y);
 
 // Whether the triangle lies entirely behind the near plane or outside one side plane.
 bool outside_frustum(const glm::dvec4 clip[3], double near_w);
@@ -170,9 +173,10 @@ struct SetupResult {
 //
 // A clipped polygon is drawn as a fan, whose diagonals are shared between its triangles. Each fan
 // triangle keeps a margin-free edge (a diagonal, or a part of a shared edge of the triangle, whose
-// neighbour's third vertex is apexes[k] for edge k) only as margin_free_edges allows: a clipped
-// sliver's fan triangles can be far thinner than the rounding of their diagonals. apexes may be
-// null when shared_bits is 0; edge_margin is the buffer's.
+// neighbour's third vertex is apexes[k] for edge k, read only where shared_bits has bit k) only
+// as margin_free_edges allows: a clipped sliver's fan triangles can be far thinner than the
+// rounding of their diagonals. apexes may be null when shared_bits is 0; edge_margin is the
+// buffer's.
 struct SetupEdgeRule {
     const glm::dvec4* apexes = nullptr;
     double edge_margin = 0.0;
