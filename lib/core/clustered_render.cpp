@@ -148,6 +148,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
         }
     }
     if (clear_first) stats_ = RasterStats{};  // after every check and allocation: a render that throws changes nothing
+    reference_cells_current_ = false;  // the noted renders' cells no longer hold d0
     const auto cache_of = [&](std::size_t band) {
         double* clip = band_vertex_clip_.data() + band * 4 * plane;
         return detail::VertexClip{clip, clip + plane, clip + 2 * plane, clip + 3 * plane, band_vertex_outcode_.data() + band * plane};
@@ -236,6 +237,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
         const detail::VertexClip cache = cache_of(0);
         std::vector<std::pair<int, int>>& runs = cluster_row_runs_;  // subtile rows [first, second)
         RasterStats serial;
+        detail::ChangedSubtiles changed;
         for (const PlacedCluster& p : placed_clusters_) {
             runs.clear();
             std::uint64_t drawn = 0;
@@ -256,13 +258,15 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
                 detail::RasterTarget target = whole;
                 for (const auto& [row_begin, row_end] : runs) {
                     target.row_begin = row_begin, target.row_end = row_end;
-                    serial.subtiles_updated += target.kernel(target, tri);
+                    const std::uint64_t n = target.kernel(target, tri);
+                    serial.subtiles_updated += n;
+                    if (n != 0) changed.add(tri, subtiles_x_, subtiles_y_);
                 }
             });
             for (std::uint64_t k = 0; k < drawn; ++k) serial += stats;
         }
         band_stats_[0] += serial;
-        build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+        build_changed_pyramid(clear_first, changed);
     }
 
     stats_ += frame;

@@ -56,6 +56,7 @@ struct OcclusionBuffer::Chunk {
 struct OcclusionBuffer::NotedPart {
     std::vector<std::uint32_t> undecided;
     RasterStats stats;
+    detail::ChangedSubtiles changed;  // the subtiles its render changed
     int row_begin = 0, row_end = 0;  // its subtile rows in the render under way
     bool drawn = false;              // its task ran (render_parts)
 };
@@ -111,6 +112,7 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
 }
 
 void OcclusionBuffer::clear() {
+    reference_cells_current_ = false;
     clear_rows(0, subtiles_y_);
     std::fill(pyramid_.begin(), pyramid_.end(), 0.0f);
     stats_ = RasterStats{};
@@ -141,11 +143,23 @@ void OcclusionBuffer::reduce_pyramid_above_bands() {
     for (int level = kBandPyramidLevels + 1; level < int(levels_.size()); ++level) reduce_pyramid_rows(level, 0, levels_[std::size_t(level)].height);
 }
 
+void OcclusionBuffer::build_pyramid_rect(int x0, int x1, int y0, int y1) {
+    if (x0 >= x1 || y0 >= y1) return;
+    for (int ty = y0; ty < y1; ++ty)
+        std::copy_n(d0_.begin() + std::ptrdiff_t(at(x0, ty)), x1 - x0, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_ + x0);
+    for (int level = 1; level < int(levels_.size()); ++level)
+        reduce_pyramid_cells(level, x0 >> level, ((x1 - 1) >> level) + 1, y0 >> level, ((y1 - 1) >> level) + 1);
+}
+
 void OcclusionBuffer::reduce_pyramid_rows(int level, int y_begin, int y_end) {
+    reduce_pyramid_cells(level, 0, levels_[std::size_t(level)].width, y_begin, y_end);
+}
+
+void OcclusionBuffer::reduce_pyramid_cells(int level, int x_begin, int x_end, int y_begin, int y_end) {
     const detail::PyramidLevel& below = levels_[std::size_t(level) - 1];
     const detail::PyramidLevel& here = levels_[std::size_t(level)];
     for (int y = y_begin; y < y_end; ++y)
-        for (int x = 0; x < here.width; ++x) {
+        for (int x = x_begin; x < x_end; ++x) {
             float m = min_d0(level - 1, 2 * x, 2 * y);
             if (2 * x + 1 < below.width) m = std::min(m, min_d0(level - 1, 2 * x + 1, 2 * y));
             if (2 * y + 1 < below.height) {
@@ -169,6 +183,11 @@ detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, 
     const std::size_t width = std::size_t(reference_cells_width_);
     const std::size_t own_begin = std::size_t(row_begin >> detail::kReferenceCellShift) * width;
     const std::size_t own_end = std::min(size, std::size_t(((row_end - 1) >> detail::kReferenceCellShift) + 1) * width);
+    // One part over every row, and the cells still those the last noted render on one thread
+    // left (nothing else drew since): they are this buffer's, as a refresh would compute them.
+    const bool current = reference_cells_current_ && !clear_first && part == 0 && row_begin == 0 && row_end == subtiles_y_;
+    reference_cells_current_ = false;
+    if (current) return cells;
     std::fill(first, first + own_begin, std::numeric_limits<float>::infinity());
     std::fill(first + own_end, first + size, std::numeric_limits<float>::infinity());
     if (clear_first) {
@@ -281,19 +300,33 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
         if (noted_parts_.empty()) noted_parts_.resize(1);
         if (noted_parts_[0].undecided.size() < kCellRefreshTriangles) noted_parts_[0].undecided.resize(kCellRefreshTriangles);
         draw_noted_part(in, list, clear_first, 0, 0, subtiles_y_);
+        // Every slice refreshed the cells of the rows it changed: they hold the buffer's d0 now,
+        // and the next noted render on one thread starts from them.
+        reference_cells_current_ = true;
         stats_ += noted_parts_[0].stats;
-        build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+        build_changed_pyramid(clear_first, noted_parts_[0].changed);
         return;
     }
+    reference_cells_current_ = false;
     if (clear_first) clear_rows(0, subtiles_y_);
     const detail::RasterTarget target = raster_target(0, subtiles_y_);
     std::uint64_t updated = 0;
     RasterStats stats;
+    detail::ChangedSubtiles changed;
     detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
-                                 stats, [&](const detail::RasterTriangle& tri) { updated += target.kernel(target, tri); }, list);
+                                 stats, [&](const detail::RasterTriangle& tri) {
+                                     const std::uint64_t n = target.kernel(target, tri);
+                                     updated += n;
+                                     if (n != 0) changed.add(tri, subtiles_x_, subtiles_y_);
+                                 }, list);
     stats.subtiles_updated = updated;
     stats_ += stats;
-    build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+    build_changed_pyramid(clear_first, changed);
+}
+
+void OcclusionBuffer::build_changed_pyramid(bool cleared, const detail::ChangedSubtiles& changed) {
+    if (cleared) build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
+    else build_pyramid_rect(changed.x0, changed.x1, changed.y0, changed.y1);
 }
 
 // The list is taken in slices of kCellRefreshTriangles: a noted triangle hidden behind the
@@ -307,6 +340,7 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
                                       int row_end) {
     NotedPart& scratch = noted_parts_[part];
     scratch.drawn = true;
+    scratch.changed = {};
     if (clear_first) clear_rows(row_begin, row_end);
     const detail::RasterTarget target = raster_target(row_begin, row_end);
     const detail::ReferenceCells cells = start_reference_cells(clear_first, part, row_begin, row_end);
@@ -322,6 +356,7 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
         const int first_row = std::max(row_begin, tri.j0 / kH);
         ++load[(first_row >> detail::kReferenceCellShift) - first_cell_row];
         if (n != 0) {
+            scratch.changed.add(tri, subtiles_x_, subtiles_y_);
             changed_begin = std::min(changed_begin, first_row);
             changed_end = std::max(changed_end, std::min(row_end, tri.j1 / kH + 1));
         }
@@ -346,6 +381,7 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
 // S1 at 1080p, two threads: 4.30 -> 3.02 ms against render_binned's waves (see
 // docs/occlusion-buffer.md, "Threads").
 void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list) {
+    reference_cells_current_ = false;  // each part's copy has the other parts' rows infinite
     const int cell_rows = detail::reference_cells_height(subtiles_y_);
     const std::size_t parts = std::min(parallel.threads ? parallel.threads : 2, std::size_t(cell_rows));  // cell_rows >= 1
     const std::size_t cells_size = std::size_t(detail::kCellTables) * std::size_t(reference_cells_width_) * std::size_t(cell_rows);
@@ -418,6 +454,7 @@ void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& p
 // free; only the speed depends on them. (A clip-space soup with cell records goes to
 // render_parts instead.)
 void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
+    reference_cells_current_ = false;
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_updated_.size();
     if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);

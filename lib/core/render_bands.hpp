@@ -5,6 +5,7 @@
 
 #include "raster/rasterize.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <vector>
@@ -23,6 +24,27 @@ constexpr int kBandSubtileRows = 32;
 // (castle C0, two threads: 0.15 ms of 1.0).
 constexpr int kBandPyramidLevels = 5;
 static_assert((1 << kBandPyramidLevels) == kBandSubtileRows, "a band's rows hold whole cells of its levels");
+
+// The subtiles [x0, x1) x [y0, y1) that a render on one thread changed: only their pyramid cells
+// are rebuilt after it, so that a render call costs what it draws, not the buffer's size (an
+// engine draws its occluders object by object, one call each).
+struct ChangedSubtiles {
+    int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+    // Adds a triangle's samples [i0, i1] x [j0, j1] (already within the buffer).
+    void add(const RasterTriangle& tri, int subtiles_x, int subtiles_y) {
+        const int tx0 = std::max(0, tri.i0 / OcclusionBuffer::kSubtileWidth);
+        const int tx1 = std::min(subtiles_x, tri.i1 / OcclusionBuffer::kSubtileWidth + 1);
+        const int ty0 = std::max(0, tri.j0 / OcclusionBuffer::kSubtileHeight);
+        const int ty1 = std::min(subtiles_y, tri.j1 / OcclusionBuffer::kSubtileHeight + 1);
+        if (tx0 >= tx1 || ty0 >= ty1) return;
+        if (empty()) {
+            x0 = tx0, x1 = tx1, y0 = ty0, y1 = ty1;
+            return;
+        }
+        x0 = std::min(x0, tx0), x1 = std::max(x1, tx1), y0 = std::min(y0, ty0), y1 = std::max(y1, ty1);
+    }
+};
 
 }  // namespace detail
 

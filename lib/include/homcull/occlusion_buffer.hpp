@@ -48,6 +48,7 @@ struct RasterTriangle;
 struct DrawOrderScratch;
 struct ReferenceCells;
 struct CellRecord;
+struct ChangedSubtiles;
 }  // namespace detail
 
 enum class Backface : std::uint8_t {
@@ -372,6 +373,14 @@ private:
     void build_pyramid_rows(int row_begin, int row_end, int last_level);
     // Rows [y_begin, y_end) of pyramid level `level` >= 1 from the level below.
     void reduce_pyramid_rows(int level, int y_begin, int y_end);
+    // Every level's cells over the subtiles [x0, x1) x [y0, y1): after a render on one thread,
+    // the subtiles it changed (nothing when the rectangle is empty).
+    void build_pyramid_rect(int x0, int x1, int y0, int y1);
+    // After a render on one thread: the whole pyramid when it cleared the buffer first, else the
+    // cells over the subtiles it changed.
+    void build_changed_pyramid(bool cleared, const detail::ChangedSubtiles& changed);
+    // Cells [x_begin, x_end) x [y_begin, y_end) of pyramid level `level` >= 1 from the level below.
+    void reduce_pyramid_cells(int level, int x_begin, int x_end, int y_begin, int y_end);
     // Zeroes the subtiles (and per-sample depths) of subtile rows [row_begin, row_end).
     void clear_rows(int row_begin, int row_end);
     float min_d0(int level, int x, int y) const {
@@ -420,6 +429,10 @@ private:
     // Per cell row: the triangles the last noted render drew there (each at its first row in its
     // part), which places the next render's part bounds.
     std::vector<std::uint32_t> cell_row_load_;
+    // The cells of part 0 hold the buffer's d0 over every row: the last render was a noted one on
+    // one thread and nothing changed the buffer since. The next such render then starts from them
+    // instead of recomputing them all (a render call costs what it draws).
+    bool reference_cells_current_ = false;
     // At the start of a render with cell records (which render_rows asks the sort for only when
     // hidden triangles are skipped and the instruction set has a refresh kernel): part `part`'s
     // cells, those of subtile rows [row_begin, row_end) zeroed when the render clears the buffer

@@ -1,0 +1,130 @@
+// Many render calls into one buffer, as an engine draws its occluders object by object: each
+// call rebuilds only the pyramid cells over the subtiles it changed and starts a noted soup from
+// the reference cells the last call left. Both must leave what a full rebuild would.
+#include "support.hpp"
+
+#include <homcull/occluder_clusters.hpp>
+#include <homcull/occlusion_buffer.hpp>
+
+#include "raster/rasterize.hpp"  // set_hidden_skip
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace homcull {
+namespace {
+
+// The pyramid as read_pyramid documents it, computed from the subtiles' d0.
+std::vector<float> pyramid_by_definition(const OcclusionBuffer& b) {
+    int w = b.subtiles_x(), h = b.subtiles_y();
+    std::vector<float> cells;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) cells.push_back(b.subtile(x, y).d0);
+    std::size_t below = 0;
+    while (w > 1 || h > 1) {
+        const int nw = (w + 1) / 2, nh = (h + 1) / 2;
+        const std::size_t here = cells.size();
+        for (int y = 0; y < nh; ++y)
+            for (int x = 0; x < nw; ++x) {
+                float m = cells[below + std::size_t(2 * y) * std::size_t(w) + std::size_t(2 * x)];
+                for (int dy = 0; dy < 2; ++dy)
+                    for (int dx = 0; dx < 2; ++dx)
+                        if (2 * x + dx < w && 2 * y + dy < h)
+                            m = std::min(m, cells[below + std::size_t(2 * y + dy) * std::size_t(w) + std::size_t(2 * x + dx)]);
+                cells.push_back(m);
+            }
+        below = here, w = nw, h = nh;
+    }
+    return cells;
+}
+
+void expect_pyramid_and_answers_exact(const OcclusionBuffer& b, const std::string& where) {
+    std::vector<float> pyramid;
+    b.read_pyramid(pyramid);
+    EXPECT_TRUE(pyramid == pyramid_by_definition(b)) << where;
+    std::size_t differing = 0;
+    for (const ScreenRect& r : test::random_screen_rects(7, 400))
+        differing += b.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min) !=
+                     b.test_rect_exhaustive(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
+    EXPECT_EQ(differing, 0u) << where;
+}
+
+// A clip-space soup (the noted path, whose calls reuse the reference cells) drawn in calls of a
+// few triangles: the same buffer as with the hidden-triangle skip off (which reads no cells),
+// and a pyramid that matches it after every call.
+TEST(RenderCalls, SoupDrawnInManySmallCallsKeepsCellsAndPyramidExact) {
+    const std::vector<float> xyzw = test::random_clip_triangles(3, 3000, 0.3f);
+    for (const std::string& isa : available_isas()) {
+        select_isa(isa);
+        OcclusionBuffer skipping(test::buffer_config(203, 117, 2, 1.0f)), oracle(test::buffer_config(203, 117, 2, 1.0f));
+        std::mt19937_64 rng(11);
+        std::size_t calls = 0;
+        for (std::size_t first = 0; first < xyzw.size() / 12; ++calls) {
+            const std::size_t count = std::min<std::size_t>(1 + rng() % 40, xyzw.size() / 12 - first);
+            std::vector<float> part(xyzw.begin() + std::ptrdiff_t(12 * first), xyzw.begin() + std::ptrdiff_t(12 * (first + count)));
+            const TriangleInput in = test::clip_space_input(part);
+            skipping.render(in);
+            detail::set_hidden_skip(false);
+            oracle.render(in);
+            detail::set_hidden_skip(true);
+            first += count;
+            if (calls % 16 == 0) expect_pyramid_and_answers_exact(skipping, isa + " after call " + std::to_string(calls));
+        }
+        EXPECT_TRUE(test::same_subtiles(skipping, oracle)) << isa;
+        expect_pyramid_and_answers_exact(skipping, isa + " at the end");
+        // A near wall over the whole view, a clear, then more calls: the cells start again from
+        // the cleared buffer, not from the wall (which would hide every triangle).
+        const std::vector<float> wall = {-2, -2, 0, 1.5f, 2, -2, 0, 1.5f, 2, 2, 0, 1.5f, -2, -2, 0, 1.5f, 2, 2, 0, 1.5f, -2, 2, 0, 1.5f};
+        skipping.render(test::clip_space_input(wall));
+        skipping.clear();
+        oracle.clear();
+        const std::vector<float> more = test::random_clip_triangles(4, 200, 0.5f);
+        skipping.render(test::clip_space_input(more));
+        detail::set_hidden_skip(false);
+        oracle.render(test::clip_space_input(more));
+        detail::set_hidden_skip(true);
+        EXPECT_TRUE(test::same_subtiles(skipping, oracle)) << isa;
+        expect_pyramid_and_answers_exact(skipping, isa + " after a clear");
+    }
+    select_isa("best");
+}
+
+// Meshes drawn as clusters, instance by instance, between soups: the pyramid follows every call.
+TEST(RenderCalls, ClustersAndIndexedCallsKeepThePyramidExact) {
+    // A grid of quads in the plane z = 0, drawn at several places and depths.
+    std::vector<float> positions;
+    std::vector<std::uint32_t> indices;
+    const int n = 6;
+    for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x) positions.insert(positions.end(), {float(x) / n - 0.5f, float(y) / n - 0.5f, 0.0f});
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const std::uint32_t a = std::uint32_t(y * (n + 1) + x), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
+            indices.insert(indices.end(), {a, b, d, a, d, c});
+        }
+    const std::size_t triangles = indices.size() / 3;
+    std::vector<std::uint8_t> shared(triangles);
+    std::vector<std::uint32_t> apexes(3 * triangles);
+    compute_shared_edges(positions.data(), 12, positions.size() / 3, indices.data(), triangles, shared.data(), apexes.data());
+    const OccluderClusters clusters =
+        build_occluder_clusters(positions.data(), 12, positions.size() / 3, indices.data(), triangles, shared.data(), apexes.data(), {16, 8});
+    OcclusionBuffer buffer(test::buffer_config(160, 90, 1, 0.5f));
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<float> place(-1.5f, 1.5f), depth(1.0f, 30.0f), size(0.05f, 0.8f);
+    for (int call = 0; call < 120; ++call) {
+        // Scale s, at NDC (x, y) and depth w: clip = (s w px + x w, s w py + y w, 0, w).
+        const float s = size(rng), x = place(rng), y = place(rng), w = depth(rng);
+        ClusteredInput in;
+        in.clusters = &clusters;
+        in.model_to_clip = {s * w, 0, 0, 0, 0, s * w, 0, 0, 0, 0, 0, 0, x * w, y * w, 0, w};
+        in.backface = Backface::none;
+        buffer.render(in);
+        if (call % 10 == 0) expect_pyramid_and_answers_exact(buffer, "after clustered call " + std::to_string(call));
+    }
+    expect_pyramid_and_answers_exact(buffer, "at the end");
+}
+
+}  // namespace
+}  // namespace homcull
