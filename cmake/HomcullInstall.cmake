@@ -1,11 +1,11 @@
 # Install rules and a versioned package config, so that consumers can write
-#   find_package(homcull 0.1 REQUIRED COMPONENTS truth io)
+#   find_package(homcull 0.2 REQUIRED COMPONENTS truth io)
 #   target_link_libraries(app PRIVATE homcull::core homcull::truth)
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(HOMCULL_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/homcull")
-install(TARGETS homcull_core homcull_tbb homcull_truth homcull_io EXPORT homcullTargets
+install(TARGETS homcull_core homcull_shared homcull_tbb homcull_truth homcull_io EXPORT homcullTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}

@@ -5,6 +5,7 @@
 #include "support.hpp"
 
 #include <homcull/generate.hpp>
+#include <homcull/homcull.h>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/world_triangles.hpp>
@@ -124,6 +125,82 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
             EXPECT_EQ(allocations_of(queries), 0u) << what;
             EXPECT_GT(buffer.stats().rasterized, 0u) << what;  // the frames drew something
         }
+}
+
+// The C interface takes every byte from the engine's allocator: with a context holding one,
+// making meshes and buffers, frames, draws (registered meshes and triangles), queries, a
+// resolution change and destroying it all never call the global operator new; and what the
+// engine gave is all given back.
+TEST(FrameAllocations, CInterfaceTakesEveryByteFromTheEngine) {
+    const test::CityStreet street;
+    const WorldTriangles& occluders = street.occluders;
+    struct Engine {
+        std::size_t calls = 0, live = 0;
+    } engine;
+    homcull_context_desc desc{};
+    desc.allocator.allocate = [](void* user, std::size_t size, std::size_t alignment) -> void* {
+        auto& e = *static_cast<Engine*>(user);
+        ++e.calls, ++e.live;
+        return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+    };
+    desc.allocator.deallocate = [](void* user, void* p) {
+        --static_cast<Engine*>(user)->live;
+        std::free(p);
+    };
+    desc.allocator.user = &engine;
+    const glm::dmat4 clip = projection_matrix(street.camera, 320.0 / 180.0) * view_matrix(street.camera);
+    homcull_view view{};
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) view.world_to_clip[4 * c + r] = clip[c][r];
+    view.layout = HOMCULL_COLUMN_MAJOR;
+    view.cull = HOMCULL_CULL_NONE;
+    std::vector<homcull_box> boxes;
+    for (const Object& o : street.city.objects)
+        boxes.push_back({{o.world_bounds.min.x, o.world_bounds.min.y, o.world_bounds.min.z}, {o.world_bounds.max.x, o.world_bounds.max.y, o.world_bounds.max.z}});
+    std::vector<homcull_visibility> answers(boxes.size());
+    std::size_t occluded = 0;
+    const std::size_t global = allocations_of([&] {
+        homcull_context* context = nullptr;
+        ASSERT_EQ(homcull_context_create(&desc, &context), HOMCULL_OK);
+        homcull_mesh_desc md{};
+        md.positions = occluders.positions.data();
+        md.position_stride = 3 * sizeof(float);
+        md.vertex_count = occluders.positions.size() / 3;
+        md.indices = occluders.indices.data();
+        md.index_size = 4;
+        md.triangle_count = occluders.triangle_count();
+        homcull_mesh* mesh = nullptr;
+        ASSERT_EQ(homcull_mesh_create(context, &md, &mesh), HOMCULL_OK);
+        homcull_buffer* buffer = nullptr;
+        const homcull_buffer_desc bd{320, 180, 2, float(street.camera.near_plane), HOMCULL_BUFFER_SAMPLE_DEPTH, 0};
+        ASSERT_EQ(homcull_buffer_create(context, &bd, &buffer), HOMCULL_OK);
+        homcull_triangles triangles{};
+        triangles.positions = md.positions;
+        triangles.position_stride = md.position_stride;
+        triangles.vertex_count = md.vertex_count;
+        triangles.indices = md.indices;
+        triangles.index_size = 4;
+        triangles.triangle_count = md.triangle_count;
+        for (int frame = 0; frame < 3; ++frame) {
+            if (frame == 2) {
+                ASSERT_EQ(homcull_buffer_set_resolution(buffer, 640, 360), HOMCULL_OK);
+            }
+            ASSERT_EQ(homcull_buffer_begin_frame(buffer, &view), HOMCULL_OK);
+            ASSERT_EQ(homcull_buffer_draw_mesh(buffer, mesh, nullptr, 1), HOMCULL_OK);
+            ASSERT_EQ(homcull_buffer_draw_triangles(buffer, &triangles, nullptr), HOMCULL_OK);
+            ASSERT_EQ(homcull_buffer_test_boxes(buffer, boxes.data(), boxes.size(), nullptr, answers.data()), HOMCULL_OK);
+            homcull_visibility v;
+            ASSERT_EQ(homcull_buffer_test_triangles(buffer, &triangles, nullptr, &v), HOMCULL_OK);
+        }
+        for (homcull_visibility a : answers) occluded += a == HOMCULL_OCCLUDED;
+        homcull_buffer_destroy(buffer);
+        homcull_mesh_destroy(mesh);
+        homcull_context_destroy(context);
+    });
+    EXPECT_EQ(global, 0u);
+    EXPECT_GT(engine.calls, 20u);
+    EXPECT_EQ(engine.live, 0u);
+    EXPECT_GT(occluded, 0u);  // the street hides something
 }
 
 }  // namespace

@@ -130,7 +130,7 @@ TEST(OccluderClusters, RepeatedTrianglesAreEachKeptOnce) {
     const std::vector<std::uint8_t> flags = {1, 2, 3, 4, 5};
     const std::vector<std::uint32_t> apexes(15, 4);
     const OccluderClusters clusters = build_occluder_clusters(positions.data(), 3 * sizeof(float), 5, indices.data(), 5, flags.data(), apexes.data());
-    std::vector<std::uint32_t> sources = clusters.source_triangles;
+    std::vector<std::uint32_t> sources(clusters.source_triangles.begin(), clusters.source_triangles.end());
     std::sort(sources.begin(), sources.end());
     EXPECT_EQ(sources, (std::vector<std::uint32_t>{0, 1, 2, 3, 4}));
     for (std::size_t t = 0; t < clusters.source_triangles.size(); ++t)

@@ -139,7 +139,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     if (band_vertex_outcode_.size() < bands * plane) band_vertex_outcode_.resize(bands * plane);
     band_stats_.assign(bands, RasterStats{});
     if (parallel.run) {  // each cluster in view: a slot for its set-up triangles
-        while (cluster_setups_.size() < placed_clusters_.size()) cluster_setups_.push_back(std::make_unique<ClusterSetup>());
+        while (cluster_setups_.size() < placed_clusters_.size()) cluster_setups_.push_back(detail::make_hooked<ClusterSetup>());
         for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
             cluster_setups_[k]->state.store(ClusterSetup::kNotSetUp, std::memory_order_relaxed);
             // Room for a cluster's triangles (clipped fans may still add some): after the first
@@ -235,7 +235,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
         if (clear_first) clear_rows(0, subtiles_y_);
         const detail::RasterTarget whole = raster_target(0, subtiles_y_);
         const detail::VertexClip cache = cache_of(0);
-        std::vector<std::pair<int, int>>& runs = cluster_row_runs_;  // subtile rows [first, second)
+        auto& runs = cluster_row_runs_;  // subtile rows [first, second)
         RasterStats serial;
         detail::ChangedSubtiles changed;
         for (const PlacedCluster& p : placed_clusters_) {

@@ -1,3 +1,4 @@
+#include <homcull/detail/memory.hpp>
 #include <homcull/error.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
@@ -28,12 +29,43 @@ struct NumberedTriangle {
     }
 };
 
+// meshoptimizer's temporary memory, from the hooks current on the calling thread (operator new
+// without them, as meshoptimizer's default), so that clusters built for the C interface take
+// every byte from the engine. meshoptimizer frees without a size: a header before each block
+// keeps it and the hooks. Set once for the process; with no hooks current it does what
+// meshoptimizer's default does.
+constexpr std::size_t kMeshoptHeader = 16;
+static_assert(sizeof(void*) + sizeof(std::size_t) <= kMeshoptHeader, "the header holds the hooks and the size");
+
+void* meshopt_allocate(std::size_t size) {
+    const detail::MemoryHooks* hooks = detail::current_memory_hooks();
+    auto* block = static_cast<unsigned char*>(detail::hooked_allocate(hooks, size + kMeshoptHeader, kMeshoptHeader));
+    std::memcpy(block, &hooks, sizeof hooks);
+    std::memcpy(block + sizeof hooks, &size, sizeof size);
+    return block + kMeshoptHeader;
+}
+
+void meshopt_deallocate(void* memory) {
+    if (!memory) return;
+    unsigned char* block = static_cast<unsigned char*>(memory) - kMeshoptHeader;
+    const detail::MemoryHooks* hooks;
+    std::size_t size;
+    std::memcpy(&hooks, block, sizeof hooks);
+    std::memcpy(&size, block + sizeof hooks, sizeof size);
+    detail::hooked_deallocate(hooks, block, size + kMeshoptHeader, kMeshoptHeader);
+}
+
+void route_meshopt_memory() {
+    static const bool routed = (meshopt_setAllocator(meshopt_allocate, meshopt_deallocate), true);
+    (void)routed;
+}
+
 }  // namespace
 
-void check_cluster_limits(const ClusterLimits& limits, const std::string& caller) {
-    if (limits.max_vertices < 3 || limits.max_vertices > 255) throw Error(caller + ": max_vertices must be in [3, 255]");
+void check_cluster_limits(const ClusterLimits& limits, const char* caller) {
+    if (limits.max_vertices < 3 || limits.max_vertices > 255) throw Error(std::string(caller) + ": max_vertices must be in [3, 255]");
     if (limits.max_triangles < 4 || limits.max_triangles > 512 || limits.max_triangles % 4 != 0)
-        throw Error(caller + ": max_triangles must be a multiple of 4 in [4, 512]");
+        throw Error(std::string(caller) + ": max_triangles must be a multiple of 4 in [4, 512]");
 }
 
 OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
@@ -54,20 +86,21 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
 
     // meshopt_buildMeshlets reads packed x, y, z (it takes a stride, but this keeps the
     // positions it sees and the ones copied below the same by construction).
-    std::vector<float> packed(3 * vertex_count);
+    detail::Vector<float> packed(3 * vertex_count);
     for (std::size_t v = 0; v < vertex_count; ++v)
         std::memcpy(&packed[3 * v], reinterpret_cast<const unsigned char*>(positions) + v * position_stride, 3 * sizeof(float));
 
     // meshoptimizer sorts positions spatially: it sees non-finite ones as the origin (the
     // clusters keep them as they are, and their boxes say so).
-    std::vector<float> finite(packed);
+    detail::Vector<float> finite(packed);
     for (float& x : finite)
         if (!std::isfinite(x)) x = 0.0f;
 
     const std::size_t index_count = 3 * triangle_count;
-    std::vector<meshopt_Meshlet> meshlets(meshopt_buildMeshletsBound(index_count, limits.max_vertices, limits.max_triangles));
-    std::vector<unsigned int> meshlet_vertices(meshlets.size() * limits.max_vertices);
-    std::vector<unsigned char> meshlet_triangles(meshlets.size() * limits.max_triangles * 3);
+    detail::Vector<meshopt_Meshlet> meshlets(meshopt_buildMeshletsBound(index_count, limits.max_vertices, limits.max_triangles));
+    detail::Vector<unsigned int> meshlet_vertices(meshlets.size() * limits.max_vertices);
+    detail::Vector<unsigned char> meshlet_triangles(meshlets.size() * limits.max_triangles * 3);
+    route_meshopt_memory();
     // cone_weight 0: clusters as compact in space as it can make them (their boxes are what the
     // render tests), not grouped by facing.
     meshlets.resize(meshopt_buildMeshlets(meshlets.data(), meshlet_vertices.data(), meshlet_triangles.data(), indices, index_count,
@@ -76,11 +109,11 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
     // The input triangles sorted by their vertices (a repeated triangle: its copies in input
     // order), each handed out once. One sorted array rather than a list per triangle: the
     // scene culler builds the clusters of every occluder at load time.
-    std::vector<NumberedTriangle> by_vertices(triangle_count);
+    detail::Vector<NumberedTriangle> by_vertices(triangle_count);
     for (std::size_t t = 0; t < triangle_count; ++t)
         by_vertices[t] = {{indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]}, std::uint32_t(t)};
     std::sort(by_vertices.begin(), by_vertices.end());
-    std::vector<std::uint32_t> handed_out(triangle_count, 0);  // at a run's first entry: how many of the run are taken
+    detail::Vector<std::uint32_t> handed_out(triangle_count, 0);  // at a run's first entry: how many of the run are taken
 
     out.indices.reserve(index_count);
     out.shared_edges.reserve(triangle_count);
@@ -89,8 +122,8 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
     out.edge_apexes.reserve(index_count);
     // Appends a cluster of the given input vertices and triangles (vertex numbers local to it;
     // `originals` the input triangles, for their flags), then the apexes its flags need.
-    const auto append = [&](std::vector<std::uint32_t>& vertices, const std::vector<std::uint8_t>& local,
-                            const std::vector<std::uint32_t>& originals) {
+    const auto append = [&](detail::Vector<std::uint32_t>& vertices, const detail::Vector<std::uint8_t>& local,
+                            const detail::Vector<std::uint32_t>& originals) {
         OccluderCluster c;
         c.first_vertex = std::uint32_t(out.positions.size() / 3);
         c.vertex_count = std::uint32_t(vertices.size());
@@ -127,8 +160,8 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
         out.clusters.push_back(c);
     };
-    std::vector<std::uint32_t> vertices, originals;
-    std::vector<std::uint8_t> local;
+    detail::Vector<std::uint32_t> vertices, originals;
+    detail::Vector<std::uint8_t> local;
     for (const meshopt_Meshlet& m : meshlets) {
         vertices.assign(meshlet_vertices.begin() + m.vertex_offset, meshlet_vertices.begin() + m.vertex_offset + m.vertex_count);
         local.assign(meshlet_triangles.begin() + m.triangle_offset, meshlet_triangles.begin() + m.triangle_offset + 3 * m.triangle_count);

@@ -47,14 +47,14 @@ void prefetch_triangle(const detail::RasterTriangle& tri) {
 // into the chunk instead saves memory, but nearly every read of a band is then a cache miss:
 // 10 % slower on S1 even with prefetching.)
 struct OcclusionBuffer::Chunk {
-    std::vector<std::vector<detail::RasterTriangle>> bins;
+    detail::Vector<detail::Vector<detail::RasterTriangle>> bins;
     RasterStats stats;
 };
 
 // A part of a noted render's rows (draw_noted_part) and its scratch: room for a slice's
 // undecided triangles, and its statistics.
 struct OcclusionBuffer::NotedPart {
-    std::vector<std::uint32_t> undecided;
+    detail::Vector<std::uint32_t> undecided;
     RasterStats stats;
     detail::ChangedSubtiles changed;  // the subtiles its render changed
     int row_begin = 0, row_end = 0;  // its subtile rows in the render under way
@@ -65,7 +65,11 @@ OcclusionBuffer::~OcclusionBuffer() = default;
 OcclusionBuffer::OcclusionBuffer(OcclusionBuffer&&) noexcept = default;
 OcclusionBuffer& OcclusionBuffer::operator=(OcclusionBuffer&&) noexcept = default;
 
-OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
+OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) { configure(config); }
+
+namespace {
+
+void validate_config(const BufferConfig& config) {
     validate_resolution({config.width, config.height});
     if (config.samples != 1 && config.samples != 2 && config.samples != 4)
         throw Error("occlusion buffer: samples per pixel axis must be 1, 2 or 4, got " + std::to_string(config.samples));
@@ -74,24 +78,71 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
     if (!(config.near_w >= 0x1.0p-126f) || !std::isfinite(config.near_w))
         throw Error("occlusion buffer: near_w must be a positive number of at least 2^-126 (1.2e-38), got " + std::to_string(config.near_w));
     if (!(config.edge_margin >= 0.0 && config.edge_margin < 0.5)) throw Error("occlusion buffer: edge margin must be in [0, 0.5) samples");
-    sample_width_ = config.width * config.samples;
-    sample_height_ = config.height * config.samples;
-    if (double(sample_width_) * sample_height_ > double(1 << 28))
+    const long long sample_width = (long long)config.width * config.samples, sample_height = (long long)config.height * config.samples;
+    if (double(sample_width) * double(sample_height) > double(1 << 28))
         throw Error("occlusion buffer: more than 2^28 samples; lower the resolution or the samples");
-    if (sample_width_ > (1 << 22) || sample_height_ > (1 << 22))  // sample coordinates stay exact in float (conservative_depth)
+    if (sample_width > (1 << 22) || sample_height > (1 << 22))  // sample coordinates stay exact in float (conservative_depth)
         throw Error("occlusion buffer: more than 2^22 samples in a row or column; lower the resolution or the samples");
-    subtiles_x_ = (sample_width_ + kW - 1) / kW;
-    subtiles_y_ = (sample_height_ + kH - 1) / kH;
-    stride_ = std::size_t(subtiles_x_ + detail::kMaxSimdLanes - 1 + detail::kMaxSimdLanes - 1) / detail::kMaxSimdLanes *
-              detail::kMaxSimdLanes;
-    const std::size_t plane = stride_ * std::size_t(subtiles_y_);
-    d0_.assign(plane, 0.0f);
-    d1_.assign(plane, 0.0f);
-    mask_.assign(plane, 0u);
-    covered_.assign(plane, 0u);
-    sample_depth_stride_ = std::size_t(sample_width_) + detail::kMaxSimdLanes;
-    if (config.sample_depth) sample_depth_.assign(sample_depth_stride_ * std::size_t(sample_height_), 0.0f);
-    band_updated_.assign(std::size_t((subtiles_y_ + kBandSubtileRows - 1) / kBandSubtileRows), 0);
+}
+
+// The sizes of a buffer's arrays for a configuration.
+struct BufferSizes {
+    int sample_width, sample_height, subtiles_x, subtiles_y;
+    std::size_t stride, plane, sample_depth_stride, sample_depth, bands, pyramid, levels, cells_width, cells_height, cells;
+};
+
+BufferSizes buffer_sizes(const BufferConfig& config) {
+    BufferSizes z{};
+    z.sample_width = config.width * config.samples;
+    z.sample_height = config.height * config.samples;
+    z.subtiles_x = (z.sample_width + kW - 1) / kW;
+    z.subtiles_y = (z.sample_height + kH - 1) / kH;
+    z.stride = std::size_t(z.subtiles_x + detail::kMaxSimdLanes - 1 + detail::kMaxSimdLanes - 1) / detail::kMaxSimdLanes * detail::kMaxSimdLanes;
+    z.plane = z.stride * std::size_t(z.subtiles_y);
+    z.sample_depth_stride = std::size_t(z.sample_width) + detail::kMaxSimdLanes;
+    z.sample_depth = config.sample_depth ? z.sample_depth_stride * std::size_t(z.sample_height) : 0;
+    z.bands = std::size_t((z.subtiles_y + kBandSubtileRows - 1) / kBandSubtileRows);
+    z.levels = 1;
+    std::size_t size = std::size_t(z.subtiles_x) * std::size_t(z.subtiles_y);
+    for (int w = z.subtiles_x, h = z.subtiles_y; w > 1 || h > 1; ++z.levels) {
+        w = (w + 1) / 2, h = (h + 1) / 2;
+        size += std::size_t(w) * std::size_t(h);
+    }
+    z.pyramid = size + detail::kMaxSimdLanes;  // padded: RectScan loads whole vectors of a level's row
+    z.cells_width = std::size_t(detail::reference_cells_width(z.subtiles_x));
+    z.cells_height = std::size_t(detail::reference_cells_height(z.subtiles_y));
+    z.cells = std::size_t(detail::kCellTables) * z.cells_width * z.cells_height;
+    return z;
+}
+
+}  // namespace
+
+// Everything that can fail (the checks, then every allocation: reserve keeps a vector's
+// contents) comes before anything changes, so that a configuration that throws leaves the buffer
+// as it was. Arrays that already hold enough keep their memory.
+void OcclusionBuffer::configure(const BufferConfig& config) {
+    validate_config(config);
+    const BufferSizes z = buffer_sizes(config);
+    d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
+    sample_depth_.reserve(z.sample_depth);
+    band_updated_.reserve(z.bands);
+    levels_.reserve(z.levels), level_offset_.reserve(z.levels), level_width_.reserve(z.levels);
+    pyramid_.reserve(z.pyramid);
+    reference_cells_.reserve(z.cells);
+    cell_row_load_.reserve(z.cells_height);
+
+    config_ = config;
+    sample_width_ = z.sample_width, sample_height_ = z.sample_height;
+    subtiles_x_ = z.subtiles_x, subtiles_y_ = z.subtiles_y;
+    stride_ = z.stride;
+    d0_.assign(z.plane, 0.0f);
+    d1_.assign(z.plane, 0.0f);
+    mask_.assign(z.plane, 0u);
+    covered_.assign(z.plane, 0u);
+    sample_depth_stride_ = z.sample_depth_stride;
+    sample_depth_.assign(z.sample_depth, 0.0f);
+    band_updated_.assign(z.bands, 0);
+    levels_.clear();
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
     std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
     while (levels_.back().width > 1 || levels_.back().height > 1) {
@@ -99,15 +150,81 @@ OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) : config_(config) {
         levels_.push_back({(below.width + 1) / 2, (below.height + 1) / 2, size});
         size += std::size_t(levels_.back().width) * std::size_t(levels_.back().height);
     }
-    pyramid_.assign(size + detail::kMaxSimdLanes, 0.0f);  // padded: RectScan loads whole vectors of a level's row
-    reference_cells_width_ = detail::reference_cells_width(subtiles_x_);
-    reference_cells_.assign(std::size_t(detail::kCellTables) * std::size_t(reference_cells_width_) *
-                                std::size_t(detail::reference_cells_height(subtiles_y_)),
-                            0.0f);
-    cell_row_load_.assign(std::size_t(detail::reference_cells_height(subtiles_y_)), 0u);
+    pyramid_.assign(z.pyramid, 0.0f);
+    reference_cells_width_ = int(z.cells_width);
+    reference_cells_.assign(z.cells, 0.0f);
+    reference_cells_current_ = false;
+    cell_row_load_.assign(z.cells_height, 0u);
+    level_offset_.clear(), level_width_.clear();
     for (const detail::PyramidLevel& l : levels_) {
         level_offset_.push_back(std::int32_t(l.offset));
         level_width_.push_back(l.width);
+    }
+    stats_ = RasterStats{};
+}
+
+void OcclusionBuffer::set_near_w(float near_w) {
+    BufferConfig config = config_;
+    config.near_w = near_w;
+    validate_config(config);
+    config_.near_w = near_w;
+    clear();
+}
+
+// Sized as the renders size them (render_rows, transform_vertices, sort_nearest_first,
+// render_serial, render_clusters), for the largest input and buffer: those on one thread then
+// find every array large enough.
+void OcclusionBuffer::reserve(const BufferReserve& r) {
+    BufferConfig largest = config_;
+    largest.width = std::max(config_.width, r.max_width);
+    largest.height = std::max(config_.height, r.max_height);
+    validate_config(largest);
+    const BufferSizes z = buffer_sizes(largest);
+    d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
+    sample_depth_.reserve(z.sample_depth);
+    band_updated_.reserve(z.bands);
+    levels_.reserve(z.levels), level_offset_.reserve(z.levels), level_width_.reserve(z.levels);
+    pyramid_.reserve(z.pyramid);
+    reference_cells_.reserve(z.cells);
+    cell_row_load_.reserve(z.cells_height);
+
+    const auto at_least = [](auto& v, std::size_t n) {
+        if (v.size() < n) v.resize(n);
+    };
+    // Triangle input: the draw order's scratch, the vertex cache and the noted render's part.
+    const std::size_t n = r.max_triangles, tasks = (n + detail::kDrawOrderTask - 1) / detail::kDrawOrderTask;
+    if (n > 0) {
+        if (!draw_order_) draw_order_ = detail::make_hooked<detail::DrawOrderScratch>();
+        detail::DrawOrderScratch& d = *draw_order_;
+        at_least(d.bucket, n);
+        at_least(d.data, 12 * n);  // a soup of 4 floats a vertex: its largest copy
+        at_least(d.shared_edges, n);
+        at_least(d.edge_apexes, 3 * n);
+        at_least(d.placed_at, n);
+        at_least(d.count, tasks * detail::kDrawOrderBuckets);
+        at_least(d.excluded, tasks * detail::kDrawOrderBuckets);
+        at_least(d.start, tasks * detail::kDrawOrderClasses);
+        at_least(d.skipped, tasks);
+        at_least(d.noted, n);
+        at_least(d.listed_notes, n);
+        if (noted_parts_.empty()) noted_parts_.resize(1);
+        at_least(noted_parts_[0].undecided, kCellRefreshTriangles);
+    }
+    if (r.max_vertices > 0) {
+        if (!draw_order_) draw_order_ = detail::make_hooked<detail::DrawOrderScratch>();
+        at_least(draw_order_->vertex_code, r.max_vertices);
+        at_least(vertex_clip_, 4 * (r.max_vertices + detail::kVertexClipPadding));
+        at_least(vertex_outcode_, r.max_vertices);
+    }
+    // Clustered input.
+    at_least(cluster_places_, r.max_clusters);
+    placed_clusters_.reserve(r.max_clusters);
+    band_stats_.reserve(z.bands);
+    cluster_row_runs_.reserve(z.bands);
+    if (r.max_clusters > 0) {
+        const std::size_t plane = r.max_cluster_vertices + detail::kVertexClipPadding;
+        at_least(band_vertex_clip_, z.bands * 4 * plane);
+        at_least(band_vertex_outcode_, z.bands * plane);
     }
 }
 
@@ -272,7 +389,7 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
     const detail::VertexClip* cache = transform_vertices(in, parallel, storage) ? &storage : nullptr;
     // Nearest first (TriangleInput::order): the sorted copy has the same vertices, so the cache
     // serves it too.
-    if (!draw_order_) draw_order_ = std::make_unique<detail::DrawOrderScratch>();
+    if (!draw_order_) draw_order_ = detail::make_hooked<detail::DrawOrderScratch>();
     TriangleInput sorted;
     detail::DrawList list;  // the order as a list of numbers, when the input allows (one thread, or a clip-space soup)
     RasterStats skipped;    // the triangles the sort leaves out (with a vertex cache)
@@ -502,7 +619,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                 const detail::RasterTarget target = b.raster_target(row_begin, row_end);
                 std::uint64_t updated = 0;
                 for (std::size_t c = j.first_chunk; c < j.end_chunk; ++c) {
-                    const std::vector<detail::RasterTriangle>& bin = b.chunks_[c].bins[band];
+                    const auto& bin = b.chunks_[c].bins[band];
                     for (std::size_t k = 0; k < bin.size(); ++k) {
                         if (k + kPrefetchTriangles < bin.size()) prefetch_triangle(bin[k + kPrefetchTriangles]);
                         updated += target.kernel(target, bin[k]);

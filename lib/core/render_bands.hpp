@@ -70,7 +70,7 @@ struct OcclusionBuffer::ClusterPlace {
 // With a job system, a cluster in view is set up once, by the first band that draws it, and
 // its triangles kept here for the other bands that draw it (each waits until they are ready).
 struct OcclusionBuffer::ClusterSetup {
-    std::vector<detail::RasterTriangle> triangles;
+    detail::Vector<detail::RasterTriangle> triangles;
     RasterStats stats;          // the setup's counts
     std::atomic<int> state{0};  // kNotSetUp, kSettingUp, kReady, or kFailed (the setup threw)
     static constexpr int kNotSetUp = 0, kSettingUp = 1, kReady = 2, kFailed = 3;

@@ -1,12 +1,20 @@
 #pragma once
 // Runs tasks 0..count-1 through the caller's job system (ParallelFor) when it has one and there
-// is more than one task, else one after another on the calling thread; each task in the
-// library's floating-point environment (float_mode.hpp), whichever thread runs it.
+// is more than one task, else one after another on the calling thread. Each task runs as the
+// calling thread would: in the library's floating-point environment (float_mode.hpp), with the
+// caller's memory hooks (homcull/detail/memory.hpp) and instruction set (raster/isa_choice.hpp),
+// whichever thread runs it. No exception leaves a task into the job system (a C job system
+// cannot pass one on, and an exception reaching it would end the process): the first one a
+// task throws is kept and thrown again on the calling thread once every task has returned.
 #include "core/float_mode.hpp"
+#include "raster/isa_choice.hpp"
 
+#include <homcull/detail/memory.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include <atomic>
 #include <cstddef>
+#include <exception>
 
 namespace homcull::detail {
 
@@ -18,12 +26,23 @@ inline void run_tasks(const ParallelFor& parallel, std::size_t count, void (*tas
     struct Wrapped {
         void (*task)(void*, std::size_t);
         void* data;
-    } wrapped{task, data};
+        const MemoryHooks* hooks;
+        const IsaChoice* isa;
+        std::atomic<bool> failed{false};
+        std::exception_ptr error;  // the first task's to throw, written once (failed guards it)
+    } wrapped{task, data, current_memory_hooks(), current_isa_choice(), {false}, nullptr};
     parallel.run(parallel.user, count, [](void* w, std::size_t i) {
-        const Wrapped& t = *static_cast<const Wrapped*>(w);
+        Wrapped& t = *static_cast<Wrapped*>(w);
         const StandardFloatMode mode;
-        t.task(t.data, i);
+        const MemoryScope memory(t.hooks);
+        const IsaScope isa(t.isa);
+        try {
+            t.task(t.data, i);
+        } catch (...) {
+            if (!t.failed.exchange(true)) t.error = std::current_exception();
+        }
     }, &wrapped);
+    if (wrapped.failed.load()) std::rethrow_exception(wrapped.error);
 }
 
 }  // namespace homcull::detail

@@ -14,6 +14,7 @@
 #include "raster/reference_cells.hpp"
 #include "raster/triangle_batch.hpp"
 
+#include <homcull/detail/memory.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
 #include <cstdint>
@@ -37,19 +38,19 @@ constexpr std::size_t kDrawOrderTask = 8192;
 // or for a clip-space soup the cell notes (8 bytes per triangle) and the list of notes (12,
 // with or without a job system).
 struct DrawOrderScratch {
-    std::vector<std::uint16_t> bucket;  // per triangle
-    std::vector<std::uint32_t> count;   // per task and bucket
-    std::vector<std::uint32_t> excluded;  // per task and bucket: of count, the triangles left out
-    std::vector<RasterStats> skipped;     // per task: the counts of the triangles left out
-    std::vector<std::uint32_t> vertex_code;  // per vertex of the cache: its bucket and outcode (when leaving triangles out)
-    std::vector<std::uint32_t> start;   // per task and class: a count, then the next position
+    Vector<std::uint16_t> bucket;  // per triangle
+    Vector<std::uint32_t> count;   // per task and bucket
+    Vector<std::uint32_t> excluded;  // per task and bucket: of count, the triangles left out
+    Vector<RasterStats> skipped;     // per task: the counts of the triangles left out
+    Vector<std::uint32_t> vertex_code;  // per vertex of the cache: its bucket and outcode (when leaving triangles out)
+    Vector<std::uint32_t> start;   // per task and class: a count, then the next position
     std::uint8_t class_of[kDrawOrderBuckets];
-    std::vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
-    std::vector<std::uint8_t> shared_edges;
-    std::vector<std::uint32_t> edge_apexes;  // 3 per triangle, with the flags
-    std::vector<std::uint32_t> placed_at;    // a soup's: each input triangle's place in the copy (its apexes are renumbered)
-    std::vector<CellRecord> noted;  // with the list of a clip-space soup: each triangle's cell record
-    std::vector<ListedNote> listed_notes;  // the list of a noted soup: the notes in order, with the triangles' numbers
+    Vector<std::uint32_t> data;    // the sorted indices or positions (32-bit words), or the list of numbers
+    Vector<std::uint8_t> shared_edges;
+    Vector<std::uint32_t> edge_apexes;  // 3 per triangle, with the flags
+    Vector<std::uint32_t> placed_at;    // a soup's: each input triangle's place in the copy (its apexes are renumbered)
+    Vector<CellRecord> noted;  // with the list of a clip-space soup: each triangle's cell record
+    Vector<ListedNote> listed_notes;  // the list of a noted soup: the notes in order, with the triangles' numbers
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 

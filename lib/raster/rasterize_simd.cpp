@@ -469,10 +469,12 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 #include <homcull/error.hpp>
 
+#include "raster/isa_choice.hpp"
 #include "raster/resolved_kernel.hpp"
 
 #include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <iterator>
 #include <string>
 
@@ -501,12 +503,25 @@ const NamedTarget kTargets[] = {{"avx512", HWY_AVX3},      {"avx2", HWY_AVX2},  
 
 }  // namespace
 
-TriangleRowsKernel selected_rows_kernel() { return use_reference ? &rasterize_rows_reference : HOMCULL_RESOLVED_KERNEL(RasterizeRows); }
-HiddenTestKernel selected_hidden_test() {
-    return use_reference ? &hidden_behind_reference_layer : HOMCULL_RESOLVED_KERNEL(HiddenBehindReferenceLayerKernel);
+TriangleRowsKernel selected_rows_kernel() {
+    return scalar_reference_selected() ? &rasterize_rows_reference : HOMCULL_RESOLVED_KERNEL(RasterizeRows);
 }
-RowIntervalsKernel selected_row_intervals_kernel() { return use_reference ? nullptr : HOMCULL_RESOLVED_KERNEL(RowIntervals); }
-bool scalar_reference_selected() { return use_reference; }
+HiddenTestKernel selected_hidden_test() {
+    return scalar_reference_selected() ? &hidden_behind_reference_layer : HOMCULL_RESOLVED_KERNEL(HiddenBehindReferenceLayerKernel);
+}
+RowIntervalsKernel selected_row_intervals_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(RowIntervals); }
+bool scalar_reference_selected() {
+    const IsaChoice* choice = current_isa_choice();
+    return choice ? choice->scalar : use_reference.load();
+}
+
+namespace {
+thread_local const IsaChoice* current_choice = nullptr;
+}  // namespace
+
+const IsaChoice* current_isa_choice() noexcept { return current_choice; }
+IsaScope::IsaScope(const IsaChoice* choice) noexcept : previous_(current_choice) { current_choice = choice; }
+IsaScope::~IsaScope() { current_choice = previous_; }
 void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
 bool hidden_skip_enabled() { return skip_hidden; }
 
@@ -532,27 +547,63 @@ std::vector<std::string> available_isas() {
     return names;
 }
 
+namespace {
+
+// The Highway target bits of a name ("best": 0), or throws. `scalar` tells the reference paths.
+std::int64_t target_bits(const std::string& name, bool& scalar) {
+    scalar = name == "scalar";
+    if (scalar || name == "best") return 0;
+    const auto t = std::find_if(std::begin(detail::kTargets), std::end(detail::kTargets), [&](const auto& k) { return name == k.name; });
+    if (t == std::end(detail::kTargets)) {
+        std::string known;
+        for (const std::string& n : available_isas()) known += (known.empty() ? "" : ", ") + n;
+        throw Error("unknown instruction set '" + name + "' (available: best, " + known + ")");
+    }
+    if (!(HWY_TARGETS & t->bits) || !(cpu_targets() & t->bits))
+        throw Error("instruction set '" + name + "' is not available on this machine or in this build");
+    return t->bits;
+}
+
+}  // namespace
+
 // Checks the name first: a name that cannot be selected throws and leaves the selection as it was.
 void select_isa(const std::string& name) {
     bool scalar = false;
-    std::int64_t bits = 0;  // best
-    if (name == "scalar") {
-        scalar = true;
-    } else if (name != "best") {
-        const auto t = std::find_if(std::begin(detail::kTargets), std::end(detail::kTargets), [&](const auto& k) { return name == k.name; });
-        if (t == std::end(detail::kTargets)) {
-            std::string known;
-            for (const std::string& n : available_isas()) known += (known.empty() ? "" : ", ") + n;
-            throw Error("unknown instruction set '" + name + "' (available: best, " + known + ")");
-        }
-        if (!(HWY_TARGETS & t->bits) || !(cpu_targets() & t->bits))
-            throw Error("instruction set '" + name + "' is not available on this machine or in this build");
-        bits = t->bits;
-    }
+    const std::int64_t bits = target_bits(name, scalar);
     detail::use_reference = scalar;
     if (scalar) return;  // the SIMD targets stay as they were: the scalar paths do not dispatch
     hwy::SetSupportedTargetsForTest(bits);
 }
+
+namespace detail {
+
+bool isa_available(const char* name) noexcept {
+    if (std::strcmp(name, "best") == 0 || std::strcmp(name, "scalar") == 0) return true;
+    for (const auto& t : kTargets)
+        if (std::strcmp(name, t.name) == 0) return (HWY_TARGETS & t.bits) && (cpu_targets() & t.bits);
+    return false;
+}
+
+// The dispatch-table entry comes from a ChosenTarget of our own, updated to the one target (or
+// to every target the CPU has, for "best"): the process-wide one is left alone.
+IsaChoice make_isa_choice(const std::string& name) {
+    IsaChoice choice;
+    const std::int64_t bits = target_bits(name, choice.scalar);
+    const std::int64_t targets = bits ? bits : cpu_targets();
+    hwy::ChosenTarget chosen;
+    chosen.Update(targets);
+    choice.table_index = int(chosen.GetIndex());
+    choice.name = "scalar";
+    if (!choice.scalar)
+        for (const auto& t : kTargets)
+            if (HWY_TARGETS & targets & t.bits) {
+                choice.name = t.name;  // the best one the table will give
+                break;
+            }
+    return choice;
+}
+
+}  // namespace detail
 
 std::string selected_isa() {
     if (detail::use_reference) return "scalar";

@@ -1,5 +1,6 @@
 // Shared edges of a mesh, matched by position: two triangles share an edge when one has it
 // from position A to position B and the other from B to A (consistent winding), bit for bit.
+#include <homcull/detail/memory.hpp>
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
@@ -64,7 +65,7 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
         std::memcpy(p.data(), reinterpret_cast<const unsigned char*>(positions) + std::size_t(v) * stride, sizeof p);
         return p;
     };
-    std::vector<Edge> edges;
+    detail::Vector<Edge> edges;
     edges.reserve(triangle_count * 3);
     for (std::size_t t = 0; t < triangle_count; ++t) {
         shared_edges[t] = 0;
@@ -91,7 +92,7 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
     // Open addressing, at most half full: slot = 1 + the first edge with that key, 0 = empty.
     std::size_t capacity = 16;
     while (capacity < 2 * edges.size()) capacity *= 2;
-    std::vector<std::uint32_t> table(capacity, 0);
+    detail::Vector<std::uint32_t> table(capacity, 0);
     for (std::size_t i = 0; i < edges.size(); ++i) {
         Edge& e = edges[i];
         for (std::size_t slot = hash(e.key) & (capacity - 1);; slot = (slot + 1) & (capacity - 1)) {

@@ -145,7 +145,7 @@ void run_bench(const BenchOptions& o) {
     ClusterLimits limits;  // --clusters N: at most N triangles and min(N, 255) vertices per cluster
     limits.max_triangles = std::size_t(o.clusters);
     limits.max_vertices = std::min<std::size_t>(255, std::size_t(o.clusters));
-    if (o.clusters > 0) check_cluster_limits(limits, "bench: --clusters " + std::to_string(o.clusters));  // before the scene is loaded
+    if (o.clusters > 0) check_cluster_limits(limits, ("bench: --clusters " + std::to_string(o.clusters)).c_str());  // before the scene is loaded
     if (o.threads < 1 || o.threads > 256) throw Error("bench: --threads must be in [1, 256], got " + std::to_string(o.threads));
     if (o.repeat < 0) throw Error("bench: --repeat must be at least 1 (0: the workload's default), got " + std::to_string(o.repeat));
     select_isa(o.isa);

@@ -12,6 +12,7 @@
 // triangles: about 60 ms, half of it in meshoptimizer) and keeps every triangle and vertex bit
 // for bit.
 #include <homcull/aabb.hpp>
+#include <homcull/detail/memory.hpp>
 
 #include <cstddef>
 #include <cstdint>
@@ -27,16 +28,18 @@ struct OccluderCluster {
     bool bounded = false;  // false when a vertex is not finite (or unknown): the box says nothing, the cluster is always drawn
 };
 
+// Its arrays come from the memory hooks current where it was built (homcull/detail/memory.hpp):
+// operator new, unless the C interface builds it.
 struct OccluderClusters {
-    std::vector<float> positions;            // x, y, z per vertex; each cluster's vertices together
-    std::vector<std::uint16_t> indices;      // 3 per triangle, relative to its cluster's first vertex
-    std::vector<std::uint8_t> shared_edges;  // one per triangle, as TriangleInput::shared_edges
+    detail::Vector<float> positions;            // x, y, z per vertex; each cluster's vertices together
+    detail::Vector<std::uint16_t> indices;      // 3 per triangle, relative to its cluster's first vertex
+    detail::Vector<std::uint8_t> shared_edges;  // one per triangle, as TriangleInput::shared_edges
     // Three per triangle, as TriangleInput::edge_apexes, numbered within the triangle's cluster
     // (from its first_vertex): a cluster's vertices end with copies of the apexes its triangles
     // need that none of them uses (never part of its box).
-    std::vector<std::uint32_t> edge_apexes;
-    std::vector<std::uint32_t> source_triangles;  // one per triangle: its number in the input mesh
-    std::vector<OccluderCluster> clusters;
+    detail::Vector<std::uint32_t> edge_apexes;
+    detail::Vector<std::uint32_t> source_triangles;  // one per triangle: its number in the input mesh
+    detail::Vector<OccluderCluster> clusters;
     std::uint32_t max_cluster_vertices = 0;  // the largest vertex_count (information: render does not rely on it)
 
     std::size_t triangle_count() const { return shared_edges.size(); }
@@ -49,7 +52,7 @@ struct ClusterLimits {
 };
 // Throws homcull::Error, naming `caller`, for limits meshopt_buildMeshlets does not accept
 // (build_occluder_clusters' own check, for callers that want it before loading a mesh).
-void check_cluster_limits(const ClusterLimits& limits, const std::string& caller = "build_occluder_clusters");
+void check_cluster_limits(const ClusterLimits& limits, const char* caller = "build_occluder_clusters");
 
 // Splits an indexed triangle mesh (x, y, z floats every position_stride bytes; 32-bit indices)
 // into clusters. Each triangle keeps its vertices in order and its shared-edge bits and their

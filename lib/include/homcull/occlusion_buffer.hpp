@@ -22,6 +22,7 @@
 // what is visible at the samples.
 #include <homcull/aabb.hpp>
 #include <homcull/camera.hpp>
+#include <homcull/detail/memory.hpp>
 
 #include <array>
 #include <cstdint>
@@ -73,6 +74,15 @@ struct BufferConfig {
     // holds occluders at different depths, at silhouettes; per-sample depth does not, which
     // test_triangles uses. Costs 4 bytes a sample and a plane evaluation per covered sample.
     bool sample_depth = false;
+};
+
+// The largest work a buffer will be given (OcclusionBuffer::reserve). Zeros reserve nothing.
+struct BufferReserve {
+    int max_width = 0, max_height = 0;  // pixels (the samples per pixel stay the buffer's)
+    std::size_t max_triangles = 0;      // per render call
+    std::size_t max_vertices = 0;       // per render(TriangleInput) call
+    std::size_t max_clusters = 0;       // per render(ClusteredInput) call
+    std::size_t max_cluster_vertices = 0;  // the largest OccluderCluster::vertex_count drawn
 };
 
 struct RasterStats {
@@ -227,6 +237,18 @@ public:
     // (tested: FrameAllocations.NoneAfterTheFirstFrame).
     explicit OcclusionBuffer(const BufferConfig& config);
 
+    // A new configuration (resolution, samples, near plane, ...): the buffer is then empty. Its
+    // arrays keep their memory and grow only where the new configuration needs more than they
+    // hold. Throws homcull::Error on an invalid configuration, std::bad_alloc when memory runs
+    // out; either way the buffer is left as it was.
+    void configure(const BufferConfig& config);
+    // A new near plane (BufferConfig::near_w), emptying the buffer; allocates nothing.
+    void set_near_w(float near_w);
+    // Sizes every array for the largest buffer and input the caller will give, so that renders
+    // on one thread within these sizes, and configure() up to that resolution, never allocate.
+    // Throws like configure; whatever it reserved stays reserved.
+    void reserve(const BufferReserve& reserve);
+
     void clear();
     // Rasterizes occluders in draw order (TriangleInput::order, nearest first by default).
     // Without a job system each triangle is set up and drawn in turn; with one, a clip-space
@@ -354,9 +376,9 @@ private:
     // subtiles as one vector per field), row-major with a padded row stride: a full vector
     // load starting at any subtile of a row stays within the row's padding.
     std::size_t stride_ = 0;
-    std::vector<float> d0_, d1_;
-    std::vector<std::uint32_t> mask_, covered_;
-    std::vector<float> sample_depth_;  // 1/w per sample, row-major; empty unless config_.sample_depth
+    detail::Vector<float> d0_, d1_;
+    detail::Vector<std::uint32_t> mask_, covered_;
+    detail::Vector<float> sample_depth_;  // 1/w per sample, row-major; empty unless config_.sample_depth
     // Its row stride: the width plus room for a whole vector from any sample of the row, so that
     // the SIMD kernel's vectors never reach into the next row (another band's, on another thread).
     std::size_t sample_depth_stride_ = 0;
@@ -365,9 +387,9 @@ private:
 
     // Farthest-depth pyramid: level l >= 1 holds, per cell of 2^l x 2^l subtiles, the minimum
     // d0; rebuilt at the end of render().
-    std::vector<detail::PyramidLevel> levels_;
-    std::vector<float> pyramid_;
-    std::vector<std::int32_t> level_offset_, level_width_;  // levels_ as arrays, for SIMD gathers
+    detail::Vector<detail::PyramidLevel> levels_;
+    detail::Vector<float> pyramid_;
+    detail::Vector<std::int32_t> level_offset_, level_width_;  // levels_ as arrays, for SIMD gathers
     // Level 0 for subtile rows [row_begin, row_end) and levels 1..last_level above them (row_begin
     // a multiple of 2^last_level: each cell's subtiles are then among these rows).
     void build_pyramid_rows(int row_begin, int row_end, int last_level);
@@ -422,13 +444,13 @@ private:
     // The smallest d0 of each cell of 8 x 8 subtiles, valid only while a render draws
     // (raster/reference_cells.hpp): a copy per part of the rows (render_parts; one thread: one
     // part), the other parts' rows infinite in each. Sized with the buffer for one part.
-    std::vector<float> reference_cells_;
+    detail::Vector<float> reference_cells_;
     int reference_cells_width_ = 0;
     struct NotedPart;
-    std::vector<NotedPart> noted_parts_;
+    detail::Vector<NotedPart> noted_parts_;
     // Per cell row: the triangles the last noted render drew there (each at its first row in its
     // part), which places the next render's part bounds.
-    std::vector<std::uint32_t> cell_row_load_;
+    detail::Vector<std::uint32_t> cell_row_load_;
     // The cells of part 0 hold the buffer's d0 over every row: the last render was a noted one on
     // one thread and nothing changed the buffer since. The next such render then starts from them
     // instead of recomputing them all (a render call costs what it draws).
@@ -444,18 +466,18 @@ private:
 
     // Render scratch, reused across frames (grown, never shrunk).
     struct Chunk;
-    std::vector<Chunk> chunks_;
-    std::vector<std::uint64_t> band_updated_;
-    std::vector<double> vertex_clip_;           // four planes of vertex_count + padding
-    std::vector<std::uint8_t> vertex_outcode_;
-    std::unique_ptr<detail::DrawOrderScratch> draw_order_;  // raster/draw_order.hpp; made by the first render
-    std::vector<ClusterPlace> cluster_places_;    // each input cluster's box this frame
-    std::vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
-    std::vector<RasterStats> band_stats_;
-    std::vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
-    std::vector<std::unique_ptr<ClusterSetup>> cluster_setups_;  // job system: one per cluster in view (never moved)
-    std::vector<double> band_vertex_clip_;         // per band: four planes of a cluster's vertices + padding
-    std::vector<std::uint8_t> band_vertex_outcode_;
+    detail::Vector<Chunk> chunks_;
+    detail::Vector<std::uint64_t> band_updated_;
+    detail::Vector<double> vertex_clip_;           // four planes of vertex_count + padding
+    detail::Vector<std::uint8_t> vertex_outcode_;
+    detail::HookPtr<detail::DrawOrderScratch> draw_order_;  // raster/draw_order.hpp; made by the first render
+    detail::Vector<ClusterPlace> cluster_places_;    // each input cluster's box this frame
+    detail::Vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
+    detail::Vector<RasterStats> band_stats_;
+    detail::Vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
+    detail::Vector<detail::HookPtr<ClusterSetup>> cluster_setups_;  // job system: one per cluster in view (never moved)
+    detail::Vector<double> band_vertex_clip_;         // per band: four planes of a cluster's vertices + padding
+    detail::Vector<std::uint8_t> band_vertex_outcode_;
 
 public:
     ~OcclusionBuffer();

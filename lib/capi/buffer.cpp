@@ -1,0 +1,340 @@
+// homcull.h: buffers, frames, draws and queries.
+#include "capi/c_objects.hpp"
+#include "capi/view_conventions.hpp"
+
+#include <homcull/aabb.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace homcull;
+
+namespace {
+
+constexpr const char* kNoFrame = "no frame has begun on this buffer (homcull_buffer_begin_frame)";
+
+BufferConfig buffer_config(const homcull_buffer_desc& d) {
+    BufferConfig c;
+    c.width = d.width;
+    c.height = d.height;
+    c.samples = d.samples;
+    c.near_w = d.near_distance;
+    c.sample_depth = (d.flags & HOMCULL_BUFFER_SAMPLE_DEPTH) != 0;
+    return c;
+}
+
+// The library's checks of a configuration, as a result instead of an exception (they would
+// allocate their message): the same conditions as OcclusionBuffer::configure.
+homcull_result check_config(const homcull_context* context, const char* fn, int width, int height, int samples, float near_distance) {
+    if (width < 1 || height < 1 || width > 65536 || height > 65536)
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: resolution %dx%d is outside 1..65536", fn, width, height);
+    if (samples != 1 && samples != 2 && samples != 4)
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: samples per pixel axis must be 1, 2 or 4, got %d", fn, samples);
+    if (!(near_distance >= 0x1.0p-126f) || !std::isfinite(near_distance))
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: near distance must be a finite number of at least 2^-126, got %g", fn,
+                            double(near_distance));
+    const double sw = double(width) * samples, sh = double(height) * samples;
+    if (sw * sh > double(1 << 28) || sw > double(1 << 22) || sh > double(1 << 22))
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: %dx%d pixels of %dx%d samples is more than the buffer holds (2^28 samples)",
+                            fn, width, height, samples, samples);
+    return HOMCULL_OK;
+}
+
+OcclusionBuffer make_buffer(capi::Account& account, const BufferConfig& config) {
+    const detail::MemoryScope scope(&account.hooks);
+    return OcclusionBuffer(config);
+}
+
+glm::dmat4 read_model(const homcull_buffer& b, const float* model) {
+    return model ? capi::read_matrix(model, b.view.layout) : glm::dmat4(1.0);
+}
+
+// The far plane's row against model positions: far_row * (clip_from_world * model).
+glm::dvec4 far_row_in_model(const homcull_buffer& b, const glm::dmat4& model) {
+    const glm::dmat4 m = b.clip_from_world * model;
+    glm::dvec4 row;
+    for (int c = 0; c < 4; ++c) row[c] = glm::dot(b.far_row, glm::dvec4(m[c][0], m[c][1], m[c][2], m[c][3]));
+    return row;
+}
+
+// The checks every draw and query shares.
+homcull_result check_frame(const homcull_buffer* b, const char* fn) {
+    if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
+    if (!b->frame_begun) return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: %s", fn, kNoFrame);
+    return HOMCULL_OK;
+}
+
+bool finite_matrix(const float* m) {
+    if (!m) return true;
+    for (int i = 0; i < 16; ++i)
+        if (!std::isfinite(m[i])) return false;
+    return true;
+}
+
+// A homcull_triangles as the library's input, or an error result.
+homcull_result triangle_input(const homcull_buffer& b, const homcull_triangles* t, const float* model, const char* fn, TriangleInput& in) {
+    const homcull_context* context = b.account.context;
+    if (!t) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: triangles is null", fn);
+    if (t->triangle_count > 0 && !t->positions) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: positions is null", fn);
+    if (t->position_stride < 3 * sizeof(float))
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: position_stride %zu is below one position (12 bytes)", fn,
+                            t->position_stride);
+    if (t->indices && t->index_size != 2 && t->index_size != 4)
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: index_size must be 2 or 4, got %u", fn, unsigned(t->index_size));
+    if (!t->indices && t->triangle_count > t->vertex_count / 3)
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: %zu triangles without indices need %zu vertices, vertex_count is %zu", fn,
+                            t->triangle_count, 3 * t->triangle_count, t->vertex_count);
+    if (t->triangle_count >= (std::size_t(1) << 32))
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: at most 2^32 - 1 triangles a call", fn);
+    if (!finite_matrix(model)) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: model_matrix has a number that is not finite", fn);
+    in = TriangleInput{};
+    in.positions = t->positions;
+    in.position_components = 3;
+    in.position_stride = t->position_stride;
+    in.vertex_count = t->vertex_count;
+    in.indices = t->indices;
+    in.indices_16bit = t->indices && t->index_size == 2;
+    in.triangle_count = t->triangle_count;
+    in.model_to_clip = capi::float_clip_from_model(b.clip_from_world, read_model(b, model));
+    in.backface = b.backface;
+    return HOMCULL_OK;
+}
+
+homcull_visibility as_c(Visibility v) {
+    return v == Visibility::occluded ? HOMCULL_OCCLUDED : v == Visibility::view_culled ? HOMCULL_VIEW_CULLED : HOMCULL_VISIBLE;
+}
+
+void all_visible(homcull_visibility* visibility, std::size_t count) {
+    if (visibility) std::fill(visibility, visibility + count, homcull_visibility(HOMCULL_VISIBLE));
+}
+
+}  // namespace
+
+homcull_buffer::homcull_buffer(homcull_context* context, const BufferConfig& config) : account(context), buffer(make_buffer(account, config)) {}
+
+extern "C" {
+
+homcull_result homcull_buffer_create(homcull_context* context, const homcull_buffer_desc* desc, homcull_buffer** out) {
+    const char* const fn = "homcull_buffer_create";
+    if (!out) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: out is null", fn);
+    *out = nullptr;
+    if (!context || !desc) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: context or desc is null", fn);
+    if (desc->flags & ~uint32_t(HOMCULL_BUFFER_SAMPLE_DEPTH))
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: unknown flags 0x%x", fn, unsigned(desc->flags));
+    const homcull_result valid = check_config(context, fn, desc->width, desc->height, desc->samples, desc->near_distance);
+    if (valid != HOMCULL_OK) return valid;
+    homcull_buffer* buffer = nullptr;
+    const homcull_result result = capi::guarded(context, fn, [&]() -> homcull_result {
+        buffer = capi::place<homcull_buffer>(context, buffer_config(*desc));
+        return HOMCULL_OK;
+    });
+    if (result == HOMCULL_OK) *out = buffer;
+    return result;
+}
+
+void homcull_buffer_destroy(homcull_buffer* buffer) {
+    if (buffer) capi::unplace(buffer);
+}
+
+homcull_result homcull_buffer_set_resolution(homcull_buffer* b, int32_t width, int32_t height) {
+    const char* const fn = "homcull_buffer_set_resolution";
+    if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
+    const BufferConfig& now = b->buffer.config();
+    const homcull_result valid = check_config(b->account.context, fn, width, height, now.samples, now.near_w);
+    if (valid != HOMCULL_OK) return valid;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        BufferConfig config = now;
+        config.width = width;
+        config.height = height;
+        b->buffer.configure(config);  // leaves the buffer as it was when it throws
+        b->frame_begun = false;
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_set_near(homcull_buffer* b, float near_distance) {
+    const char* const fn = "homcull_buffer_set_near";
+    if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
+    const BufferConfig& now = b->buffer.config();
+    const homcull_result valid = check_config(b->account.context, fn, now.width, now.height, now.samples, near_distance);
+    if (valid != HOMCULL_OK) return valid;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        b->buffer.set_near_w(near_distance);
+        b->frame_begun = false;
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_reserve(homcull_buffer* b, const homcull_reserve_desc* desc) {
+    const char* const fn = "homcull_buffer_reserve";
+    if (!b || !desc) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer or desc is null", fn);
+    const BufferConfig& now = b->buffer.config();
+    const int width = std::max(now.width, desc->max_width), height = std::max(now.height, desc->max_height);
+    const homcull_result valid = check_config(b->account.context, fn, width, height, now.samples, now.near_w);
+    if (valid != HOMCULL_OK) return valid;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        BufferReserve r;
+        r.max_width = width;
+        r.max_height = height;
+        r.max_triangles = desc->max_draw_triangles;
+        r.max_vertices = desc->max_draw_vertices;
+        // A mesh's clusters hold at least one triangle each, and at most the limits' vertices
+        // plus a copy of each triangle's three apexes (OccluderClusters::edge_apexes).
+        r.max_clusters = desc->max_draw_triangles;
+        const ClusterLimits limits;
+        r.max_cluster_vertices = desc->max_draw_triangles > 0 ? limits.max_vertices + 3 * limits.max_triangles : 0;
+        b->buffer.reserve(r);
+        return HOMCULL_OK;
+    });
+}
+
+uint64_t homcull_buffer_allocated_bytes(const homcull_buffer* b) { return b ? b->account.bytes.load() : 0; }
+
+homcull_result homcull_buffer_begin_frame(homcull_buffer* b, const homcull_view* view) {
+    const char* const fn = "homcull_buffer_begin_frame";
+    if (!b || !view) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer or view is null", fn);
+    capi::ViewConventions conventions;
+    const homcull_result r = capi::read_view(b->account.context, *view, conventions);
+    if (r != HOMCULL_OK) {
+        b->frame_begun = false;  // answers nothing until a frame begins
+        return r;
+    }
+    b->buffer.clear();  // allocates nothing
+    b->view = *view;
+    b->clip_from_world = conventions.clip_from_world;
+    b->backface = conventions.backface;
+    b->far_plane = conventions.far_plane;
+    b->far_row = conventions.far_row;
+    b->frame_begun = true;
+    b->draw_calls = 0;
+    b->allocations_at_frame = b->account.allocations.load();
+    return HOMCULL_OK;
+}
+
+homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* mesh, const float* model_matrices, size_t instance_count) {
+    const char* const fn = "homcull_buffer_draw_mesh";
+    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    const homcull_context* context = b->account.context;
+    if (!mesh) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: mesh is null", fn);
+    if (!model_matrices && instance_count > 1)
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: %zu instances need their model matrices", fn, instance_count);
+    for (std::size_t i = 0; model_matrices && i < instance_count; ++i)
+        if (!finite_matrix(model_matrices + 16 * i))
+            return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: model matrix %zu has a number that is not finite", fn, i);
+    ++b->draw_calls;
+    if (mesh->triangle_count == 0) return HOMCULL_OK;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        ClusteredInput in;
+        in.clusters = &mesh->clusters;
+        in.backface = b->backface;
+        for (std::size_t i = 0; i < instance_count; ++i) {
+            in.model_to_clip = capi::float_clip_from_model(b->clip_from_world, read_model(*b, model_matrices ? model_matrices + 16 * i : nullptr));
+            b->buffer.render(in);  // a render that fails leaves what it drew: occluders all, so still conservative
+        }
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_draw_triangles(homcull_buffer* b, const homcull_triangles* triangles, const float* model_matrix) {
+    const char* const fn = "homcull_buffer_draw_triangles";
+    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    TriangleInput in;
+    if (homcull_result r = triangle_input(*b, triangles, model_matrix, fn, in); r != HOMCULL_OK) return r;
+    ++b->draw_calls;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        b->buffer.render(in);
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_test_boxes(const homcull_buffer* b, const homcull_box* boxes, size_t count, const float* model_matrix,
+                                         homcull_visibility* visibility) {
+    const char* const fn = "homcull_buffer_test_boxes";
+    if (count > 0 && !visibility)
+        return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: visibility is null", fn);
+    all_visible(visibility, count);
+    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    if (count > 0 && !boxes) return capi::report(b->account.context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: boxes is null", fn);
+    if (!finite_matrix(model_matrix))
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: model_matrix has a number that is not finite", fn);
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        const glm::dmat4 model = read_model(*b, model_matrix);
+        const std::array<float, 16> clip_from_model = capi::float_clip_from_model(b->clip_from_world, model);
+        const glm::dvec4 far_row = far_row_in_model(*b, model);
+        // The library's boxes (glm) filled from the C ones a block at a time, on the stack.
+        constexpr std::size_t kBlock = 64;
+        Aabb block[kBlock];
+        Visibility answers[kBlock];
+        for (std::size_t base = 0; base < count; base += kBlock) {
+            const std::size_t n = std::min(kBlock, count - base);
+            for (std::size_t k = 0; k < n; ++k) {
+                const homcull_box& c = boxes[base + k];
+                block[k].min = {c.min[0], c.min[1], c.min[2]};
+                block[k].max = {c.max[0], c.max[1], c.max[2]};
+            }
+            b->buffer.test_aabbs(block, n, clip_from_model, answers);
+            for (std::size_t k = 0; k < n; ++k) {
+                homcull_visibility v = as_c(answers[k]);
+                if (v != HOMCULL_VIEW_CULLED && b->far_plane && capi::box_beyond_far(far_row, boxes[base + k].min, boxes[base + k].max))
+                    v = HOMCULL_VIEW_CULLED;
+                visibility[base + k] = v;
+            }
+        }
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_test_rects(const homcull_buffer* b, const homcull_rect* rects, size_t count, homcull_visibility* visibility) {
+    const char* const fn = "homcull_buffer_test_rects";
+    if (count > 0 && !visibility)
+        return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: visibility is null", fn);
+    all_visible(visibility, count);
+    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    if (count > 0 && !rects) return capi::report(b->account.context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: rects is null", fn);
+    const bool y_down = (b->view.flags & HOMCULL_VIEW_Y_DOWN) != 0;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        constexpr std::size_t kBlock = 64;
+        ScreenRect block[kBlock];
+        Visibility answers[kBlock];
+        for (std::size_t base = 0; base < count; base += kBlock) {
+            const std::size_t n = std::min(kBlock, count - base);
+            for (std::size_t k = 0; k < n; ++k) {
+                const homcull_rect& r = rects[base + k];
+                block[k] = y_down ? ScreenRect{r.min_x, -r.max_y, r.max_x, -r.min_y, r.nearest_w}
+                                  : ScreenRect{r.min_x, r.min_y, r.max_x, r.max_y, r.nearest_w};
+            }
+            b->buffer.test_rects(block, n, answers);
+            for (std::size_t k = 0; k < n; ++k) visibility[base + k] = as_c(answers[k]);
+        }
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_test_triangles(const homcull_buffer* b, const homcull_triangles* triangles, const float* model_matrix,
+                                             homcull_visibility* visibility) {
+    const char* const fn = "homcull_buffer_test_triangles";
+    if (!visibility) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: visibility is null", fn);
+    *visibility = HOMCULL_VISIBLE;
+    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    TriangleInput in;
+    if (homcull_result r = triangle_input(*b, triangles, model_matrix, fn, in); r != HOMCULL_OK) return r;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        *visibility = as_c(b->buffer.test_triangles(in).visibility);
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_frame_stats(const homcull_buffer* b, homcull_frame_stats* stats) {
+    const char* const fn = "homcull_buffer_frame_stats";
+    if (!b || !stats) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer or stats is null", fn);
+    const RasterStats& s = b->buffer.stats();
+    stats->triangles_in = s.triangles_in;
+    stats->triangles_drawn = s.rasterized;
+    stats->triangles_skipped = s.invalid + s.outside + s.too_large + s.backface_culled + s.degenerate;
+    stats->clusters_hidden = s.cluster_bands_hidden;
+    stats->draw_calls = b->draw_calls;
+    stats->allocations = b->account.allocations.load() - b->allocations_at_frame;
+    return HOMCULL_OK;
+}
+
+}  // extern "C"

@@ -1,0 +1,316 @@
+/* homcull: the engine-facing interface, in C99.
+ *
+ * A CPU occlusion culler for engines: the engine draws its occluders (registered meshes, or
+ * triangles as they come) into an occlusion buffer, then asks whether boxes, screen rectangles
+ * or occludee triangles are hidden behind them. Answers are conservative: "occluded" only when
+ * every sample of the buffer's grid the occludee could cover holds an occluder certainly
+ * nearer (docs/engine-interface.md has the guarantees and the conventions in full).
+ *
+ * Objects. A context holds the engine's allocator, error callback and instruction set. Meshes
+ * (registered once, at load time) and buffers (one per view) are made from a context and must
+ * be destroyed before it. Every byte the library uses comes from the context's allocator.
+ *
+ * Errors. Every call that can fail returns a homcull_result; no C++ exception ever leaves the
+ * library. The message of the last error on the calling thread is homcull_last_error(), and
+ * the context's error callback receives it too. Out of memory leaves every object usable;
+ * a query that cannot be answered answers HOMCULL_VISIBLE.
+ *
+ * Threads. A context and its meshes may be used from any thread. A buffer's draws, frames and
+ * settings must not overlap any other call on the same buffer; its queries may run on many
+ * threads at once. The library makes no threads.
+ *
+ * Frames cost what they draw. A draw call costs its own triangles plus a few microseconds,
+ * whatever the resolution: drawing occluders object by object, interleaved with queries during
+ * the engine's scene traversal, is as cheap as drawing them in one call. After
+ * homcull_buffer_reserve, no draw within the reserved sizes and no query allocates.
+ */
+#ifndef HOMCULL_H
+#define HOMCULL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define HOMCULL_VERSION_MAJOR 0
+#define HOMCULL_VERSION_MINOR 2
+#define HOMCULL_VERSION_PATCH 0
+/* major * 10000 + minor * 100 + patch, as homcull_version() returns it. */
+#define HOMCULL_VERSION (HOMCULL_VERSION_MAJOR * 10000 + HOMCULL_VERSION_MINOR * 100 + HOMCULL_VERSION_PATCH)
+
+/* HOMCULL_API marks the exported functions. Define HOMCULL_STATIC when linking the static
+ * library on Windows. Everything else in the library has hidden visibility. */
+#if defined(_WIN32) && !defined(HOMCULL_STATIC)
+#  if defined(HOMCULL_BUILDING)
+#    define HOMCULL_API __declspec(dllexport)
+#  else
+#    define HOMCULL_API __declspec(dllimport)
+#  endif
+#elif defined(__GNUC__)
+#  define HOMCULL_API __attribute__((visibility("default")))
+#else
+#  define HOMCULL_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- Results ------------------------------------------------------------------------------ */
+
+typedef int32_t homcull_result;
+enum {
+    HOMCULL_OK = 0,
+    HOMCULL_ERROR_INVALID_ARGUMENT = 1,  /* a null pointer, a number out of range, a malformed mesh */
+    HOMCULL_ERROR_OUT_OF_MEMORY = 2,     /* the allocator returned null: the object is unchanged or conservative */
+    HOMCULL_ERROR_UNSUPPORTED = 3,       /* an instruction set this CPU or build lacks */
+    HOMCULL_ERROR_INVALID_OPERATION = 4, /* a call out of order: a query or draw before the first frame */
+    HOMCULL_ERROR_INTERNAL = 5           /* a bug: please report it with the message */
+};
+/* A constant name for a result ("HOMCULL_ERROR_OUT_OF_MEMORY"), never null. */
+HOMCULL_API const char* homcull_result_name(homcull_result result);
+/* The message of the last call that failed on this thread ("" when none): what went wrong and
+ * with which argument. Valid until the next failing call on this thread. */
+HOMCULL_API const char* homcull_last_error(void);
+
+/* ---- Version and instruction sets --------------------------------------------------------- */
+
+/* HOMCULL_VERSION of the library linked: compare with the header's to catch a mismatch. */
+HOMCULL_API uint32_t homcull_version(void);
+
+typedef int32_t homcull_isa;
+enum {
+    HOMCULL_ISA_BEST = 0,   /* the best this CPU supports */
+    HOMCULL_ISA_SCALAR = 1, /* the plain reference path (no SIMD) */
+    HOMCULL_ISA_SSE4 = 2,
+    HOMCULL_ISA_AVX2 = 3,
+    HOMCULL_ISA_AVX512 = 4,
+    HOMCULL_ISA_NEON = 5,
+    HOMCULL_ISA_SVE = 6,
+    HOMCULL_ISA_SVE2 = 7,
+    HOMCULL_ISA_EMU128 = 8, /* Highway's portable 128-bit emulation */
+    HOMCULL_ISA_COUNT = 9
+};
+/* Bit (1u << isa) set for every instruction set this CPU and build can run (SCALAR always).
+ * Every one gives the same bits. */
+HOMCULL_API uint32_t homcull_supported_isas(void);
+/* "avx2", "scalar", ...; "unknown" out of range. */
+HOMCULL_API const char* homcull_isa_name(homcull_isa isa);
+
+/* ---- Context -------------------------------------------------------------------------------- */
+
+/* The engine's memory. allocate returns size bytes aligned to alignment (a power of two, at most
+ * 64) or null; deallocate frees what allocate returned (never null). Called from any thread that
+ * calls the library. Both null: the C library's aligned_alloc and free. */
+typedef struct homcull_allocator {
+    void* (*allocate)(void* user, size_t size, size_t alignment);
+    void (*deallocate)(void* user, void* memory);
+    void* user;
+} homcull_allocator;
+
+/* Called on the failing thread before the call returns its error. */
+typedef void (*homcull_error_callback)(void* user, homcull_result result, const char* message);
+
+typedef struct homcull_context_desc {
+    homcull_allocator allocator;
+    homcull_error_callback on_error; /* may be null */
+    void* error_user;
+    homcull_isa isa;                 /* HOMCULL_ISA_BEST, or one of homcull_supported_isas() */
+    uint32_t reserved;               /* 0 */
+} homcull_context_desc;
+
+typedef struct homcull_context homcull_context;
+
+HOMCULL_API homcull_result homcull_context_create(const homcull_context_desc* desc, homcull_context** out);
+/* Null is ignored. Its meshes and buffers must be destroyed first. */
+HOMCULL_API void homcull_context_destroy(homcull_context* context);
+/* The instruction set the context's calls run (BEST resolved). */
+HOMCULL_API homcull_isa homcull_context_isa(const homcull_context* context);
+/* Bytes the context's objects hold from its allocator right now. */
+HOMCULL_API uint64_t homcull_context_allocated_bytes(const homcull_context* context);
+
+/* ---- Meshes: occluder geometry registered once ------------------------------------------------ */
+
+typedef struct homcull_mesh_desc {
+    const float* positions;   /* x, y, z at the start of every position_stride bytes */
+    size_t position_stride;   /* bytes, at least 12 */
+    size_t vertex_count;
+    const void* indices;      /* index_size bytes each, 3 per triangle; null: vertices 3t, 3t+1, 3t+2 */
+    uint32_t index_size;      /* 2 or 4 (ignored without indices) */
+    uint32_t reserved;        /* 0 */
+    size_t triangle_count;
+} homcull_mesh_desc;
+
+typedef struct homcull_mesh homcull_mesh;
+
+/* Copies the mesh, finds the edges its triangles share (drawn without a coverage margin where
+ * the neighbour lies across the edge in the view, so that the mesh leaves no cracks) and splits
+ * it into clusters of nearby triangles (skipped as a whole when outside the view or hidden).
+ * Load time: allocates about 200 bytes a triangle. An index out of range is an error. */
+HOMCULL_API homcull_result homcull_mesh_create(homcull_context* context, const homcull_mesh_desc* desc, homcull_mesh** out);
+HOMCULL_API void homcull_mesh_destroy(homcull_mesh* mesh);
+HOMCULL_API size_t homcull_mesh_triangle_count(const homcull_mesh* mesh);
+
+/* ---- Conventions --------------------------------------------------------------------------- */
+
+/* How the 16 numbers of a matrix are stored. The matrix maps column vectors: clip = M * p.
+ * COLUMN_MAJOR: element (row r, column c) at [4c + r] (glm, OpenGL, Vulkan, and DirectXMath's
+ * XMMATRIX, whose row-vector convention stores the same numbers); ROW_MAJOR: at [4r + c]. */
+typedef int32_t homcull_matrix_layout;
+enum { HOMCULL_COLUMN_MAJOR = 0, HOMCULL_ROW_MAJOR = 1 };
+
+/* The clip-space depth range of the projection: OpenGL's z/w in [-1, 1], or D3D's, Vulkan's and
+ * Metal's [0, 1]. With reversed depth the far plane is at -1 (or 0) and the near one at 1. */
+typedef int32_t homcull_depth_range;
+enum { HOMCULL_DEPTH_MINUS_ONE_TO_ONE = 0, HOMCULL_DEPTH_ZERO_TO_ONE = 1 };
+
+typedef int32_t homcull_winding;
+enum { HOMCULL_FRONT_CCW = 0, HOMCULL_FRONT_CW = 1 };
+
+typedef int32_t homcull_cull;
+enum { HOMCULL_CULL_BACK = 0, HOMCULL_CULL_NONE = 1, HOMCULL_CULL_FRONT = 2 };
+
+enum {
+    HOMCULL_VIEW_REVERSED_Z = 1u,  /* depth runs from 1 (near) to 0 or -1 (far) */
+    HOMCULL_VIEW_INFINITE_FAR = 2u,/* no far plane: nothing is culled for its distance */
+    HOMCULL_VIEW_Y_DOWN = 4u       /* clip y points down the screen (Vulkan without a flipped viewport) */
+};
+
+/* A frame's camera. The projection must be a perspective one whose clip w is the view depth
+ * (every standard perspective matrix, left- or right-handed, reversed or infinite); clip w at
+ * least the buffer's near distance is in front of the near plane. Orthographic projections are
+ * not supported yet: HOMCULL_ERROR_UNSUPPORTED.
+ * The winding is the one the engine's own rasterizer calls front, as it sees the screen. */
+typedef struct homcull_view {
+    double world_to_clip[16];       /* projection * view, in `layout` */
+    homcull_matrix_layout layout;   /* of world_to_clip and of every model matrix drawn or tested */
+    homcull_depth_range depth_range;
+    homcull_winding front_face;
+    homcull_cull cull;              /* which occluder faces are not drawn */
+    uint32_t flags;                 /* HOMCULL_VIEW_* */
+    uint32_t reserved;              /* 0 */
+} homcull_view;
+
+/* ---- Buffers --------------------------------------------------------------------------------- */
+
+enum {
+    HOMCULL_BUFFER_SAMPLE_DEPTH = 1u /* keep a depth per sample too: tighter occludee-triangle tests, 4 bytes a sample */
+};
+
+typedef struct homcull_buffer_desc {
+    int32_t width, height;  /* pixels, 1 to 65536 */
+    int32_t samples;        /* S x S samples per pixel: 1, 2 or 4 */
+    float near_distance;    /* clip w of the near plane (the camera's near distance), at least 2^-126 */
+    uint32_t flags;         /* HOMCULL_BUFFER_* */
+    uint32_t reserved;      /* 0 */
+} homcull_buffer_desc;
+
+/* The largest work the engine will give a buffer: after homcull_buffer_reserve, frames within
+ * these sizes never allocate. Zeros keep what the buffer already holds. */
+typedef struct homcull_reserve_desc {
+    int32_t max_width, max_height;  /* largest resolution set_resolution will be asked for */
+    size_t max_draw_triangles;      /* the most triangles one draw call carries (an instanced draw: per instance) */
+    size_t max_draw_vertices;       /* the most vertices one homcull_buffer_draw_triangles call carries */
+} homcull_reserve_desc;
+
+typedef struct homcull_buffer homcull_buffer;
+
+HOMCULL_API homcull_result homcull_buffer_create(homcull_context* context, const homcull_buffer_desc* desc, homcull_buffer** out);
+HOMCULL_API void homcull_buffer_destroy(homcull_buffer* buffer);
+/* A new resolution or near distance, keeping the memory the buffer holds (it grows only when the
+ * new resolution needs more than it ever had or was reserved). The buffer is then empty until
+ * the next frame begins. On error the buffer keeps its old settings. */
+HOMCULL_API homcull_result homcull_buffer_set_resolution(homcull_buffer* buffer, int32_t width, int32_t height);
+HOMCULL_API homcull_result homcull_buffer_set_near(homcull_buffer* buffer, float near_distance);
+HOMCULL_API homcull_result homcull_buffer_reserve(homcull_buffer* buffer, const homcull_reserve_desc* desc);
+/* Bytes of the context's allocator the buffer holds, and how many allocations it has made. */
+HOMCULL_API uint64_t homcull_buffer_allocated_bytes(const homcull_buffer* buffer);
+
+/* Starts a frame: empties the buffer and takes the camera. */
+HOMCULL_API homcull_result homcull_buffer_begin_frame(homcull_buffer* buffer, const homcull_view* view);
+
+/* Draws a registered mesh as occluder, once per model matrix (model to world, 16 floats each in
+ * the view's layout, instance_count of them; null with instance_count 1: the identity). Each
+ * instance is composed with the view in double and drawn nearest cluster first. Occluders drawn
+ * nearest first cull best (what is behind drawn occluders is skipped cheaply). */
+HOMCULL_API homcull_result homcull_buffer_draw_mesh(homcull_buffer* buffer, const homcull_mesh* mesh, const float* model_matrices,
+                                                    size_t instance_count);
+
+/* Triangles given for one call (not registered): occluders, or occludees to test. */
+typedef struct homcull_triangles {
+    const float* positions;   /* x, y, z at the start of every position_stride bytes */
+    size_t position_stride;   /* bytes, at least 12 */
+    size_t vertex_count;
+    const void* indices;      /* index_size bytes each, 3 per triangle; null: vertices 3t, 3t+1, 3t+2 */
+    uint32_t index_size;      /* 2 or 4 */
+    uint32_t reserved;        /* 0 */
+    size_t triangle_count;
+} homcull_triangles;
+
+/* Draws triangles as occluder under a model matrix (null: identity), with a coverage margin on
+ * every edge (no shared-edge information: register meshes to draw them without cracks). */
+HOMCULL_API homcull_result homcull_buffer_draw_triangles(homcull_buffer* buffer, const homcull_triangles* triangles,
+                                                         const float* model_matrix);
+
+/* ---- Queries ------------------------------------------------------------------------------------ */
+
+typedef uint8_t homcull_visibility;
+enum {
+    HOMCULL_VISIBLE = 0,     /* may be seen (and every answer the library cannot give) */
+    HOMCULL_OCCLUDED = 1,    /* hidden behind the occluders drawn so far in this frame */
+    HOMCULL_VIEW_CULLED = 2  /* outside the view frustum (beyond the far plane too) */
+};
+
+typedef struct homcull_box {
+    float min[3];
+    float max[3];
+} homcull_box;
+
+/* A screen rectangle in normalized device coordinates (in the view's y direction) and the
+ * nearest view depth (clip w) of what it stands for. */
+typedef struct homcull_rect {
+    float min_x, min_y, max_x, max_y;
+    float nearest_w;
+} homcull_rect;
+
+/* Boxes (in model space of model_matrix; null: world boxes), count of them, answers into
+ * visibility[count]. A box crossing the near plane is visible; one wholly beyond the far plane
+ * (unless the view has none) or outside a side plane is view-culled. Answers account for every
+ * occluder drawn in this frame before the call. Thread-safe with other queries. */
+HOMCULL_API homcull_result homcull_buffer_test_boxes(const homcull_buffer* buffer, const homcull_box* boxes, size_t count,
+                                                     const float* model_matrix, homcull_visibility* visibility);
+HOMCULL_API homcull_result homcull_buffer_test_rects(const homcull_buffer* buffer, const homcull_rect* rects, size_t count,
+                                                     homcull_visibility* visibility);
+/* An occludee by its own triangles, sample by sample: occluded when no sample any of its
+ * triangles may cover (either side facing) has no occluder certainly nearer. */
+HOMCULL_API homcull_result homcull_buffer_test_triangles(const homcull_buffer* buffer, const homcull_triangles* triangles,
+                                                         const float* model_matrix, homcull_visibility* visibility);
+
+/* What the frame drew so far. */
+typedef struct homcull_frame_stats {
+    uint64_t triangles_in;       /* submitted (instances counted each) */
+    uint64_t triangles_drawn;    /* reached the buffer (after clipping) */
+    uint64_t triangles_skipped;  /* outside the view, back-facing, degenerate, invalid or too large */
+    uint64_t clusters_hidden;    /* cluster and band pairs skipped as hidden behind what was drawn */
+    uint64_t draw_calls;
+    uint64_t allocations;        /* allocations the buffer made during this frame (0 after a reserve) */
+} homcull_frame_stats;
+HOMCULL_API homcull_result homcull_buffer_frame_stats(const homcull_buffer* buffer, homcull_frame_stats* stats);
+
+/* ---- Layout checks: the sizes both sides of the interface agree on ---------------------------- */
+
+#define HOMCULL_CHECK_SIZE_(name, type, size) typedef char homcull_size_check_##name[(sizeof(type) == (size)) ? 1 : -1]
+HOMCULL_CHECK_SIZE_(box, homcull_box, 24);
+HOMCULL_CHECK_SIZE_(rect, homcull_rect, 20);
+HOMCULL_CHECK_SIZE_(view, homcull_view, 152);
+HOMCULL_CHECK_SIZE_(buffer_desc, homcull_buffer_desc, 24);
+HOMCULL_CHECK_SIZE_(frame_stats, homcull_frame_stats, 48);
+HOMCULL_CHECK_SIZE_(allocator, homcull_allocator, 3 * sizeof(void*));
+HOMCULL_CHECK_SIZE_(context_desc, homcull_context_desc, 5 * sizeof(void*) + 8);
+HOMCULL_CHECK_SIZE_(mesh_desc, homcull_mesh_desc, 5 * sizeof(void*) + 8);
+HOMCULL_CHECK_SIZE_(triangles, homcull_triangles, 5 * sizeof(void*) + 8);
+HOMCULL_CHECK_SIZE_(reserve_desc, homcull_reserve_desc, 8 + 2 * sizeof(size_t));
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* HOMCULL_H */

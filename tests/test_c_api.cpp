@@ -1,0 +1,378 @@
+// The C interface (homcull.h) from C++: results instead of exceptions, per-context instruction
+// sets, camera conventions, memory from the engine only (no allocation after a reserve), and
+// out-of-memory at every allocation. The C99 engine host (tests/c_host) drives it on the castle.
+#include <homcull/homcull.h>
+
+#include <homcull/occlusion_buffer.hpp>
+
+#include <gtest/gtest.h>
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/glm.hpp>
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace {
+
+// An engine's allocator: counts, and fails the allocation number `fail_at` (1-based; 0: never).
+struct EngineMemory {
+    std::size_t calls = 0, live = 0, fail_at = 0;
+    static void* allocate(void* user, std::size_t size, std::size_t alignment) {
+        auto& m = *static_cast<EngineMemory*>(user);
+        if (++m.calls == m.fail_at) return nullptr;
+        void* p = std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+        if (p) ++m.live;
+        return p;
+    }
+    static void deallocate(void* user, void* p) {
+        --static_cast<EngineMemory*>(user)->live;
+        std::free(p);
+    }
+    homcull_allocator allocator() { return {allocate, deallocate, this}; }
+};
+
+struct ErrorLog {
+    std::vector<std::string> messages;
+    static void on_error(void* user, homcull_result, const char* message) { static_cast<ErrorLog*>(user)->messages.push_back(message); }
+};
+
+homcull_context* make_context(EngineMemory* memory = nullptr, homcull_isa isa = HOMCULL_ISA_BEST, ErrorLog* log = nullptr) {
+    homcull_context_desc desc{};
+    if (memory) desc.allocator = memory->allocator();
+    desc.isa = isa;
+    if (log) desc.on_error = ErrorLog::on_error, desc.error_user = log;
+    homcull_context* context = nullptr;
+    EXPECT_EQ(homcull_context_create(&desc, &context), HOMCULL_OK) << homcull_last_error();
+    return context;
+}
+
+// A small world with answers known by construction, seen from the origin looking down -z
+// (right-handed, y up): a wall of 2 x 2 quads at z = -10 over x in [-20, 5] and y in [-20, 20]
+// (CCW towards the camera), covering the view but for a strip on the right, and boxes.
+struct Scene {
+    std::vector<float> positions;
+    std::vector<std::uint16_t> indices;
+    std::vector<homcull_box> boxes;
+    std::vector<homcull_visibility> expected;  // with a far plane at 100
+    Scene() {
+        // Its inner vertex is off the screen's centre: a vertex on a sample centre leaves that
+        // sample unclaimed (docs/occlusion-buffer.md, rule 2), which would open a hole there.
+        const float xs[3] = {-20.0f, -7.5f, 5.0f}, ys[3] = {-20.0f, 1.3f, 20.0f};
+        for (int y = 0; y <= 2; ++y)
+            for (int x = 0; x <= 2; ++x) positions.insert(positions.end(), {xs[x], ys[y], -10.0f});
+        for (int y = 0; y < 2; ++y)
+            for (int x = 0; x < 2; ++x) {
+                const auto a = std::uint16_t(3 * y + x), b = std::uint16_t(a + 1), c = std::uint16_t(a + 3), d = std::uint16_t(a + 4);
+                indices.insert(indices.end(), {a, b, d, a, d, c});
+            }
+        add({-1, -1, -30}, {1, 1, -28}, HOMCULL_OCCLUDED);     // behind the wall
+        add({-3, 2, -15}, {-1, 4, -11}, HOMCULL_OCCLUDED);     // just behind it
+        add({-1, -1, -8}, {1, 1, -6}, HOMCULL_VISIBLE);        // in front of it
+        add({-1, -1, -0.5f}, {1, 1, 0.5f}, HOMCULL_VISIBLE);   // across the near plane
+        add({-1, -1, 5}, {1, 1, 7}, HOMCULL_VIEW_CULLED);      // behind the camera
+        add({200, -1, -30}, {202, 1, -28}, HOMCULL_VIEW_CULLED);  // far off to the side
+        add({-1, -1, -300}, {1, 1, -290}, HOMCULL_VIEW_CULLED);  // beyond the far plane (hidden by the wall too)
+        add({30, -1, -30}, {32, 1, -28}, HOMCULL_VISIBLE);     // right of the wall
+    }
+    void add(glm::vec3 lo, glm::vec3 hi, homcull_visibility v) {
+        boxes.push_back({{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}});
+        expected.push_back(v);
+    }
+    homcull_mesh_desc mesh_desc() const {
+        homcull_mesh_desc d{};
+        d.positions = positions.data();
+        d.position_stride = 12;
+        d.vertex_count = positions.size() / 3;
+        d.indices = indices.data();
+        d.index_size = 2;
+        d.triangle_count = indices.size() / 3;
+        return d;
+    }
+};
+
+constexpr double kNear = 0.1, kFar = 100.0, kFovY = glm::radians(60.0), kAspect = 16.0 / 9.0;
+
+void store(const glm::dmat4& m, homcull_matrix_layout layout, double out[16]) {
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) out[layout == HOMCULL_ROW_MAJOR ? 4 * r + c : 4 * c + r] = m[c][r];
+}
+
+// The scene's camera as engines of different conventions would give it.
+enum class Engine { opengl, d3d_reversed_lh, d3d_reversed_infinite_lh, vulkan_y_down };
+homcull_view engine_view(Engine e) {
+    homcull_view v{};
+    v.front_face = HOMCULL_FRONT_CCW;
+    v.cull = HOMCULL_CULL_BACK;
+    const glm::dmat4 rh_view = glm::lookAtRH(glm::dvec3(0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
+    // The left-handed engine keeps the world with z mirrored (as it imported it): world_to_clip
+    // takes the scene's positions through that mirror, then its own view (looking down its +z).
+    const glm::dmat4 mirror_z = glm::scale(glm::dmat4(1.0), glm::dvec3(1, 1, -1));
+    const glm::dmat4 lh_view = glm::lookAtLH(glm::dvec3(0), glm::dvec3(0, 0, 1), glm::dvec3(0, 1, 0)) * mirror_z;
+    glm::dmat4 m(1.0);
+    switch (e) {
+        case Engine::opengl:
+            m = glm::perspectiveRH_NO(kFovY, kAspect, kNear, kFar) * rh_view;
+            v.layout = HOMCULL_COLUMN_MAJOR, v.depth_range = HOMCULL_DEPTH_MINUS_ONE_TO_ONE;
+            break;
+        case Engine::d3d_reversed_lh: {
+            // Reversed depth: z' = w - z of the [0, 1] projection (near at 1, far at 0).
+            glm::dmat4 r(1.0);  // row 2 = (0, 0, -1, 1)
+            r[2] = glm::dvec4(0, 0, -1, 0);
+            r[3] = glm::dvec4(0, 0, 1, 1);
+            m = r * glm::perspectiveLH_ZO(kFovY, kAspect, kNear, kFar) * lh_view;
+            v.layout = HOMCULL_ROW_MAJOR, v.depth_range = HOMCULL_DEPTH_ZERO_TO_ONE, v.flags = HOMCULL_VIEW_REVERSED_Z;
+            break;
+        }
+        case Engine::d3d_reversed_infinite_lh: {
+            // Infinite reversed: clip z = near, w = view depth.
+            const double f = 1.0 / std::tan(kFovY / 2);
+            glm::dmat4 p(0.0);
+            p[0][0] = f / kAspect, p[1][1] = f, p[3][2] = kNear, p[2][3] = 1.0;
+            m = p * lh_view;
+            v.layout = HOMCULL_ROW_MAJOR, v.depth_range = HOMCULL_DEPTH_ZERO_TO_ONE, v.flags = HOMCULL_VIEW_REVERSED_Z | HOMCULL_VIEW_INFINITE_FAR;
+            break;
+        }
+        case Engine::vulkan_y_down: {
+            glm::dmat4 flip(1.0);
+            flip[1][1] = -1.0;
+            m = flip * glm::perspectiveRH_ZO(kFovY, kAspect, kNear, kFar) * rh_view;
+            v.layout = HOMCULL_COLUMN_MAJOR, v.depth_range = HOMCULL_DEPTH_ZERO_TO_ONE, v.flags = HOMCULL_VIEW_Y_DOWN;
+            break;
+        }
+    }
+    store(m, v.layout, v.world_to_clip);
+    return v;
+}
+
+struct Culler {
+    homcull_context* context = nullptr;
+    homcull_mesh* mesh = nullptr;
+    homcull_buffer* buffer = nullptr;
+    explicit Culler(const Scene& scene, homcull_context* c, int width = 320, int height = 180) : context(c) {
+        const homcull_mesh_desc md = scene.mesh_desc();
+        EXPECT_EQ(homcull_mesh_create(context, &md, &mesh), HOMCULL_OK) << homcull_last_error();
+        homcull_buffer_desc bd{width, height, 1, float(kNear), 0, 0};
+        EXPECT_EQ(homcull_buffer_create(context, &bd, &buffer), HOMCULL_OK) << homcull_last_error();
+    }
+    ~Culler() {
+        homcull_buffer_destroy(buffer);
+        homcull_mesh_destroy(mesh);
+        homcull_context_destroy(context);
+    }
+    std::vector<homcull_visibility> frame(const Scene& scene, const homcull_view& view) {
+        std::vector<homcull_visibility> answers(scene.boxes.size(), 99);
+        EXPECT_EQ(homcull_buffer_begin_frame(buffer, &view), HOMCULL_OK) << homcull_last_error();
+        EXPECT_EQ(homcull_buffer_draw_mesh(buffer, mesh, nullptr, 1), HOMCULL_OK) << homcull_last_error();
+        EXPECT_EQ(homcull_buffer_test_boxes(buffer, scene.boxes.data(), scene.boxes.size(), nullptr, answers.data()), HOMCULL_OK)
+            << homcull_last_error();
+        return answers;
+    }
+};
+
+TEST(CApi, VersionNamesAndInstructionSets) {
+    EXPECT_EQ(homcull_version(), std::uint32_t(HOMCULL_VERSION));
+    EXPECT_STREQ(homcull_result_name(HOMCULL_ERROR_OUT_OF_MEMORY), "HOMCULL_ERROR_OUT_OF_MEMORY");
+    EXPECT_STREQ(homcull_result_name(12345), "HOMCULL_ERROR_UNKNOWN");
+    const std::uint32_t isas = homcull_supported_isas();
+    EXPECT_TRUE(isas & (1u << HOMCULL_ISA_BEST));
+    EXPECT_TRUE(isas & (1u << HOMCULL_ISA_SCALAR));
+    EXPECT_STREQ(homcull_isa_name(HOMCULL_ISA_AVX2), "avx2");
+    EXPECT_STREQ(homcull_isa_name(-1), "unknown");
+    // The names agree with the C++ list of what this machine runs.
+    for (const std::string& name : homcull::available_isas()) {
+        bool found = false;
+        for (homcull_isa i = 1; i < HOMCULL_ISA_COUNT; ++i) found |= name == homcull_isa_name(i) && (isas & (1u << i));
+        EXPECT_TRUE(found || name == "sve2_128" || name == "sve_256") << name;
+    }
+}
+
+TEST(CApi, ErrorsAreResultsWithMessages) {
+    ErrorLog log;
+    homcull_context* context = make_context(nullptr, HOMCULL_ISA_BEST, &log);
+    homcull_buffer* buffer = nullptr;
+    homcull_buffer_desc bad{0, 10, 1, 0.1f, 0, 0};
+    EXPECT_EQ(homcull_buffer_create(context, &bad, &buffer), HOMCULL_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(buffer, nullptr);
+    EXPECT_NE(std::string(homcull_last_error()).find("resolution 0x10"), std::string::npos) << homcull_last_error();
+    ASSERT_EQ(log.messages.size(), 1u);
+    EXPECT_EQ(log.messages[0], homcull_last_error());
+    bad = {64, 36, 3, 0.1f, 0, 0};
+    EXPECT_EQ(homcull_buffer_create(context, &bad, &buffer), HOMCULL_ERROR_INVALID_ARGUMENT);
+    bad = {64, 36, 1, std::nanf(""), 0, 0};
+    EXPECT_EQ(homcull_buffer_create(context, &bad, &buffer), HOMCULL_ERROR_INVALID_ARGUMENT);
+
+    const homcull_buffer_desc good{64, 36, 1, 0.1f, 0, 0};
+    ASSERT_EQ(homcull_buffer_create(context, &good, &buffer), HOMCULL_OK);
+    // Queries before a frame: an error, and every answer visible.
+    Scene scene;
+    std::vector<homcull_visibility> answers(scene.boxes.size(), HOMCULL_OCCLUDED);
+    EXPECT_EQ(homcull_buffer_test_boxes(buffer, scene.boxes.data(), answers.size(), nullptr, answers.data()), HOMCULL_ERROR_INVALID_OPERATION);
+    for (homcull_visibility v : answers) EXPECT_EQ(v, HOMCULL_VISIBLE);
+    // A mesh index out of range; an orthographic camera; a matrix with a NaN.
+    homcull_mesh_desc md = scene.mesh_desc();
+    std::vector<std::uint16_t> indices = scene.indices;
+    indices[4] = 9;
+    md.indices = indices.data();
+    homcull_mesh* mesh = nullptr;
+    EXPECT_EQ(homcull_mesh_create(context, &md, &mesh), HOMCULL_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(homcull_last_error()).find("index 9 of triangle 1"), std::string::npos) << homcull_last_error();
+    homcull_view ortho = engine_view(Engine::opengl);
+    store(glm::orthoRH_NO(-10.0, 10.0, -10.0, 10.0, 0.1, 100.0), HOMCULL_COLUMN_MAJOR, ortho.world_to_clip);
+    EXPECT_EQ(homcull_buffer_begin_frame(buffer, &ortho), HOMCULL_ERROR_UNSUPPORTED);
+    homcull_view nan_view = engine_view(Engine::opengl);
+    nan_view.world_to_clip[5] = std::nan("");
+    EXPECT_EQ(homcull_buffer_begin_frame(buffer, &nan_view), HOMCULL_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(homcull_buffer_draw_mesh(buffer, nullptr, nullptr, 1), HOMCULL_ERROR_INVALID_OPERATION);  // no frame began
+    homcull_buffer_destroy(buffer);
+    homcull_context_destroy(context);
+
+    homcull_context_desc desc{};
+    desc.isa = 77;
+    homcull_context* none = nullptr;
+    EXPECT_EQ(homcull_context_create(&desc, &none), HOMCULL_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(none, nullptr);
+    EXPECT_EQ(homcull_context_create(nullptr, &none), HOMCULL_ERROR_INVALID_ARGUMENT);
+}
+
+// The same camera in four engines' conventions gives the answers known by construction.
+TEST(CApi, EngineConventionsGiveTheSameAnswers) {
+    const Scene scene;
+    for (Engine e : {Engine::opengl, Engine::d3d_reversed_lh, Engine::d3d_reversed_infinite_lh, Engine::vulkan_y_down}) {
+        Culler culler(scene, make_context());
+        const std::vector<homcull_visibility> answers = culler.frame(scene, engine_view(e));
+        for (std::size_t k = 0; k < answers.size(); ++k) {
+            homcull_visibility expected = scene.expected[k];
+            if (e == Engine::d3d_reversed_infinite_lh && k == 6) expected = HOMCULL_OCCLUDED;  // no far plane: the wall hides it
+            EXPECT_EQ(answers[k], expected) << "engine " << int(e) << ", box " << k;
+        }
+    }
+}
+
+// Back faces are named by the engine's winding: the wall faces the camera counter-clockwise.
+TEST(CApi, FrontFaceWindingDecidesWhatIsCulled) {
+    const Scene scene;
+    for (Engine e : {Engine::opengl, Engine::d3d_reversed_lh, Engine::vulkan_y_down})
+        for (homcull_winding front : {HOMCULL_FRONT_CCW, HOMCULL_FRONT_CW})
+            for (homcull_cull cull : {HOMCULL_CULL_BACK, HOMCULL_CULL_FRONT, HOMCULL_CULL_NONE}) {
+                Culler culler(scene, make_context());
+                homcull_view view = engine_view(e);
+                view.front_face = front;
+                view.cull = cull;
+                const bool wall_is_front = front == HOMCULL_FRONT_CCW;
+                const bool wall_drawn = cull == HOMCULL_CULL_NONE || (cull == HOMCULL_CULL_BACK) == wall_is_front;
+                EXPECT_EQ(culler.frame(scene, view)[0], wall_drawn ? HOMCULL_OCCLUDED : HOMCULL_VISIBLE)
+                    << "engine " << int(e) << ", front " << front << ", cull " << cull;
+            }
+}
+
+// Each context runs its own instruction set, leaving the process-wide choice alone, and all give
+// the same answers.
+TEST(CApi, InstructionSetsArePerContext) {
+    const Scene scene;
+    const std::string process_wide = homcull::selected_isa();
+    std::vector<homcull_visibility> first;
+    for (homcull_isa isa = 0; isa < HOMCULL_ISA_COUNT; ++isa) {
+        if (!(homcull_supported_isas() & (1u << isa))) continue;
+        Culler culler(scene, make_context(nullptr, isa));
+        if (isa != HOMCULL_ISA_BEST) {
+            EXPECT_EQ(homcull_context_isa(culler.context), isa);
+        }
+        const auto answers = culler.frame(scene, engine_view(Engine::opengl));
+        if (first.empty()) first = answers;
+        EXPECT_EQ(answers, first) << homcull_isa_name(isa);
+        EXPECT_EQ(homcull::selected_isa(), process_wide);
+    }
+}
+
+// A resolution change keeps the buffer's memory within what it held or reserved; after a
+// reserve, frames allocate nothing; everything is given back.
+TEST(CApi, NoAllocationAfterReserve) {
+    const Scene scene;
+    EngineMemory memory;
+    {
+        Culler culler(scene, make_context(&memory), 320, 180);
+        const homcull_reserve_desc reserve{1280, 720, 64, 64};
+        ASSERT_EQ(homcull_buffer_reserve(culler.buffer, &reserve), HOMCULL_OK) << homcull_last_error();
+        const std::size_t before = memory.calls;
+        for (int k = 0; k < 6; ++k) {
+            const int width = k % 2 ? 1280 : 333, height = k % 2 ? 720 : 97;
+            ASSERT_EQ(homcull_buffer_set_resolution(culler.buffer, width, height), HOMCULL_OK);
+            ASSERT_EQ(homcull_buffer_set_near(culler.buffer, k % 3 ? 0.1f : 0.05f), HOMCULL_OK);
+            const auto answers = culler.frame(scene, engine_view(Engine::opengl));
+            EXPECT_EQ(answers, scene.expected) << width << "x" << height;
+            homcull_frame_stats stats{};
+            ASSERT_EQ(homcull_buffer_frame_stats(culler.buffer, &stats), HOMCULL_OK);
+            EXPECT_EQ(stats.allocations, 0u);
+            EXPECT_EQ(stats.draw_calls, 1u);
+            EXPECT_GT(stats.triangles_drawn, 0u);
+        }
+        EXPECT_EQ(memory.calls, before);
+        EXPECT_GT(homcull_context_allocated_bytes(culler.context), 0u);
+        EXPECT_GT(homcull_buffer_allocated_bytes(culler.buffer), 0u);
+    }
+    EXPECT_EQ(memory.live, 0u);
+}
+
+// Whichever allocation fails, every call returns OK or HOMCULL_ERROR_OUT_OF_MEMORY, nothing
+// leaks, and no answer hides what is visible.
+TEST(CApi, OutOfMemoryAtEveryAllocation) {
+    const Scene scene;
+    EngineMemory counting;
+    {
+        Culler culler(scene, make_context(&counting));
+        culler.frame(scene, engine_view(Engine::opengl));
+    }
+    const std::size_t total = counting.calls;
+    ASSERT_GT(total, 10u);
+    std::size_t failures_seen = 0;
+    for (std::size_t k = 1; k <= total + 1; ++k) {
+        EngineMemory memory;
+        memory.fail_at = k;
+        homcull_context_desc desc{};
+        desc.allocator = memory.allocator();
+        homcull_context* context = nullptr;
+        const homcull_result made = homcull_context_create(&desc, &context);
+        if (made != HOMCULL_OK) {
+            EXPECT_EQ(made, HOMCULL_ERROR_OUT_OF_MEMORY);
+            EXPECT_EQ(memory.live, 0u);
+            ++failures_seen;
+            continue;
+        }
+        const homcull_mesh_desc md = scene.mesh_desc();
+        homcull_mesh* mesh = nullptr;
+        homcull_result r = homcull_mesh_create(context, &md, &mesh);
+        EXPECT_TRUE(r == HOMCULL_OK || r == HOMCULL_ERROR_OUT_OF_MEMORY) << homcull_result_name(r);
+        failures_seen += r != HOMCULL_OK;
+        homcull_buffer_desc bd{320, 180, 1, float(kNear), 0, 0};
+        homcull_buffer* buffer = nullptr;
+        r = homcull_buffer_create(context, &bd, &buffer);
+        EXPECT_TRUE(r == HOMCULL_OK || r == HOMCULL_ERROR_OUT_OF_MEMORY) << homcull_result_name(r);
+        failures_seen += r != HOMCULL_OK;
+        if (buffer) {
+            const homcull_view view = engine_view(Engine::opengl);
+            EXPECT_EQ(homcull_buffer_begin_frame(buffer, &view), HOMCULL_OK);
+            if (mesh) {
+                r = homcull_buffer_draw_mesh(buffer, mesh, nullptr, 1);
+                EXPECT_TRUE(r == HOMCULL_OK || r == HOMCULL_ERROR_OUT_OF_MEMORY) << homcull_result_name(r);
+                failures_seen += r != HOMCULL_OK;
+            }
+            std::vector<homcull_visibility> answers(scene.boxes.size());
+            EXPECT_EQ(homcull_buffer_test_boxes(buffer, scene.boxes.data(), answers.size(), nullptr, answers.data()), HOMCULL_OK);
+            for (std::size_t b = 0; b < answers.size(); ++b) {
+                if (scene.expected[b] == HOMCULL_VISIBLE) {
+                    EXPECT_EQ(answers[b], HOMCULL_VISIBLE) << "failing allocation " << k << ", box " << b;
+                }
+            }
+        }
+        homcull_buffer_destroy(buffer);
+        homcull_mesh_destroy(mesh);
+        homcull_context_destroy(context);
+        EXPECT_EQ(memory.live, 0u) << "failing allocation " << k;
+    }
+    EXPECT_EQ(failures_seen, total);  // every allocation failed once, and was reported
+}
+
+}  // namespace
