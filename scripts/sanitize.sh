@@ -37,7 +37,7 @@ dir="build-$kind"
 generator=()
 if [ ! -f "$dir/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DHOMCULL_BUILD_TESTS=ON \
-  -DHOMCULL_SANITIZE="$kind" -DCMAKE_CXX_FLAGS="$flags -g1" \
+  -DHOMCULL_SANITIZE="$kind" -DCMAKE_CXX_FLAGS="$flags -g1" -DCMAKE_C_FLAGS="$flags -g1" \
   -DCMAKE_EXE_LINKER_FLAGS="$flags" -DCMAKE_SHARED_LINKER_FLAGS="$flags"
 cmake --build "$dir" --parallel "$(nproc)"
 cd "$dir"

@@ -27,7 +27,7 @@ struct EngineMemory {
         if (p) ++m.live;
         return p;
     }
-    static void deallocate(void* user, void* p) {
+    static void deallocate(void* user, void* p, std::size_t) {
         --static_cast<EngineMemory*>(user)->live;
         std::free(p);
     }

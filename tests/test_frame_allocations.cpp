@@ -143,7 +143,7 @@ TEST(FrameAllocations, CInterfaceTakesEveryByteFromTheEngine) {
         ++e.calls, ++e.live;
         return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
     };
-    desc.allocator.deallocate = [](void* user, void* p) {
+    desc.allocator.deallocate = [](void* user, void* p, std::size_t) {
         --static_cast<Engine*>(user)->live;
         std::free(p);
     };

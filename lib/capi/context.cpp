@@ -18,7 +18,7 @@ void* default_allocate(void*, std::size_t size, std::size_t alignment) {
     // aligned_alloc wants a size that is a multiple of the alignment.
     return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
 }
-void default_deallocate(void*, void* memory) { std::free(memory); }
+void default_deallocate(void*, void* memory, std::size_t) { std::free(memory); }
 
 void* account_allocate(void* user, std::size_t size, std::size_t alignment) {
     Account& a = *static_cast<Account*>(user);
@@ -35,7 +35,7 @@ void account_deallocate(void* user, void* memory, std::size_t size) {
     Account& a = *static_cast<Account*>(user);
     a.bytes -= size;
     a.context->bytes -= size;
-    a.context->allocator.deallocate(a.context->allocator.user, memory);
+    a.context->allocator.deallocate(a.context->allocator.user, memory, size);
 }
 
 // The instruction sets of homcull.h by the names select_isa takes.
@@ -57,6 +57,16 @@ homcull_result report(const homcull_context* context, homcull_result result, con
     if (context && context->on_error) context->on_error(context->error_user, result, last_error);
     return result;
 }
+
+namespace {
+
+// homcull_context_create's errors: to the desc's callback, there being no context yet.
+homcull_result report_to(const homcull_context_desc* desc, homcull_result result) {
+    if (desc && desc->on_error) desc->on_error(desc->error_user, result, last_error);
+    return result;
+}
+
+}  // namespace
 
 homcull_result exception_result(const homcull_context* context, const char* function) noexcept {
     try {
@@ -112,30 +122,35 @@ uint32_t homcull_supported_isas(void) {
 const char* homcull_isa_name(homcull_isa isa) { return isa >= 0 && isa < HOMCULL_ISA_COUNT ? capi::kIsaNames[isa] : "unknown"; }
 
 homcull_result homcull_context_create(const homcull_context_desc* desc, homcull_context** out) {
-    if (!out) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_context_create: out is null");
+    const auto fail = [desc](homcull_result r) { return capi::report_to(desc, r); };
+    if (!out) return fail(capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_context_create: out is null"));
     *out = nullptr;
-    if (!desc) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_context_create: desc is null");
+    if (!desc) return fail(capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_context_create: desc is null"));
     if (!desc->allocator.allocate != !desc->allocator.deallocate)
-        return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT,
-                            "homcull_context_create: give both allocate and deallocate, or neither (the C library's then)");
+        return fail(capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT,
+                                 "homcull_context_create: give both allocate and deallocate, or neither (the C library's then)"));
     if (desc->isa < 0 || desc->isa >= HOMCULL_ISA_COUNT)
-        return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_context_create: instruction set %d is not a homcull_isa", int(desc->isa));
+        return fail(capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_context_create: instruction set %d is not a homcull_isa",
+                                 int(desc->isa)));
     if (!(homcull_supported_isas() & (1u << desc->isa)))
-        return capi::report(nullptr, HOMCULL_ERROR_UNSUPPORTED, "homcull_context_create: instruction set '%s' is not available on this CPU or in this build",
-                            capi::kIsaNames[desc->isa]);
+        return fail(capi::report(nullptr, HOMCULL_ERROR_UNSUPPORTED,
+                                 "homcull_context_create: instruction set '%s' is not available on this CPU or in this build",
+                                 capi::kIsaNames[desc->isa]));
     homcull_allocator engine = desc->allocator;
     if (!engine.allocate) engine = {capi::default_allocate, capi::default_deallocate, nullptr};
     void* memory = engine.allocate(engine.user, sizeof(homcull_context), alignof(homcull_context));
-    if (!memory) return capi::report(nullptr, HOMCULL_ERROR_OUT_OF_MEMORY, "homcull_context_create: out of memory (the engine's allocator returned null)");
+    if (!memory)
+        return fail(capi::report(nullptr, HOMCULL_ERROR_OUT_OF_MEMORY, "homcull_context_create: out of memory (the engine's allocator returned null)"));
     homcull_context* context = new (memory) homcull_context(*desc);
     try {
         context->choice = detail::make_isa_choice(capi::kIsaNames[desc->isa]);
     } catch (...) {  // checked above: only a bug gets here
         const homcull_result r = capi::exception_result(nullptr, "homcull_context_create");
         context->~homcull_context();
-        engine.deallocate(engine.user, memory);
-        return r;
+        engine.deallocate(engine.user, memory, sizeof(homcull_context));
+        return fail(r);
     }
+    context->bytes += sizeof(homcull_context);
     *out = context;
     return HOMCULL_OK;
 }
@@ -144,7 +159,7 @@ void homcull_context_destroy(homcull_context* context) {
     if (!context) return;
     const homcull_allocator engine = context->allocator;
     context->~homcull_context();
-    engine.deallocate(engine.user, context);
+    engine.deallocate(engine.user, context, sizeof(homcull_context));
 }
 
 homcull_isa homcull_context_isa(const homcull_context* context) {

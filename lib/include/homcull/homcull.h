@@ -98,15 +98,17 @@ HOMCULL_API const char* homcull_isa_name(homcull_isa isa);
 /* ---- Context -------------------------------------------------------------------------------- */
 
 /* The engine's memory. allocate returns size bytes aligned to alignment (a power of two, at most
- * 64) or null; deallocate frees what allocate returned (never null). Called from any thread that
- * calls the library. Both null: the C library's aligned_alloc and free. */
+ * 64) or null; deallocate frees a block allocate returned, with the size it was asked for (the
+ * library never passes null). Called from any thread that calls the library. Give both or
+ * neither: both null means the C library's aligned_alloc and free. */
 typedef struct homcull_allocator {
     void* (*allocate)(void* user, size_t size, size_t alignment);
-    void (*deallocate)(void* user, void* memory);
+    void (*deallocate)(void* user, void* memory, size_t size);
     void* user;
 } homcull_allocator;
 
-/* Called on the failing thread before the call returns its error. */
+/* Called on the failing thread before the call returns its error (homcull_context_create's
+ * errors too, through the desc's callback). */
 typedef void (*homcull_error_callback)(void* user, homcull_result result, const char* message);
 
 typedef struct homcull_context_desc {
@@ -124,7 +126,8 @@ HOMCULL_API homcull_result homcull_context_create(const homcull_context_desc* de
 HOMCULL_API void homcull_context_destroy(homcull_context* context);
 /* The instruction set the context's calls run (BEST resolved). */
 HOMCULL_API homcull_isa homcull_context_isa(const homcull_context* context);
-/* Bytes the context's objects hold from its allocator right now. */
+/* Bytes the context and its objects hold from its allocator right now (the context's own block
+ * included). */
 HOMCULL_API uint64_t homcull_context_allocated_bytes(const homcull_context* context);
 
 /* ---- Meshes: occluder geometry registered once ------------------------------------------------ */
@@ -228,7 +231,9 @@ HOMCULL_API uint64_t homcull_buffer_allocated_bytes(const homcull_buffer* buffer
 HOMCULL_API homcull_result homcull_buffer_begin_frame(homcull_buffer* buffer, const homcull_view* view);
 
 /* Draws a registered mesh as occluder, once per model matrix (model to world, 16 floats each in
- * the view's layout, instance_count of them; null with instance_count 1: the identity). Each
+ * the view's layout, instance_count of them; null with instance_count 1: the identity). Model
+ * matrices are floats, as engines keep them; the view is double, so that a world far from the
+ * origin loses nothing before the two are composed (in double, rounded once). Each
  * instance is composed with the view in double and drawn nearest cluster first. Occluders drawn
  * nearest first cull best (what is behind drawn occluders is skipped cheaply). */
 HOMCULL_API homcull_result homcull_buffer_draw_mesh(homcull_buffer* buffer, const homcull_mesh* mesh, const float* model_matrices,
