@@ -48,6 +48,10 @@ struct homcull_mesh {
     homcull::capi::Account account;
     homcull::OccluderClusters clusters;  // made in the account's scope
     std::size_t triangle_count = 0;
+    // The box of the vertices its triangles use (bounded: all finite): an instance wholly outside
+    // the view is skipped before its clusters are placed.
+    float bounds_min[3] = {0, 0, 0}, bounds_max[3] = {0, 0, 0};
+    bool bounded = false;
     explicit homcull_mesh(homcull_context* context) : account(context) {}
 };
 

@@ -4,6 +4,7 @@
 
 #include "core/float_mode.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -69,6 +70,16 @@ homcull_result homcull_mesh_create(homcull_context* context, const homcull_mesh_
                                                      shared.data(), apexes.data());
         }
         mesh->triangle_count = d.triangle_count;
+        mesh->bounded = d.triangle_count > 0;
+        for (int k = 0; k < 3; ++k) mesh->bounds_min[k] = INFINITY, mesh->bounds_max[k] = -INFINITY;
+        for (const std::uint32_t v : indices) {
+            const float* p = reinterpret_cast<const float*>(reinterpret_cast<const unsigned char*>(d.positions) + std::size_t(v) * d.position_stride);
+            for (int k = 0; k < 3; ++k) {
+                mesh->bounded = mesh->bounded && std::isfinite(p[k]);
+                mesh->bounds_min[k] = std::min(mesh->bounds_min[k], p[k]);
+                mesh->bounds_max[k] = std::max(mesh->bounds_max[k], p[k]);
+            }
+        }
         return HOMCULL_OK;
     });
     if (result != HOMCULL_OK) {
