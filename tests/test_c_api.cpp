@@ -376,3 +376,40 @@ TEST(CApi, OutOfMemoryAtEveryAllocation) {
 }
 
 }  // namespace
+
+// The header-only C++ layer (homcull.hpp): handles own their objects, spans carry the arrays.
+#include <homcull/homcull.hpp>
+
+namespace {
+
+TEST(CApi, CppLayerOwnsItsHandles) {
+    const Scene scene;
+    EngineMemory memory;
+    {
+        homcull_context_desc desc{};
+        desc.allocator = memory.allocator();
+        homcull::api::Context context;
+        ASSERT_EQ(homcull::api::Context::create(desc, context), HOMCULL_OK);
+        homcull::api::Mesh mesh;
+        ASSERT_EQ(homcull::api::Mesh::create(context, scene.mesh_desc(), mesh), HOMCULL_OK);
+        EXPECT_EQ(mesh.triangle_count(), 8u);
+        homcull::api::Buffer buffer;
+        ASSERT_EQ(homcull::api::Buffer::create(context, homcull_buffer_desc{320, 180, 1, float(kNear), 0, 0}, buffer), HOMCULL_OK);
+        ASSERT_EQ(buffer.begin_frame(engine_view(Engine::opengl)), HOMCULL_OK);
+        const float identity[2][16] = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+        ASSERT_EQ(buffer.draw(mesh, homcull::api::Span<const float>(&identity[0][0], 32)), HOMCULL_OK);  // two instances
+        std::vector<homcull_visibility> answers(scene.boxes.size());
+        ASSERT_EQ(buffer.test(scene.boxes, answers), HOMCULL_OK);
+        EXPECT_EQ(answers, scene.expected);
+        std::vector<homcull_visibility> too_short(1);
+        EXPECT_EQ(buffer.test(scene.boxes, too_short), HOMCULL_ERROR_INVALID_ARGUMENT);
+        EXPECT_EQ(buffer.frame_stats().draw_calls, 1u);
+        homcull::api::Buffer moved = std::move(buffer);
+        EXPECT_FALSE(buffer);
+        EXPECT_TRUE(moved);
+        EXPECT_GT(memory.live, 0u);
+    }
+    EXPECT_EQ(memory.live, 0u);  // destroyed in reverse order, all given back
+}
+
+}  // namespace

@@ -9,7 +9,7 @@
 // flipped every other round); the medians and their ratio are printed per view.
 //
 //   draw_calls_bench SCENE.glb VIEWS.json [--rounds N] [--width W --height H]
-#include <homcull/homcull.h>
+#include <homcull/homcull.hpp>
 
 #include <homcull/camera.hpp>
 #include <homcull/io/camera_path.hpp>
@@ -40,7 +40,7 @@ void check(homcull_result r, const char* what) {
     }
 }
 
-homcull_mesh* register_mesh(homcull_context* context, const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices) {
+api::Mesh register_mesh(const api::Context& context, const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices) {
     homcull_mesh_desc d{};
     d.positions = &positions[0].x;
     d.position_stride = sizeof(glm::vec3);
@@ -48,13 +48,13 @@ homcull_mesh* register_mesh(homcull_context* context, const std::vector<glm::vec
     d.indices = indices.data();
     d.index_size = 4;
     d.triangle_count = indices.size() / 3;
-    homcull_mesh* mesh = nullptr;
-    check(homcull_mesh_create(context, &d, &mesh), "homcull_mesh_create");
+    api::Mesh mesh;
+    check(api::Mesh::create(context, d, mesh), "homcull_mesh_create");
     return mesh;
 }
 
 struct Draw {
-    homcull_mesh* mesh;
+    const api::Mesh* mesh;
     std::array<float, 16> model;  // column-major, anchored world
     double distance2;
 };
@@ -82,12 +82,11 @@ int main(int argc, char** argv) {
     const glm::dvec3 anchor = scene_anchor(scene);
     const std::vector<std::uint32_t> occluders = occluder_candidates(scene, OccluderFilter::role);
 
-    homcull_context_desc cd{};
-    homcull_context* context = nullptr;
-    check(homcull_context_create(&cd, &context), "homcull_context_create");
+    api::Context context;
+    check(api::Context::create(homcull_context_desc{}, context), "homcull_context_create");
     // Per object: one registered mesh per scene mesh. Merged: every occluder's anchored world
     // triangles (transform_point_from, as the culler and the truth round them) in one mesh.
-    std::map<std::uint32_t, homcull_mesh*> meshes;
+    std::map<std::uint32_t, api::Mesh> meshes;
     std::vector<Draw> draws;
     std::vector<glm::vec3> world;
     std::vector<std::uint32_t> world_indices;
@@ -98,7 +97,7 @@ int main(int argc, char** argv) {
         if (m.triangle_count() == 0) continue;
         if (!meshes.count(o.mesh)) meshes[o.mesh] = register_mesh(context, m.positions, m.indices);
         const glm::dmat4 model = glm::translate(glm::dmat4(1.0), -anchor) * o.world;
-        Draw d{meshes[o.mesh], {}, 0.0};
+        Draw d{&meshes[o.mesh], {}, 0.0};
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r) d.model[std::size_t(4 * c + r)] = float(model[c][r]);
         draws.push_back(d);
@@ -107,21 +106,19 @@ int main(int argc, char** argv) {
         for (std::uint32_t i : m.indices) world_indices.push_back(base + i);
         triangles += m.triangle_count();
     }
-    homcull_mesh* merged = register_mesh(context, world, world_indices);
+    const api::Mesh merged = register_mesh(context, world, world_indices);
 
-    homcull_buffer_desc bd{width, height, 1, 1.0f, 0, 0};
-    homcull_buffer* buffer = nullptr;
-    check(homcull_buffer_create(context, &bd, &buffer), "homcull_buffer_create");
-    homcull_reserve_desc reserve{width, height, triangles, 0};
-    check(homcull_buffer_reserve(buffer, &reserve), "homcull_buffer_reserve");
+    api::Buffer buffer;
+    check(api::Buffer::create(context, homcull_buffer_desc{width, height, 1, 1.0f, 0, 0}, buffer), "homcull_buffer_create");
+    check(buffer.reserve(homcull_reserve_desc{width, height, triangles, 0}), "homcull_buffer_reserve");
 
     std::printf("%zu occluder objects (%zu triangles), %dx%d, %d rounds, instruction set %s\n", draws.size(), triangles, width, height, rounds,
-                homcull_isa_name(homcull_context_isa(context)));
+                homcull_isa_name(context.isa()));
     std::printf("| view | per object (ms) | merged (ms) | per object / merged | calls | drawn per object | drawn merged |\n|---|---|---|---|---|---|---|\n");
     double sum_objects = 0.0, sum_merged = 0.0;
     for (std::size_t v = 0; v < views.frames.size(); ++v) {
         Camera camera = views.frames[v];
-        check(homcull_buffer_set_near(buffer, float(camera.near_plane)), "homcull_buffer_set_near");
+        check(buffer.set_near(float(camera.near_plane)), "homcull_buffer_set_near");
         camera.eye -= anchor, camera.target -= anchor;
         const glm::dmat4 clip = projection_matrix(camera, double(width) / height) * view_matrix(camera);
         homcull_view view{};
@@ -137,14 +134,14 @@ int main(int argc, char** argv) {
         std::sort(draws.begin(), draws.end(), [](const Draw& a, const Draw& b) { return a.distance2 < b.distance2; });
         homcull_frame_stats objects_stats{}, merged_stats{};
         const auto per_object = [&] {
-            check(homcull_buffer_begin_frame(buffer, &view), "homcull_buffer_begin_frame");
-            for (const Draw& d : draws) check(homcull_buffer_draw_mesh(buffer, d.mesh, d.model.data(), 1), "homcull_buffer_draw_mesh");
-            homcull_buffer_frame_stats(buffer, &objects_stats);
+            check(buffer.begin_frame(view), "homcull_buffer_begin_frame");
+            for (const Draw& d : draws) check(buffer.draw(*d.mesh, d.model), "homcull_buffer_draw_mesh");
+            objects_stats = buffer.frame_stats();
         };
         const auto one_call = [&] {
-            check(homcull_buffer_begin_frame(buffer, &view), "homcull_buffer_begin_frame");
-            check(homcull_buffer_draw_mesh(buffer, merged, nullptr, 1), "homcull_buffer_draw_mesh");
-            homcull_buffer_frame_stats(buffer, &merged_stats);
+            check(buffer.begin_frame(view), "homcull_buffer_begin_frame");
+            check(buffer.draw(merged), "homcull_buffer_draw_mesh");
+            merged_stats = buffer.frame_stats();
         };
         const auto time = [](auto&& frame) {
             const auto t0 = std::chrono::steady_clock::now();
@@ -164,9 +161,5 @@ int main(int argc, char** argv) {
         if (objects_stats.allocations || merged_stats.allocations) std::printf("  (frames allocated after the reserve: a bug)\n");
     }
     std::printf("| all | %.3f | %.3f | %.2f | | | |\n", sum_objects, sum_merged, sum_objects / sum_merged);
-    homcull_buffer_destroy(buffer);
-    homcull_mesh_destroy(merged);
-    for (auto& [id, mesh] : meshes) homcull_mesh_destroy(mesh);
-    homcull_context_destroy(context);
     return 0;
 }
