@@ -413,3 +413,73 @@ TEST(CApi, CppLayerOwnsItsHandles) {
 }
 
 }  // namespace
+
+// The engine's job system: the same answers and statistics as the calling thread, for
+// registered meshes and for triangles, frame after frame.
+#include "support.hpp"
+
+#include <homcull/world_triangles.hpp>
+
+namespace {
+
+TEST(CApi, JobSystemGivesTheAnswersOfTheCallingThread) {
+    const homcull::test::CityStreet street;
+    const homcull::WorldTriangles& occluders = street.occluders;
+    homcull_mesh_desc md{};
+    md.positions = occluders.positions.data();
+    md.position_stride = 12;
+    md.vertex_count = occluders.positions.size() / 3;
+    md.indices = occluders.indices.data();
+    md.index_size = 4;
+    md.triangle_count = occluders.triangle_count();
+    homcull_triangles triangles{md.positions, 12, md.vertex_count, md.indices, 4, 0, md.triangle_count};
+    std::vector<homcull_box> boxes;
+    for (const homcull::Object& o : street.city.objects)
+        boxes.push_back({{o.world_bounds.min.x, o.world_bounds.min.y, o.world_bounds.min.z}, {o.world_bounds.max.x, o.world_bounds.max.y, o.world_bounds.max.z}});
+    const homcull::ParallelFor threads = homcull::test::parallel_jobs();
+    std::vector<homcull_visibility> answers[2];
+    homcull_frame_stats stats[2][3];
+    for (int threaded = 0; threaded < 2; ++threaded) {
+        homcull_context* context = make_context();
+        homcull_mesh* mesh = nullptr;
+        ASSERT_EQ(homcull_mesh_create(context, &md, &mesh), HOMCULL_OK);
+        homcull_buffer* buffer = nullptr;
+        const homcull_buffer_desc bd{480, 270, 2, float(street.camera.near_plane), 0, 0};
+        ASSERT_EQ(homcull_buffer_create(context, &bd, &buffer), HOMCULL_OK);
+        if (threaded) {
+            const homcull_job_system jobs{threads.run, threads.user, 2, 0};
+            ASSERT_EQ(homcull_buffer_set_job_system(buffer, &jobs), HOMCULL_OK);
+        }
+        for (int frame = 0; frame < 3; ++frame) {
+            homcull::Camera camera = street.camera;
+            camera.eye.z += 4.0 * frame;
+            const glm::dmat4 clip = homcull::projection_matrix(camera, 480.0 / 270.0) * homcull::view_matrix(camera);
+            homcull_view view{};
+            store(clip, HOMCULL_COLUMN_MAJOR, view.world_to_clip);
+            view.cull = HOMCULL_CULL_NONE;
+            ASSERT_EQ(homcull_buffer_begin_frame(buffer, &view), HOMCULL_OK);
+            if (frame == 1) {
+                ASSERT_EQ(homcull_buffer_draw_triangles(buffer, &triangles, nullptr), HOMCULL_OK);
+            } else {
+                ASSERT_EQ(homcull_buffer_draw_mesh(buffer, mesh, nullptr, 1), HOMCULL_OK);
+            }
+            std::vector<homcull_visibility> a(boxes.size());
+            ASSERT_EQ(homcull_buffer_test_boxes(buffer, boxes.data(), boxes.size(), nullptr, a.data()), HOMCULL_OK);
+            answers[threaded].insert(answers[threaded].end(), a.begin(), a.end());
+            ASSERT_EQ(homcull_buffer_frame_stats(buffer, &stats[threaded][frame]), HOMCULL_OK);
+        }
+        homcull_buffer_destroy(buffer);
+        homcull_mesh_destroy(mesh);
+        homcull_context_destroy(context);
+    }
+    EXPECT_EQ(answers[0], answers[1]);
+    for (int frame = 0; frame < 3; ++frame) {
+        EXPECT_EQ(stats[0][frame].triangles_drawn, stats[1][frame].triangles_drawn) << frame;
+        EXPECT_EQ(stats[0][frame].clusters_hidden, stats[1][frame].clusters_hidden) << frame;
+    }
+    std::size_t occluded = 0;
+    for (homcull_visibility v : answers[0]) occluded += v == HOMCULL_OCCLUDED;
+    EXPECT_GT(occluded, 10u);
+}
+
+}  // namespace

@@ -200,6 +200,13 @@ homcull_result homcull_buffer_reserve(homcull_buffer* b, const homcull_reserve_d
     });
 }
 
+homcull_result homcull_buffer_set_job_system(homcull_buffer* b, const homcull_job_system* jobs) {
+    if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_buffer_set_job_system: buffer is null");
+    b->jobs = ParallelFor{};
+    if (jobs && jobs->run) b->jobs = ParallelFor{jobs->run, jobs->user, jobs->threads};
+    return HOMCULL_OK;
+}
+
 uint64_t homcull_buffer_allocated_bytes(const homcull_buffer* b) { return b ? b->account.bytes.load() : 0; }
 
 homcull_result homcull_buffer_begin_frame(homcull_buffer* b, const homcull_view* view) {
@@ -242,7 +249,7 @@ homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* m
         for (std::size_t i = 0; i < instance_count; ++i) {
             in.model_to_clip = capi::float_clip_from_model(b->clip_from_world, read_model(*b, model_matrices ? model_matrices + 16 * i : nullptr));
             if (mesh->bounded && outside_view(mesh->bounds_min, mesh->bounds_max, in.model_to_clip, b->buffer.config().near_w)) continue;
-            b->buffer.render(in);  // a render that fails leaves what it drew: occluders all, so still conservative
+            b->buffer.render(in, b->jobs);  // a render that fails leaves what it drew: occluders all, so still conservative
         }
         return HOMCULL_OK;
     });
@@ -255,7 +262,7 @@ homcull_result homcull_buffer_draw_triangles(homcull_buffer* b, const homcull_tr
     if (homcull_result r = triangle_input(*b, triangles, model_matrix, fn, in); r != HOMCULL_OK) return r;
     ++b->draw_calls;
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
-        b->buffer.render(in);
+        b->buffer.render(in, b->jobs);
         return HOMCULL_OK;
     });
 }

@@ -66,6 +66,7 @@ struct homcull_buffer {
     bool far_plane = false;
     glm::dvec4 far_row{0.0};  // in front of (or on) the far plane: dot(far_row, world clip) >= 0
     std::uint64_t draw_calls = 0, allocations_at_frame = 0;
+    homcull::ParallelFor jobs;  // the engine's job system for draws (empty: the calling thread)
     homcull_buffer(homcull_context* context, const homcull::BufferConfig& config);
 };
 

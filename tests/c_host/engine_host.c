@@ -4,7 +4,8 @@
  * row-major matrices). It walks a scene written by tests/test_engine_host.cpp: it registers
  * the meshes once, draws the occluders object by object, nearest first, and tests every
  * object's box each frame, then writes the answers for the test to check against Embree and
- * against the C++ interface.
+ * against the C++ interface. It draws the walk a second time through its own job system (tasks
+ * taken in turn by two threads) and checks that the answers are the same.
  *
  *   engine_host WALK ANSWERS            the walk; exit 0, or 2 and a message when a call fails or
  *                                       the walk allocated after its reserve. ANSWERS.trace gets
@@ -265,6 +266,40 @@ static homcull_result test_boxes_on_two_threads(const homcull_buffer* buffer, co
     return jobs[0].result != HOMCULL_OK ? jobs[0].result : jobs[1].result;
 }
 
+/* ---- The engine's job system: tasks taken in turn by the calling thread and one more --------- */
+
+typedef struct {
+    void (*task)(void*, size_t);
+    void* data;
+    size_t count, next;
+    pthread_mutex_t lock;
+} JobBatch;
+
+static void* take_jobs(void* data) {
+    JobBatch* b = (JobBatch*)data;
+    for (;;) {
+        size_t i;
+        pthread_mutex_lock(&b->lock);
+        i = b->next++;
+        pthread_mutex_unlock(&b->lock);
+        if (i >= b->count) return NULL;
+        b->task(b->data, i);
+    }
+}
+
+static void run_jobs(void* user, size_t count, void (*task)(void* task_data, size_t index), void* task_data) {
+    JobBatch b;
+    pthread_t helper;
+    int started;
+    (void)user;
+    b.task = task, b.data = task_data, b.count = count, b.next = 0;
+    pthread_mutex_init(&b.lock, NULL);
+    started = pthread_create(&helper, NULL, take_jobs, &b) == 0;
+    take_jobs(&b);
+    if (started) pthread_join(helper, NULL);
+    pthread_mutex_destroy(&b.lock);
+}
+
 /* ---- The walk ------------------------------------------------------------------------------- */
 
 typedef struct {
@@ -290,7 +325,7 @@ static int acceptable(homcull_result r, int sweeping, const char* what) {
  * writing each frame's answers to `answers` (box_count each; all visible where nothing could
  * be answered). Returns the allocator's calls; *walk_allocations gets those after the reserve. */
 static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail_at, homcull_visibility* answers,
-                              unsigned long* walk_allocations, FILE* trace) {
+                              unsigned long* walk_allocations, FILE* trace, int with_jobs) {
     EngineMemory memory;
     homcull_context_desc desc;
     homcull_context* context = NULL;
@@ -342,6 +377,12 @@ static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail
             memset(&reserve, 0, sizeof reserve);
             reserve.max_width = width, reserve.max_height = height, reserve.max_draw_triangles = largest;
             acceptable(homcull_buffer_reserve(buffer, &reserve), sweeping, "homcull_buffer_reserve");
+            if (with_jobs) {
+                homcull_job_system jobs;
+                memset(&jobs, 0, sizeof jobs);
+                jobs.run = run_jobs, jobs.threads = 2;
+                acceptable(homcull_buffer_set_job_system(buffer, &jobs), sweeping, "homcull_buffer_set_job_system");
+            }
         }
     }
     calls_after_reserve = memory.calls;
@@ -387,7 +428,7 @@ static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail
         r = test_boxes_on_two_threads(buffer, w, answers + (size_t)f * w->box_count);
         if (r != HOMCULL_OK) fail("homcull_buffer_test_boxes: %s (%s)", homcull_result_name(r), homcull_last_error());
         if (homcull_buffer_frame_stats(buffer, &stats) != HOMCULL_OK) fail("homcull_buffer_frame_stats failed");
-        if (!sweeping && stats.allocations != 0) fail("frame %u allocated %lu times after the reserve", f, (unsigned long)stats.allocations);
+        if (!sweeping && !with_jobs && stats.allocations != 0) fail("frame %u allocated %lu times after the reserve", f, (unsigned long)stats.allocations);
     }
     if (walk_allocations) *walk_allocations = memory.calls - calls_after_reserve;
 
@@ -428,10 +469,18 @@ int main(int argc, char** argv) {
         snprintf(trace_path, sizeof trace_path, "%s.trace", argv[2]);
         trace = fopen(trace_path, "wb");
         if (!trace) fail("cannot write %s", trace_path);
-        calls = run_walk(&walk, walk.frame_count, 0, answers, &after_reserve, trace);
+        calls = run_walk(&walk, walk.frame_count, 0, answers, &after_reserve, trace, 0);
         fclose(trace);
+        {   /* The same walk drawn through the engine's job system: the same answers. */
+            homcull_visibility* threaded = (homcull_visibility*)checked_malloc((size_t)walk.frame_count * walk.box_count);
+            run_walk(&walk, walk.frame_count, 0, threaded, NULL, NULL, 1);
+            if (memcmp(answers, threaded, (size_t)walk.frame_count * walk.box_count) != 0)
+                fail("the walk drawn through the job system answers differently from the calling thread");
+            free(threaded);
+        }
         if (after_reserve != 0) fail("the walk allocated %lu times after the reserve", after_reserve);
-        printf("engine_host: %u frames, %u occluders drawn one by one, %u boxes; %lu allocations, none after the reserve\n",
+        printf("engine_host: %u frames, %u occluders drawn one by one, %u boxes; %lu allocations, none after the reserve; "
+               "the same answers through the job system\n",
                walk.frame_count, walk.occluder_count, walk.box_count, calls);
         write_answers(argv[2], 1, walk.frame_count, walk.box_count, answers);
     } else {
@@ -440,10 +489,10 @@ int main(int argc, char** argv) {
         unsigned long total, k;
         homcull_visibility* all;
         answers = (homcull_visibility*)checked_malloc(per_run);
-        total = run_walk(&walk, walk.frame_count, 0, answers, NULL, NULL);
+        total = run_walk(&walk, walk.frame_count, 0, answers, NULL, NULL, 0);
         free(answers);
         all = (homcull_visibility*)checked_malloc((total + 1) * per_run);
-        for (k = 1; k <= total + 1; ++k) run_walk(&walk, walk.frame_count, k, all + (k - 1) * per_run, NULL, NULL);
+        for (k = 1; k <= total + 1; ++k) run_walk(&walk, walk.frame_count, k, all + (k - 1) * per_run, NULL, NULL, 0);
         printf("engine_host: %lu runs, each failing one allocation of %lu; every call returned OK or out of memory, every block came back\n",
                total + 1, total);
         write_answers(argv[3], (uint32_t)(total + 1), walk.frame_count, walk.box_count, all);

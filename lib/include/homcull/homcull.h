@@ -224,6 +224,22 @@ HOMCULL_API void homcull_buffer_destroy(homcull_buffer* buffer);
 HOMCULL_API homcull_result homcull_buffer_set_resolution(homcull_buffer* buffer, int32_t width, int32_t height);
 HOMCULL_API homcull_result homcull_buffer_set_near(homcull_buffer* buffer, float near_distance);
 HOMCULL_API homcull_result homcull_buffer_reserve(homcull_buffer* buffer, const homcull_reserve_desc* desc);
+/* The engine's job system, for draws: run(user, count, task, task_data) must call
+ * task(task_data, i) once for every i in [0, count), in any order, on any threads, and return
+ * when every call has returned. Tasks never fail and never unwind (the library catches what
+ * goes wrong inside one and reports it from the draw). The answers are the same bits as on the
+ * calling thread. Null run: draws run on the calling thread (the default).
+ * With a job system, a draw's per-band scratch may still grow after a reserve when clipping
+ * makes a cluster's triangles outnumber the reserve's room (counted in
+ * homcull_frame_stats.allocations, through the allocator). */
+typedef struct homcull_job_system {
+    void (*run)(void* user, size_t count, void (*task)(void* task_data, size_t index), void* task_data);
+    void* user;
+    uint32_t threads;  /* how many threads run the tasks: a hint for splitting work (0: 2) */
+    uint32_t reserved; /* 0 */
+} homcull_job_system;
+HOMCULL_API homcull_result homcull_buffer_set_job_system(homcull_buffer* buffer, const homcull_job_system* jobs);
+
 /* Bytes of the context's allocator the buffer holds, and how many allocations it has made. */
 HOMCULL_API uint64_t homcull_buffer_allocated_bytes(const homcull_buffer* buffer);
 
@@ -313,6 +329,7 @@ HOMCULL_CHECK_SIZE_(context_desc, homcull_context_desc, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(mesh_desc, homcull_mesh_desc, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(triangles, homcull_triangles, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(reserve_desc, homcull_reserve_desc, 8 + 2 * sizeof(size_t));
+HOMCULL_CHECK_SIZE_(job_system, homcull_job_system, 2 * sizeof(void*) + 8);
 
 #ifdef __cplusplus
 }
