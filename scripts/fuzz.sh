@@ -4,14 +4,14 @@
 # seed corpus (tests/fuzz/corpus/<target>). New inputs go to build-fuzz/corpus/<target>, crashes
 # to build-fuzz/crashes/<target>; the repository's corpus is only read. Fails when a target
 # crashes, leaks, hangs (20 s on one input) or reports undefined behaviour.
-#   bash scripts/fuzz.sh [SECONDS] [TARGET...]     targets: fuzz_scene_import fuzz_buffer fuzz_conservative
+#   bash scripts/fuzz.sh [SECONDS] [TARGET...]     targets: fuzz_scene_import fuzz_buffer fuzz_conservative fuzz_c_interface
 # A long run: bash scripts/fuzz.sh 3600 (an hour each). Expects scripts/install-deps.sh's packages.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_scene_import fuzz_buffer fuzz_conservative)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_scene_import fuzz_buffer fuzz_conservative fuzz_c_interface)
 flags="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fsanitize=fuzzer-no-link -fno-omit-frame-pointer -g1"
 generator=()
 if [ ! -f build-fuzz/CMakeCache.txt ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi

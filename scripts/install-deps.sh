@@ -20,6 +20,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev        # the fuzzers (libFuzzer, scripts/fuzz.sh)
   libgmp-dev                      # the conservativeness tests' exact rational oracle (gmpxx)
+  python3                         # the C interface's ctypes test (tests/python)
   g++-aarch64-linux-gnu           # the test that the SIMD kernels compile for Arm NEON/SVE (scripts/check-neon.sh)
 )
 # ... and give the scalar path's bits there, run under qemu (scripts/check-neon.sh --run): arm64

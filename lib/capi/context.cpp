@@ -4,10 +4,21 @@
 #include <homcull/error.hpp>
 
 #include <cstdarg>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+
+// The layout the C side compiles against, checked on this side too (homcull.h checks the sizes
+// where it is included; these are the offsets an FFI binding must also agree on).
+static_assert(offsetof(homcull_view, layout) == 128 && offsetof(homcull_view, flags) == 144, "homcull_view's layout");
+static_assert(offsetof(homcull_box, max) == 12, "homcull_box's layout");
+static_assert(offsetof(homcull_rect, nearest_w) == 16, "homcull_rect's layout");
+static_assert(offsetof(homcull_buffer_desc, near_distance) == 12 && offsetof(homcull_buffer_desc, flags) == 16, "homcull_buffer_desc's layout");
+static_assert(offsetof(homcull_frame_stats, allocations) == 40, "homcull_frame_stats' layout");
+static_assert(offsetof(homcull_context_desc, isa) == 5 * sizeof(void*), "homcull_context_desc's layout");
+static_assert(sizeof(homcull_visibility) == 1 && sizeof(homcull_result) == 4 && sizeof(homcull_isa) == 4, "enums' sizes");
 
 namespace homcull::capi {
 namespace {

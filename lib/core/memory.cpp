@@ -25,8 +25,9 @@ void* hooked_allocate(const MemoryHooks* hooks, std::size_t bytes, std::size_t a
 void hooked_deallocate(const MemoryHooks* hooks, void* memory, std::size_t bytes, std::size_t alignment) noexcept {
     if (!memory) return;
     if (!hooks) {
-        if (alignment > __STDCPP_DEFAULT_NEW_ALIGNMENT__) ::operator delete(memory, bytes, std::align_val_t(alignment));
-        else ::operator delete(memory, bytes);
+        // The unsized forms: clang leaves sized deallocation off by default.
+        if (alignment > __STDCPP_DEFAULT_NEW_ALIGNMENT__) ::operator delete(memory, std::align_val_t(alignment));
+        else ::operator delete(memory);
         return;
     }
     hooks->deallocate(hooks->user, memory, bytes == 0 ? 1 : bytes);
