@@ -27,10 +27,10 @@ case "$kind" in
     flags="-fsanitize=thread -fno-omit-frame-pointer"
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1"
     # The tests whose work runs on several threads through the library's job-system interface:
-    # renders, queries, clusters, the draw order and the reference cells (test::parallel_jobs:
-    # std::threads under TSan). Tests that cast ground truth are left out: the truth library
-    # runs Embree and its tiles on oneTBB, which TSan cannot see into.
-    filter=(-R "RenderThreads|HiddenTriangleSkip|FrameAllocations|OccluderClusters|ReferenceCells|DrawOrder")
+    # renders, queries, clusters, the draw order, the reference cells and the C interface
+    # (test::parallel_jobs: std::threads under TSan). Tests that cast ground truth are left
+    # out: the truth library runs Embree and its tiles on oneTBB, which TSan cannot see into.
+    filter=(-R "RenderThreads|HiddenTriangleSkip|FrameAllocations|OccluderClusters|ReferenceCells|DrawOrder|CApi|RenderCalls")
     ;;
   *) echo "sanitize.sh: unknown kind '$kind' (asan or tsan)" >&2; exit 2 ;;
 esac
