@@ -386,7 +386,7 @@ private:
     RasterStats stats_;
 
     // Farthest-depth pyramid: level l >= 1 holds, per cell of 2^l x 2^l subtiles, the minimum
-    // d0; rebuilt at the end of render().
+    // d0; brought up to date at the end of render() (on one thread, over the subtiles it changed).
     detail::Vector<detail::PyramidLevel> levels_;
     detail::Vector<float> pyramid_;
     detail::Vector<std::int32_t> level_offset_, level_width_;  // levels_ as arrays, for SIMD gathers
