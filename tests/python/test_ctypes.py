@@ -85,6 +85,14 @@ class homcull_reserve_desc(Structure):
                 ("max_draw_vertices", c_size_t)]
 
 
+job_task_fn = CFUNCTYPE(None, c_void_p, c_size_t)
+job_run_fn = CFUNCTYPE(None, c_void_p, c_size_t, job_task_fn, c_void_p)
+
+
+class homcull_job_system(Structure):
+    _fields_ = [("run", job_run_fn), ("user", c_void_p), ("threads", c_uint32), ("reserved", c_uint32)]
+
+
 class homcull_triangles(Structure):
     _fields_ = [("positions", POINTER(c_float)), ("position_stride", c_size_t), ("vertex_count", c_size_t),
                 ("indices", c_void_p), ("index_size", c_uint32), ("reserved", c_uint32), ("triangle_count", c_size_t)]
@@ -125,6 +133,7 @@ MIRRORS = {
     "box": homcull_box, "rect": homcull_rect, "view": homcull_view, "buffer_desc": homcull_buffer_desc,
     "frame_stats": homcull_frame_stats, "allocator": homcull_allocator, "context_desc": homcull_context_desc,
     "mesh_desc": homcull_mesh_desc, "triangles": homcull_triangles, "reserve_desc": homcull_reserve_desc,
+    "job_system": homcull_job_system,
 }
 
 
