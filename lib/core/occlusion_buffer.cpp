@@ -292,7 +292,8 @@ void OcclusionBuffer::read_pyramid(std::vector<float>& cells) const {
     cells.assign(pyramid_.begin(), pyramid_.begin() + std::ptrdiff_t(top.offset + std::size_t(top.width) * std::size_t(top.height)));
 }
 
-detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end) {
+detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end,
+                                                               bool cells_current) {
     const int height = detail::reference_cells_height(subtiles_y_);
     const std::size_t size = std::size_t(reference_cells_width_) * std::size_t(height);  // of the cells (table (0, 0))
     float* first = reference_cells_.data() + part * std::size_t(detail::kCellTables) * size;
@@ -302,9 +303,7 @@ detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, 
     const std::size_t own_end = std::min(size, std::size_t(((row_end - 1) >> detail::kReferenceCellShift) + 1) * width);
     // One part over every row, and the cells still those the last noted render on one thread
     // left (nothing else drew since): they are this buffer's, as a refresh would compute them.
-    const bool current = reference_cells_current_ && !clear_first && part == 0 && row_begin == 0 && row_end == subtiles_y_;
-    reference_cells_current_ = false;
-    if (current) return cells;
+    if (cells_current && !clear_first && part == 0 && row_begin == 0 && row_end == subtiles_y_) return cells;
     std::fill(first, first + own_begin, std::numeric_limits<float>::infinity());
     std::fill(first + own_end, first + size, std::numeric_limits<float>::infinity());
     if (clear_first) {
@@ -416,7 +415,9 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
     if (list.notes) {
         if (noted_parts_.empty()) noted_parts_.resize(1);
         if (noted_parts_[0].undecided.size() < kCellRefreshTriangles) noted_parts_[0].undecided.resize(kCellRefreshTriangles);
-        draw_noted_part(in, list, clear_first, 0, 0, subtiles_y_);
+        // Not current while the cells are being changed (should the render stop half-way).
+        const bool cells_current = std::exchange(reference_cells_current_, false);
+        draw_noted_part(in, list, clear_first, 0, 0, subtiles_y_, cells_current);
         // Every slice refreshed the cells of the rows it changed: they hold the buffer's d0 now,
         // and the next noted render on one thread starts from them.
         reference_cells_current_ = true;
@@ -454,13 +455,13 @@ void OcclusionBuffer::build_changed_pyramid(bool cleared, const detail::ChangedS
 // others as it would for the whole buffer (a triangle outside the target's rows is hidden
 // there): so each part's statistics are the whole render's, but for subtiles_updated.
 void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin,
-                                      int row_end) {
+                                      int row_end, bool cells_current) {
     NotedPart& scratch = noted_parts_[part];
     scratch.drawn = true;
     scratch.changed = {};
     if (clear_first) clear_rows(row_begin, row_end);
     const detail::RasterTarget target = raster_target(row_begin, row_end);
-    const detail::ReferenceCells cells = start_reference_cells(clear_first, part, row_begin, row_end);
+    const detail::ReferenceCells cells = start_reference_cells(clear_first, part, row_begin, row_end, cells_current);
     RasterStats stats;
     int changed_begin = row_end, changed_end = row_begin;  // the subtile rows changed since the last refresh
     // The triangles drawn per cell row of the part, counted here and copied out at the end: the

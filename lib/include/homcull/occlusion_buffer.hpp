@@ -424,7 +424,8 @@ private:
     void render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list);
     // Part `part` of a noted render: the list's triangles drawn into subtile rows [row_begin,
     // row_end) with that part's cells; its statistics counted as for the whole buffer.
-    void draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin, int row_end);
+    void draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin, int row_end,
+                         bool cells_current = false);
     void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
@@ -460,7 +461,8 @@ private:
     // cells, those of subtile rows [row_begin, row_end) zeroed when the render clears the buffer
     // first, else computed from d0, and the others infinite (every noted triangle is hidden
     // there: another part draws them).
-    detail::ReferenceCells start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end);
+    // cells_current: part 0's cells already hold d0 (reference_cells_current_ when the render began).
+    detail::ReferenceCells start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end, bool cells_current);
     // Refreshes the cells holding subtile rows [row_begin, row_end).
     void refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end);
 
