@@ -17,12 +17,14 @@
  *
  * Threads. A context and its meshes may be used from any thread. A buffer's draws, frames and
  * settings must not overlap any other call on the same buffer; its queries may run on many
- * threads at once. The library makes no threads.
+ * threads at once. The library makes no threads; draws can run as tasks of the engine's job
+ * system (homcull_buffer_set_job_system).
  *
  * Frames cost what they draw. A draw call costs its own triangles plus a few microseconds,
  * whatever the resolution: drawing occluders object by object, interleaved with queries during
  * the engine's scene traversal, is as cheap as drawing them in one call. After
- * homcull_buffer_reserve, no draw within the reserved sizes and no query allocates.
+ * homcull_buffer_reserve, no draw within the reserved sizes (on the calling thread) and no
+ * query allocates.
  */
 #ifndef HOMCULL_H
 #define HOMCULL_H
