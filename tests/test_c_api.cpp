@@ -196,7 +196,7 @@ TEST(CApi, ErrorsAreResultsWithMessages) {
     homcull_buffer_desc bad{0, 10, 1, 0.1f, 0, 0};
     EXPECT_EQ(homcull_buffer_create(context, &bad, &buffer), HOMCULL_ERROR_INVALID_ARGUMENT);
     EXPECT_EQ(buffer, nullptr);
-    EXPECT_NE(std::string(homcull_last_error()).find("resolution 0x10"), std::string::npos) << homcull_last_error();
+    EXPECT_NE(std::string(homcull_last_error()).find("got 0x10 pixels"), std::string::npos) << homcull_last_error();
     ASSERT_EQ(log.messages.size(), 1u);
     EXPECT_EQ(log.messages[0], homcull_last_error());
     bad = {64, 36, 3, 0.1f, 0, 0};

@@ -25,21 +25,13 @@ BufferConfig buffer_config(const homcull_buffer_desc& d) {
     return c;
 }
 
-// The library's checks of a configuration, as a result instead of an exception (they would
-// allocate their message): the same conditions as OcclusionBuffer::configure.
-homcull_result check_config(const homcull_context* context, const char* fn, int width, int height, int samples, float near_distance) {
-    if (width < 1 || height < 1 || width > 65536 || height > 65536)
-        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: resolution %dx%d is outside 1..65536", fn, width, height);
-    if (samples != 1 && samples != 2 && samples != 4)
-        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: samples per pixel axis must be 1, 2 or 4, got %d", fn, samples);
-    if (!(near_distance >= 0x1.0p-126f) || !std::isfinite(near_distance))
-        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: near distance must be a finite number of at least 2^-126, got %g", fn,
-                            double(near_distance));
-    const double sw = double(width) * samples, sh = double(height) * samples;
-    if (sw * sh > double(1 << 28) || sw > double(1 << 22) || sh > double(1 << 22))
-        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: %dx%d pixels of %dx%d samples is more than the buffer holds (2^28 samples)",
-                            fn, width, height, samples, samples);
-    return HOMCULL_OK;
+// The library's check of a configuration (buffer_config_problem), as a result: its exception
+// would allocate its message.
+homcull_result check_config(const homcull_context* context, const char* fn, const BufferConfig& c) {
+    const char* problem = buffer_config_problem(c);
+    if (!problem) return HOMCULL_OK;
+    return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: %s (got %dx%d pixels, %d samples per axis, near %g)", fn, problem, c.width,
+                        c.height, c.samples, double(c.near_w));
 }
 
 OcclusionBuffer make_buffer(capi::Account& account, const BufferConfig& config) {
@@ -133,7 +125,7 @@ homcull_result homcull_buffer_create(homcull_context* context, const homcull_buf
     if (!context || !desc) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: context or desc is null", fn);
     if (desc->flags & ~uint32_t(HOMCULL_BUFFER_SAMPLE_DEPTH))
         return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: unknown flags 0x%x", fn, unsigned(desc->flags));
-    const homcull_result valid = check_config(context, fn, desc->width, desc->height, desc->samples, desc->near_distance);
+    const homcull_result valid = check_config(context, fn, buffer_config(*desc));
     if (valid != HOMCULL_OK) return valid;
     homcull_buffer* buffer = nullptr;
     const homcull_result result = capi::guarded(context, fn, [&]() -> homcull_result {
@@ -151,13 +143,12 @@ void homcull_buffer_destroy(homcull_buffer* buffer) {
 homcull_result homcull_buffer_set_resolution(homcull_buffer* b, int32_t width, int32_t height) {
     const char* const fn = "homcull_buffer_set_resolution";
     if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
-    const BufferConfig& now = b->buffer.config();
-    const homcull_result valid = check_config(b->account.context, fn, width, height, now.samples, now.near_w);
+    BufferConfig config = b->buffer.config();
+    config.width = width;
+    config.height = height;
+    const homcull_result valid = check_config(b->account.context, fn, config);
     if (valid != HOMCULL_OK) return valid;
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
-        BufferConfig config = now;
-        config.width = width;
-        config.height = height;
         b->buffer.configure(config);  // leaves the buffer as it was when it throws
         b->frame_begun = false;
         return HOMCULL_OK;
@@ -167,8 +158,9 @@ homcull_result homcull_buffer_set_resolution(homcull_buffer* b, int32_t width, i
 homcull_result homcull_buffer_set_near(homcull_buffer* b, float near_distance) {
     const char* const fn = "homcull_buffer_set_near";
     if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
-    const BufferConfig& now = b->buffer.config();
-    const homcull_result valid = check_config(b->account.context, fn, now.width, now.height, now.samples, near_distance);
+    BufferConfig config = b->buffer.config();
+    config.near_w = near_distance;
+    const homcull_result valid = check_config(b->account.context, fn, config);
     if (valid != HOMCULL_OK) return valid;
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
         b->buffer.set_near_w(near_distance);
@@ -180,9 +172,10 @@ homcull_result homcull_buffer_set_near(homcull_buffer* b, float near_distance) {
 homcull_result homcull_buffer_reserve(homcull_buffer* b, const homcull_reserve_desc* desc) {
     const char* const fn = "homcull_buffer_reserve";
     if (!b || !desc) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer or desc is null", fn);
-    const BufferConfig& now = b->buffer.config();
-    const int width = std::max(now.width, desc->max_width), height = std::max(now.height, desc->max_height);
-    const homcull_result valid = check_config(b->account.context, fn, width, height, now.samples, now.near_w);
+    BufferConfig largest = b->buffer.config();
+    const int width = std::max(largest.width, desc->max_width), height = std::max(largest.height, desc->max_height);
+    largest.width = width, largest.height = height;
+    const homcull_result valid = check_config(b->account.context, fn, largest);
     if (valid != HOMCULL_OK) return valid;
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
         BufferReserve r;

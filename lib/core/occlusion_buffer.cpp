@@ -67,32 +67,42 @@ OcclusionBuffer& OcclusionBuffer::operator=(OcclusionBuffer&&) noexcept = defaul
 
 OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) { configure(config); }
 
-namespace {
-
-void validate_config(const BufferConfig& config) {
-    validate_resolution({config.width, config.height});
-    if (config.samples != 1 && config.samples != 2 && config.samples != 4)
-        throw Error("occlusion buffer: samples per pixel axis must be 1, 2 or 4, got " + std::to_string(config.samples));
+const char* buffer_config_problem(const BufferConfig& config) noexcept {
+    if (config.width < 1 || config.height < 1 || config.width > 65536 || config.height > 65536)
+        return "the resolution must be between 1x1 and 65536x65536";
+    if (config.samples != 1 && config.samples != 2 && config.samples != 4) return "samples per pixel axis must be 1, 2 or 4";
     // Depths are stored as float 1/w: below 2^-126 (subnormal) 1/near_w overflows float, and the
     // draw order's and the cells' float depths stop agreeing with the setup's double ones.
     if (!(config.near_w >= 0x1.0p-126f) || !std::isfinite(config.near_w))
-        throw Error("occlusion buffer: near_w must be a positive number of at least 2^-126 (1.2e-38), got " + std::to_string(config.near_w));
-    if (!(config.edge_margin >= 0.0 && config.edge_margin < 0.5)) throw Error("occlusion buffer: edge margin must be in [0, 0.5) samples");
-    const long long sample_width = (long long)config.width * config.samples, sample_height = (long long)config.height * config.samples;
-    if (double(sample_width) * double(sample_height) > double(1 << 28))
-        throw Error("occlusion buffer: more than 2^28 samples; lower the resolution or the samples");
-    if (sample_width > (1 << 22) || sample_height > (1 << 22))  // sample coordinates stay exact in float (conservative_depth)
-        throw Error("occlusion buffer: more than 2^22 samples in a row or column; lower the resolution or the samples");
+        return "near_w must be a finite number of at least 2^-126 (1.2e-38)";
+    if (!(config.edge_margin >= 0.0 && config.edge_margin < 0.5)) return "the edge margin must be in [0, 0.5) samples";
+    const double sample_width = double(config.width) * config.samples, sample_height = double(config.height) * config.samples;
+    if (sample_width * sample_height > double(1 << 28)) return "more than 2^28 samples; lower the resolution or the samples";
+    if (sample_width > double(1 << 22) || sample_height > double(1 << 22))  // sample coordinates stay exact in float (conservative_depth)
+        return "more than 2^22 samples in a row or column; lower the resolution or the samples";
+    return nullptr;
 }
 
+namespace {
+
+void validate_config(const BufferConfig& config) {
+    if (const char* problem = buffer_config_problem(config))
+        throw Error(std::string("occlusion buffer: ") + problem + " (got " + std::to_string(config.width) + "x" + std::to_string(config.height) +
+                    " pixels, " + std::to_string(config.samples) + " samples per axis, near_w " + std::to_string(config.near_w) + ")");
+}
+
+}  // namespace
+
 // The sizes of a buffer's arrays for a configuration.
-struct BufferSizes {
+struct detail::BufferSizes {
     int sample_width, sample_height, subtiles_x, subtiles_y;
     std::size_t stride, plane, sample_depth_stride, sample_depth, bands, pyramid, levels, cells_width, cells_height, cells;
 };
 
-BufferSizes buffer_sizes(const BufferConfig& config) {
-    BufferSizes z{};
+namespace {
+
+detail::BufferSizes buffer_sizes(const BufferConfig& config) {
+    detail::BufferSizes z{};
     z.sample_width = config.width * config.samples;
     z.sample_height = config.height * config.samples;
     z.subtiles_x = (z.sample_width + kW - 1) / kW;
@@ -117,12 +127,8 @@ BufferSizes buffer_sizes(const BufferConfig& config) {
 
 }  // namespace
 
-// Everything that can fail (the checks, then every allocation: reserve keeps a vector's
-// contents) comes before anything changes, so that a configuration that throws leaves the buffer
-// as it was. Arrays that already hold enough keep their memory.
-void OcclusionBuffer::configure(const BufferConfig& config) {
-    validate_config(config);
-    const BufferSizes z = buffer_sizes(config);
+// Room in the arrays whose size follows the configuration (reserve keeps their contents).
+void OcclusionBuffer::reserve_arrays(const detail::BufferSizes& z) {
     d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
     sample_depth_.reserve(z.sample_depth);
     band_updated_.reserve(z.bands);
@@ -130,6 +136,15 @@ void OcclusionBuffer::configure(const BufferConfig& config) {
     pyramid_.reserve(z.pyramid);
     reference_cells_.reserve(z.cells);
     cell_row_load_.reserve(z.cells_height);
+}
+
+// Everything that can fail (the checks, then every allocation: reserve keeps a vector's
+// contents) comes before anything changes, so that a configuration that throws leaves the buffer
+// as it was. Arrays that already hold enough keep their memory.
+void OcclusionBuffer::configure(const BufferConfig& config) {
+    validate_config(config);
+    const detail::BufferSizes z = buffer_sizes(config);
+    reserve_arrays(z);
 
     config_ = config;
     sample_width_ = z.sample_width, sample_height_ = z.sample_height;
@@ -179,14 +194,8 @@ void OcclusionBuffer::reserve(const BufferReserve& r) {
     largest.width = std::max(config_.width, r.max_width);
     largest.height = std::max(config_.height, r.max_height);
     validate_config(largest);
-    const BufferSizes z = buffer_sizes(largest);
-    d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
-    sample_depth_.reserve(z.sample_depth);
-    band_updated_.reserve(z.bands);
-    levels_.reserve(z.levels), level_offset_.reserve(z.levels), level_width_.reserve(z.levels);
-    pyramid_.reserve(z.pyramid);
-    reference_cells_.reserve(z.cells);
-    cell_row_load_.reserve(z.cells_height);
+    const detail::BufferSizes z = buffer_sizes(largest);
+    reserve_arrays(z);
 
     const auto at_least = [](auto& v, std::size_t n) {
         if (v.size() < n) v.resize(n);

@@ -50,6 +50,7 @@ struct DrawOrderScratch;
 struct ReferenceCells;
 struct CellRecord;
 struct ChangedSubtiles;
+struct BufferSizes;
 }  // namespace detail
 
 enum class Backface : std::uint8_t {
@@ -220,6 +221,11 @@ struct ParallelFor {
 struct ScreenRect {
     float ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min;
 };
+
+// What is wrong with a configuration (a constant text naming the rule it breaks), or null when
+// it is valid. The buffer's constructor and configure() throw homcull::Error with it. Allocates
+// nothing (the C interface reports it without a C++ string).
+const char* buffer_config_problem(const BufferConfig& config) noexcept;
 
 class OcclusionBuffer {
 public:
@@ -395,6 +401,8 @@ private:
     void build_pyramid_rows(int row_begin, int row_end, int last_level);
     // Rows [y_begin, y_end) of pyramid level `level` >= 1 from the level below.
     void reduce_pyramid_rows(int level, int y_begin, int y_end);
+    // Room for the arrays sized by the configuration (configure, reserve): allocation only.
+    void reserve_arrays(const detail::BufferSizes& sizes);
     // Every level's cells over the subtiles [x0, x1) x [y0, y1): after a render on one thread,
     // the subtiles it changed (nothing when the rectangle is empty).
     void build_pyramid_rect(int x0, int x1, int y0, int y1);
