@@ -86,7 +86,10 @@ std::vector<std::uint8_t> read_answers(const std::string& path, std::uint32_t& r
     return answers;
 }
 
-HostWalk castle_walk(const Scene& castle, const std::vector<std::uint32_t>& occluders, const CameraPath& path) {
+// The host's input: the occluders' meshes and placements, every object's box, the cameras. Every
+// frame at `fixed` when it is given; else, a walk: 640x360, then 800x450 from the third of the
+// walk on and a farther near plane (0.3) from two thirds on.
+HostWalk castle_walk(const Scene& castle, const std::vector<std::uint32_t>& occluders, const CameraPath& path, Resolution fixed = {}) {
     HostWalk w;
     const glm::dvec3 anchor = scene_anchor(castle);
     std::map<std::uint32_t, std::uint32_t> walk_mesh;
@@ -108,8 +111,12 @@ HostWalk castle_walk(const Scene& castle, const std::vector<std::uint32_t>& occl
         Camera c = path.frames[f];
         // Mid-walk: a larger display from the third of the walk on, a farther near plane from
         // two thirds on.
-        if (3 * f >= 2 * path.frames.size()) c.near_plane = 0.3;
-        w.resolutions.push_back(3 * f >= path.frames.size() ? Resolution{800, 450} : Resolution{640, 360});
+        if (fixed.width > 0) {
+            w.resolutions.push_back(fixed);
+        } else {
+            if (3 * f >= 2 * path.frames.size()) c.near_plane = 0.3;
+            w.resolutions.push_back(3 * f >= path.frames.size() ? Resolution{800, 450} : Resolution{640, 360});
+        }
         c.eye -= anchor, c.target -= anchor;
         w.cameras.push_back(c);
     }
@@ -219,6 +226,56 @@ TEST(EngineHost, CastleWalkFromAC99Host) {
     EXPECT_EQ(differing, 0u) << "answers that differ from the C++ interface's";
 }
 
+// The objects the host answers hidden that Embree sees, over every frame of every run in the
+// answers file (runs x frames x boxes); `culled` counts the hidden answers.
+std::size_t false_culls(const RayScene& rays, const Scene& scene, const HostWalk& walk, const std::vector<std::uint8_t>& answers,
+                        std::uint32_t runs, std::size_t& culled) {
+    const std::uint32_t frames = std::uint32_t(walk.cameras.size()), boxes = std::uint32_t(scene.objects.size());
+    std::size_t wrong = 0;
+    for (std::uint32_t f = 0; f < frames; ++f) {
+        TruthOptions truth_options;
+        truth_options.resolution = walk.resolutions[f];
+        const TruthResult truth = compute_ground_truth(rays, scene, world_camera(walk.cameras[f], scene), truth_options);
+        for (std::uint32_t run = 0; run < runs; ++run)
+            for (std::uint32_t id = 0; id < boxes; ++id) {
+                const std::uint8_t a = answers[(std::size_t(run) * frames + f) * boxes + id];
+                culled += a == 1;
+                wrong += a != 0 && truth.objects[id].visible_samples > 0;
+            }
+    }
+    return wrong;
+}
+
+// Random views (the eye anywhere in the free space, any direction) at an odd resolution, on the
+// castle, sponza and the castle moved 10^5 from the origin: no false cull.
+TEST(EngineHost, RandomViewsOnSharedScenesFromAC99Host) {
+    struct Case {
+        const char* file;
+        glm::dvec3 offset;
+    };
+    std::size_t scenes = 0;
+    for (const Case& c : {Case{"intel_castle.glb", {0, 0, 0}}, Case{"crytek_sponza.glb", {0, 0, 0}}, Case{"intel_castle.glb", {1e5, 0, -1e5}}}) {
+        const std::string file = test::shared_scene(c.file);
+        if (file.empty()) continue;
+        ++scenes;
+        const Scene scene = translated_scene(load_scene(file), c.offset);
+        const RayScene rays(scene);
+        const HostWalk walk = castle_walk(scene, occluder_candidates(scene, OccluderFilter::size), random_views(rays, scene, 8, 11), {643, 359});
+        const std::string dir = test::temp_dir("EngineHost.RandomViews");
+        write_walk(dir + "/views.walk", scene, walk);
+        const std::string command = std::string(HOMCULL_ENGINE_HOST) + " " + dir + "/views.walk " + dir + "/answers";
+        ASSERT_EQ(std::system(command.c_str()), 0) << command;
+        std::uint32_t runs, frames, boxes;
+        const std::vector<std::uint8_t> answers = read_answers(dir + "/answers", runs, frames, boxes);
+        ASSERT_EQ(boxes, scene.objects.size());
+        std::size_t culled = 0;
+        EXPECT_EQ(false_culls(rays, scene, walk, answers, runs, culled), 0u) << c.file << " moved by " << format_vec3(c.offset);
+        std::printf("engine host, %s moved by %s: 8 random views at 643x359, %zu objects answered hidden\n", c.file,
+                    format_vec3(c.offset).c_str(), culled);
+    }
+    if (scenes == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
+}
+
 // For every k, the host's walk (a few frames of a part of the castle) with an allocator that
 // fails on its k-th call: every call returns OK or out of memory, every block comes back (the
 // host checks both; under AddressSanitizer, leaks and bad accesses fail it too), and no answer
@@ -241,19 +298,10 @@ TEST(EngineHost, AllocationFailureSweep) {
     std::uint32_t runs, frames, boxes;
     const std::vector<std::uint8_t> answers = read_answers(dir + "/answers", runs, frames, boxes);
     ASSERT_GT(runs, 50u);
-    std::size_t false_culls = 0, culled = 0;
-    for (std::uint32_t f = 0; f < frames; ++f) {
-        TruthOptions truth_options;
-        truth_options.resolution = walk.resolutions[f];
-        const TruthResult truth = compute_ground_truth(rays, castle, world_camera(walk.cameras[f], castle), truth_options);
-        for (std::uint32_t run = 0; run < runs; ++run)
-            for (std::uint32_t id = 0; id < boxes; ++id) {
-                const std::uint8_t a = answers[(std::size_t(run) * frames + f) * boxes + id];
-                culled += a == 1;
-                false_culls += a != 0 && truth.objects[id].visible_samples > 0;
-            }
-    }
-    EXPECT_EQ(false_culls, 0u);
+    ASSERT_EQ(frames, walk.cameras.size());
+    ASSERT_EQ(boxes, castle.objects.size());
+    std::size_t culled = 0;
+    EXPECT_EQ(false_culls(rays, castle, walk, answers, runs, culled), 0u);
     EXPECT_GT(culled, 0u);  // the runs whose allocations all succeeded cull something
 }
 
