@@ -123,6 +123,29 @@ void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t
     for (std::size_t i : order) task(data, i);
 }
 
+std::vector<float> pyramid_by_definition(const OcclusionBuffer& b) {
+    int w = b.subtiles_x(), h = b.subtiles_y();
+    std::vector<float> cells;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) cells.push_back(b.subtile(x, y).d0);
+    std::size_t below = 0;
+    while (w > 1 || h > 1) {
+        const int nw = (w + 1) / 2, nh = (h + 1) / 2;
+        const std::size_t here = cells.size();
+        for (int y = 0; y < nh; ++y)
+            for (int x = 0; x < nw; ++x) {
+                float m = cells[below + std::size_t(2 * y) * std::size_t(w) + std::size_t(2 * x)];
+                for (int dy = 0; dy < 2; ++dy)
+                    for (int dx = 0; dx < 2; ++dx)
+                        if (2 * x + dx < w && 2 * y + dy < h)
+                            m = std::min(m, cells[below + std::size_t(2 * y + dy) * std::size_t(w) + std::size_t(2 * x + dx)]);
+                cells.push_back(m);
+            }
+        below = here, w = nw, h = nh;
+    }
+    return cells;
+}
+
 bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
     const auto x = a.subtiles();
     const auto y = b.subtiles();

@@ -41,6 +41,8 @@ void run_shuffled(void* user, std::size_t count, void (*task)(void*, std::size_t
 bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b);
 // The same pyramids of the rectangle tests (built band by band with a job system).
 bool same_pyramid(const OcclusionBuffer& a, const OcclusionBuffer& b);
+// The pyramid as read_pyramid documents it, computed from the subtiles' d0.
+std::vector<float> pyramid_by_definition(const OcclusionBuffer& b);
 
 // Wherever the buffer claims an occluder (read_depth finite), a ray through the sample's
 // centre must hit something at or before the claimed depth (the ray parameter is the view

@@ -294,7 +294,7 @@ TEST(CApi, NoAllocationAfterReserve) {
     EngineMemory memory;
     {
         Culler culler(scene, make_context(&memory), 320, 180);
-        const homcull_reserve_desc reserve{1280, 720, 64, 64};
+        const homcull_reserve_desc reserve{1280, 720, 64, 64, 4, 256};
         ASSERT_EQ(homcull_buffer_reserve(culler.buffer, &reserve), HOMCULL_OK) << homcull_last_error();
         const std::size_t before = memory.calls;
         for (int k = 0; k < 6; ++k) {
@@ -312,6 +312,91 @@ TEST(CApi, NoAllocationAfterReserve) {
         EXPECT_EQ(memory.calls, before);
         EXPECT_GT(homcull_context_allocated_bytes(culler.context), 0u);
         EXPECT_GT(homcull_buffer_allocated_bytes(culler.buffer), 0u);
+    }
+    EXPECT_EQ(memory.live, 0u);
+}
+
+// Task lists (the pull model): a frame drawn as one gives the answers of draws on the calling
+// thread, allocating nothing after a reserve; calls out of order are errors that change nothing;
+// a list whose tasks did not all run says so and leaves the buffer usable and conservative.
+TEST(CApi, TaskListsAnswerAsDrawsDoAndRefuseCallsOutOfOrder) {
+    const Scene scene;
+    EngineMemory memory;
+    {
+        Culler culler(scene, make_context(&memory));
+        homcull_buffer* b = culler.buffer;
+        const homcull_reserve_desc reserve{320, 180, 8, 0, 3, 24};
+        ASSERT_EQ(homcull_buffer_reserve(b, &reserve), HOMCULL_OK) << homcull_last_error();
+        const homcull_view view = engine_view(Engine::opengl);
+        std::size_t tasks = 99;
+        EXPECT_EQ(homcull_buffer_begin_tasks(b), HOMCULL_ERROR_INVALID_OPERATION);  // no frame yet
+        ASSERT_EQ(homcull_buffer_begin_frame(b, &view), HOMCULL_OK);
+        EXPECT_EQ(homcull_buffer_close_tasks(b, &tasks), HOMCULL_ERROR_INVALID_OPERATION);
+        EXPECT_EQ(tasks, 0u);
+        EXPECT_EQ(homcull_buffer_run_task(b, 0), HOMCULL_ERROR_INVALID_OPERATION);
+        EXPECT_EQ(homcull_buffer_finish_tasks(b), HOMCULL_ERROR_INVALID_OPERATION);
+
+        const float shifted[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 40, 0, 0, 1};  // off the screen
+        const float matrices[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -20, 1};
+        homcull_frame_stats drawn{};  // the same draws without a list
+        ASSERT_EQ(homcull_buffer_begin_frame(b, &view), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_draw_mesh(b, culler.mesh, shifted, 1), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_draw_mesh(b, culler.mesh, matrices, 2), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_frame_stats(b, &drawn), HOMCULL_OK);
+        const std::size_t before = memory.calls;
+        for (int frame = 0; frame < 3; ++frame) {
+            ASSERT_EQ(homcull_buffer_begin_frame(b, &view), HOMCULL_OK);
+            ASSERT_EQ(homcull_buffer_begin_tasks(b), HOMCULL_OK) << homcull_last_error();
+            // While it records: draws of meshes only; no queries, frames or settings.
+            EXPECT_EQ(homcull_buffer_begin_tasks(b), HOMCULL_ERROR_INVALID_OPERATION);
+            ASSERT_EQ(homcull_buffer_draw_mesh(b, culler.mesh, shifted, 1), HOMCULL_OK) << homcull_last_error();
+            ASSERT_EQ(homcull_buffer_draw_mesh(b, culler.mesh, matrices, 2), HOMCULL_OK) << homcull_last_error();
+            const homcull_triangles triangles{scene.positions.data(), 12, scene.positions.size() / 3, scene.indices.data(), 2, 0, 8};
+            EXPECT_EQ(homcull_buffer_draw_triangles(b, &triangles, nullptr), HOMCULL_ERROR_INVALID_OPERATION);
+            std::vector<homcull_visibility> refused(scene.boxes.size(), 99);
+            EXPECT_EQ(homcull_buffer_test_boxes(b, scene.boxes.data(), scene.boxes.size(), nullptr, refused.data()),
+                      HOMCULL_ERROR_INVALID_OPERATION);
+            EXPECT_EQ(refused, std::vector<homcull_visibility>(scene.boxes.size(), HOMCULL_VISIBLE));
+            EXPECT_EQ(homcull_buffer_begin_frame(b, &view), HOMCULL_ERROR_INVALID_OPERATION);
+            EXPECT_EQ(homcull_buffer_set_resolution(b, 100, 100), HOMCULL_ERROR_INVALID_OPERATION);
+            EXPECT_EQ(homcull_buffer_run_task(b, 0), HOMCULL_ERROR_INVALID_OPERATION);  // not closed
+            ASSERT_EQ(homcull_buffer_close_tasks(b, &tasks), HOMCULL_OK) << homcull_last_error();
+            ASSERT_GE(tasks, 1u);
+            EXPECT_EQ(homcull_buffer_draw_mesh(b, culler.mesh, nullptr, 1), HOMCULL_ERROR_INVALID_OPERATION);  // closed
+            EXPECT_EQ(homcull_buffer_run_task(b, tasks), HOMCULL_ERROR_INVALID_ARGUMENT);
+            for (std::size_t i = tasks; i-- > 0;) ASSERT_EQ(homcull_buffer_run_task(b, i), HOMCULL_OK);
+            ASSERT_EQ(homcull_buffer_finish_tasks(b), HOMCULL_OK) << homcull_last_error();
+            std::vector<homcull_visibility> answers(scene.boxes.size(), 99);
+            ASSERT_EQ(homcull_buffer_test_boxes(b, scene.boxes.data(), scene.boxes.size(), nullptr, answers.data()), HOMCULL_OK);
+            EXPECT_EQ(answers, scene.expected) << "frame " << frame;
+            homcull_frame_stats stats{};
+            ASSERT_EQ(homcull_buffer_frame_stats(b, &stats), HOMCULL_OK);
+            EXPECT_EQ(stats.draw_calls, 2u);
+            EXPECT_EQ(stats.triangles_in, drawn.triangles_in);
+            EXPECT_EQ(stats.triangles_drawn, drawn.triangles_drawn);
+            EXPECT_EQ(stats.clusters_hidden, drawn.clusters_hidden);
+            EXPECT_EQ(stats.allocations, 0u);
+        }
+        EXPECT_EQ(memory.calls, before);
+
+        // A list whose tasks did not all run: an error; the buffer answers, conservatively.
+        ASSERT_EQ(homcull_buffer_begin_frame(b, &view), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_begin_tasks(b), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_draw_mesh(b, culler.mesh, nullptr, 1), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_close_tasks(b, &tasks), HOMCULL_OK);
+        EXPECT_EQ(homcull_buffer_finish_tasks(b), HOMCULL_ERROR_INVALID_OPERATION);
+        EXPECT_NE(std::string(homcull_last_error()).find("did not run"), std::string::npos) << homcull_last_error();
+        std::vector<homcull_visibility> answers(scene.boxes.size(), 99);
+        ASSERT_EQ(homcull_buffer_test_boxes(b, scene.boxes.data(), scene.boxes.size(), nullptr, answers.data()), HOMCULL_OK);
+        for (std::size_t k = 0; k < answers.size(); ++k)
+            if (scene.expected[k] == HOMCULL_VISIBLE) {
+                EXPECT_EQ(answers[k], HOMCULL_VISIBLE) << "box " << k;
+            }
+        // And one never closed: nothing was drawn.
+        ASSERT_EQ(homcull_buffer_begin_tasks(b), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_draw_mesh(b, culler.mesh, nullptr, 1), HOMCULL_OK);
+        EXPECT_EQ(homcull_buffer_finish_tasks(b), HOMCULL_ERROR_INVALID_OPERATION);
+        EXPECT_EQ(culler.frame(scene, view), scene.expected);
     }
     EXPECT_EQ(memory.live, 0u);
 }

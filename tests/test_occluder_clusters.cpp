@@ -347,6 +347,138 @@ TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
     }
 }
 
+// Runs a closed task list's tasks through a job system (the engine's side of the pull model).
+void run_task_list(OcclusionBuffer& buffer, const ParallelFor& jobs) {
+    const std::size_t tasks = buffer.close_tasks();
+    const auto task = [](void* b, std::size_t i) { static_cast<OcclusionBuffer*>(b)->run_task(i); };
+    if (jobs.run) jobs.run(jobs.user, tasks, task, &buffer);
+    else
+        for (std::size_t i = 0; i < tasks; ++i) task(&buffer, i);
+    buffer.finish_tasks();
+}
+
+// The castle's clusters as many draws (slices of its clusters, as an engine draws object by
+// object), and one draw of quads crossing the near plane and the guard band (clipping gives
+// them more triangles than their room, so every band sets them up itself), recorded in a task
+// list: on every instruction set, with the tasks in order, shuffled or on threads, the buffer
+// holds the bits, statistics and pyramid of one render per draw on one thread.
+TEST(ClusteredRender, TaskListsGiveTheBitsOfOneRenderPerDraw) {
+    const CastleOccluders* c = castle();
+    if (!c) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const OccluderClusters clusters = cluster_world(c->world);
+    OccluderClusters near_quads;
+    for (int k = 0; k < 6; ++k) {  // from behind the eye to far ahead, wide enough to reach the guard band
+        const float x = -3.0f + 1.3f * float(k), z = 2.0f - 4.0f * float(k);
+        append_quad(near_quads, {x - 1e4f, -1.0f, 5.0f}, {x, -1.0f, z - 40.0f}, {x, 1.0f, z - 40.0f}, {x - 1e4f, 1.0f, 5.0f});
+        // One triangle, one vertex behind the eye: clipped into a quad, two triangles in a room of one.
+        append_cluster(near_quads, {{x, -2.0f, 3.0f}, {x + 2.0f, -1.0f, z - 30.0f}, {x - 2.0f, 1.5f, z - 30.0f}}, {0, 1, 2}, {0});
+    }
+    std::vector<std::uint32_t> ids(clusters.clusters.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) ids[k] = std::uint32_t(k);
+    std::mt19937_64 order_rng(9);
+    const ParallelFor tbb = test::parallel_jobs(), shuffled{test::run_shuffled, &order_rng}, threads = test::thread_jobs(2);
+    for (const std::size_t view : {std::size_t(0), std::size_t(3)}) {
+        const Camera& camera = c->views.frames[view];
+        const std::array<float, 16> clip = clip_from_world(camera, 1280.0 / 720.0);
+        std::vector<ClusteredInput> draws;
+        for (std::size_t first = 0; first < ids.size(); first += 37) {
+            ClusteredInput d{&clusters, clip, Backface::cw};
+            d.cluster_ids = ids.data() + first;
+            d.cluster_count = std::min<std::size_t>(37, ids.size() - first);
+            draws.push_back(d);
+            if (first == 37 * 4)  // the quads are in the camera's view space
+                draws.push_back(ClusteredInput{&near_quads, float_matrix(projection_matrix(camera, 1280.0 / 720.0)), Backface::none});
+        }
+        for (const bool keep_before : {false, true}) {
+            const BufferConfig config = test::buffer_config(640, 360, 2, float(camera.near_plane), view == 3);
+            select_isa("scalar");
+            OcclusionBuffer reference(config);
+            if (keep_before) reference.render(draws[2]);  // the list then draws onto what is there
+            for (const ClusteredInput& d : draws) reference.render(d);
+            EXPECT_GT(reference.stats().cluster_bands_hidden, 10u);
+            EXPECT_GT(reference.stats().near_clipped, 0u);
+            for (const std::string& isa : available_isas())
+                for (const ParallelFor* jobs : {&shuffled, &tbb, &threads}) {
+                    select_isa(isa);
+                    OcclusionBuffer buffer(config);
+                    if (keep_before) buffer.render(draws[2]);
+                    else buffer.render(draws[5]);  // cleared by the list
+                    buffer.begin_tasks(!keep_before);
+                    for (const ClusteredInput& d : draws) buffer.record(d, jobs == &tbb ? tbb : ParallelFor{});
+                    run_task_list(buffer, *jobs);
+                    const std::string what = isa + (jobs == &shuffled ? ", shuffled" : jobs == &tbb ? ", TBB" : ", threads") + ", view " +
+                                             std::to_string(view) + (keep_before ? ", onto a render" : ", cleared");
+                    EXPECT_TRUE(reference.stats() == buffer.stats()) << what;
+                    EXPECT_TRUE(test::same_subtiles(reference, buffer)) << what;
+                    EXPECT_TRUE(test::same_pyramid(reference, buffer)) << what;
+                }
+            select_isa("best");
+        }
+    }
+}
+
+// Calls out of order are errors that change nothing; a task list whose tasks did not all run
+// is an error, and the buffer then holds what ran (with its pyramid): conservative, and no row
+// of the frame before when the list clears.
+TEST(ClusteredRender, TaskListMisuseIsAnErrorAndMissingTasksStayConservative) {
+    constexpr int kBandSampleRows = 32 * OcclusionBuffer::kSubtileHeight;  // a task's rows (render_bands.hpp)
+    OccluderClusters clusters;
+    for (int k = 0; k < 40; ++k) {
+        const float x = -10.0f + 0.5f * float(k), z = -5.0f - 0.5f * float(k % 7);
+        append_quad(clusters, {x - 2.0f, -8.0f, z}, {x + 2.0f, -8.0f, z}, {x + 2.0f, 8.0f, z}, {x - 2.0f, 8.0f, z});
+    }
+    const ClusteredInput draw{&clusters, clip_from_world(test::camera_down_minus_z(70.0, 0.5), 1.6), Backface::cw};
+    const BufferConfig config = test::buffer_config(320, 300, 2, 0.5f);
+    OcclusionBuffer buffer(config), full(config);
+    full.render(draw);
+    EXPECT_THROW(buffer.record(draw), Error);
+    EXPECT_THROW((void)buffer.close_tasks(), Error);
+    EXPECT_THROW(buffer.finish_tasks(), Error);
+    buffer.run_task(0);  // no list: nothing happens
+    buffer.begin_tasks();
+    EXPECT_THROW(buffer.begin_tasks(), Error);
+    EXPECT_THROW(buffer.render(draw), Error);
+    ClusteredInput bad = draw;
+    bad.cluster_ids = nullptr;
+    bad.clusters = nullptr;
+    EXPECT_THROW(buffer.record(bad), Error);
+    buffer.record(draw);
+    const std::size_t tasks = buffer.close_tasks();
+    ASSERT_GE(tasks, 2u);
+    EXPECT_THROW(buffer.record(draw), Error);
+    buffer.run_task(tasks);  // out of range: ignored
+    buffer.run_task(0);
+    EXPECT_THROW(buffer.finish_tasks(), Error);  // the others did not run
+    buffer.begin_tasks();  // the list is closed, whatever finish_tasks said
+    buffer.finish_tasks(std::nothrow);
+    std::vector<float> drawn, whole;
+    buffer.read_depth(drawn);
+    full.read_depth(whole);
+    std::size_t claimed = 0;
+    for (std::size_t i = 0; i < drawn.size(); ++i) {
+        if (drawn[i] == INFINITY) continue;
+        ++claimed;
+        ASSERT_GE(drawn[i], whole[i]) << "sample " << i;  // never nearer than the whole render claims
+        ASSERT_LT(i, std::size_t(kBandSampleRows) * std::size_t(buffer.sample_width())) << "only the first band ran";
+    }
+    EXPECT_GT(claimed, 0u);
+    std::vector<float> pyramid;
+    buffer.read_pyramid(pyramid);
+    EXPECT_TRUE(pyramid == test::pyramid_by_definition(buffer));
+
+    // A clearing list that did not run leaves none of the frame before.
+    buffer.begin_tasks(true);
+    buffer.record(draw);
+    (void)buffer.close_tasks();
+    buffer.run_task(1);
+    EXPECT_THROW(buffer.finish_tasks(), Error);
+    buffer.read_depth(drawn);
+    for (std::size_t i = 0; i < std::size_t(kBandSampleRows) * std::size_t(buffer.sample_width()); ++i)
+        ASSERT_EQ(drawn[i], INFINITY) << "sample " << i << " of the band that did not run";
+    buffer.read_pyramid(pyramid);
+    EXPECT_TRUE(pyramid == test::pyramid_by_definition(buffer));
+}
+
 // More clusters than one placement task takes (64), drawn as a subset in another order, with
 // empty clusters and clusters outside the view among them, frame after frame on the same
 // buffers: every job system gives the serial bits and statistics (no shared scene needed).

@@ -16,34 +16,10 @@
 namespace homcull {
 namespace {
 
-// The pyramid as read_pyramid documents it, computed from the subtiles' d0.
-std::vector<float> pyramid_by_definition(const OcclusionBuffer& b) {
-    int w = b.subtiles_x(), h = b.subtiles_y();
-    std::vector<float> cells;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) cells.push_back(b.subtile(x, y).d0);
-    std::size_t below = 0;
-    while (w > 1 || h > 1) {
-        const int nw = (w + 1) / 2, nh = (h + 1) / 2;
-        const std::size_t here = cells.size();
-        for (int y = 0; y < nh; ++y)
-            for (int x = 0; x < nw; ++x) {
-                float m = cells[below + std::size_t(2 * y) * std::size_t(w) + std::size_t(2 * x)];
-                for (int dy = 0; dy < 2; ++dy)
-                    for (int dx = 0; dx < 2; ++dx)
-                        if (2 * x + dx < w && 2 * y + dy < h)
-                            m = std::min(m, cells[below + std::size_t(2 * y + dy) * std::size_t(w) + std::size_t(2 * x + dx)]);
-                cells.push_back(m);
-            }
-        below = here, w = nw, h = nh;
-    }
-    return cells;
-}
-
 void expect_pyramid_and_answers_exact(const OcclusionBuffer& b, const std::string& where) {
     std::vector<float> pyramid;
     b.read_pyramid(pyramid);
-    EXPECT_TRUE(pyramid == pyramid_by_definition(b)) << where;
+    EXPECT_TRUE(pyramid == test::pyramid_by_definition(b)) << where;
     std::size_t differing = 0;
     for (const ScreenRect& r : test::random_screen_rects(7, 400))
         differing += b.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min) !=

@@ -14,6 +14,7 @@ using namespace homcull;
 namespace {
 
 constexpr const char* kNoFrame = "no frame has begun on this buffer (homcull_buffer_begin_frame)";
+constexpr const char* kTaskListOpen = "a task list is open on this buffer (homcull_buffer_finish_tasks ends it)";
 
 BufferConfig buffer_config(const homcull_buffer_desc& d) {
     BufferConfig c;
@@ -62,10 +63,19 @@ bool outside_view(const float box_min[3], const float box_max[3], const std::arr
 }
 
 // The checks every draw and query shares.
-homcull_result check_frame(const homcull_buffer* b, const char* fn) {
+// recording: the call may come while a task list records (a mesh draw, which it records).
+homcull_result check_frame(const homcull_buffer* b, const char* fn, bool recording = false) {
     if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
     if (!b->frame_begun) return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: %s", fn, kNoFrame);
+    if (b->tasks != homcull_buffer::Tasks::none && !(recording && b->tasks == homcull_buffer::Tasks::recording))
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: %s", fn, kTaskListOpen);
     return HOMCULL_OK;
+}
+
+// Calls that change the buffer's settings or frame, refused while a task list is open.
+homcull_result check_no_task_list(const homcull_buffer& b, const char* fn) {
+    if (b.tasks == homcull_buffer::Tasks::none) return HOMCULL_OK;
+    return capi::report(b.account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: %s", fn, kTaskListOpen);
 }
 
 bool finite_matrix(const float* m) {
@@ -143,6 +153,7 @@ void homcull_buffer_destroy(homcull_buffer* buffer) {
 homcull_result homcull_buffer_set_resolution(homcull_buffer* b, int32_t width, int32_t height) {
     const char* const fn = "homcull_buffer_set_resolution";
     if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
+    if (homcull_result r = check_no_task_list(*b, fn); r != HOMCULL_OK) return r;
     BufferConfig config = b->buffer.config();
     config.width = width;
     config.height = height;
@@ -158,6 +169,7 @@ homcull_result homcull_buffer_set_resolution(homcull_buffer* b, int32_t width, i
 homcull_result homcull_buffer_set_near(homcull_buffer* b, float near_distance) {
     const char* const fn = "homcull_buffer_set_near";
     if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
+    if (homcull_result r = check_no_task_list(*b, fn); r != HOMCULL_OK) return r;
     BufferConfig config = b->buffer.config();
     config.near_w = near_distance;
     const homcull_result valid = check_config(b->account.context, fn, config);
@@ -172,6 +184,7 @@ homcull_result homcull_buffer_set_near(homcull_buffer* b, float near_distance) {
 homcull_result homcull_buffer_reserve(homcull_buffer* b, const homcull_reserve_desc* desc) {
     const char* const fn = "homcull_buffer_reserve";
     if (!b || !desc) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer or desc is null", fn);
+    if (homcull_result r = check_no_task_list(*b, fn); r != HOMCULL_OK) return r;
     BufferConfig largest = b->buffer.config();
     const int width = std::max(largest.width, desc->max_width), height = std::max(largest.height, desc->max_height);
     largest.width = width, largest.height = height;
@@ -187,7 +200,10 @@ homcull_result homcull_buffer_reserve(homcull_buffer* b, const homcull_reserve_d
         // plus a copy of each triangle's three apexes (OccluderClusters::edge_apexes).
         r.max_clusters = desc->max_draw_triangles;
         const ClusterLimits limits;
-        r.max_cluster_vertices = desc->max_draw_triangles > 0 ? limits.max_vertices + 3 * limits.max_triangles : 0;
+        r.max_cluster_vertices = desc->max_draw_triangles + desc->max_task_list_triangles > 0 ? limits.max_vertices + 3 * limits.max_triangles : 0;
+        // A draw through the job system is a task list of one draw.
+        r.max_task_list_draws = std::max<std::size_t>(desc->max_task_list_draws, 1);
+        r.max_task_list_clusters = r.max_task_list_triangles = std::max(desc->max_draw_triangles, desc->max_task_list_triangles);
         b->buffer.reserve(r);
         return HOMCULL_OK;
     });
@@ -195,8 +211,72 @@ homcull_result homcull_buffer_reserve(homcull_buffer* b, const homcull_reserve_d
 
 homcull_result homcull_buffer_set_job_system(homcull_buffer* b, const homcull_job_system* jobs) {
     if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "homcull_buffer_set_job_system: buffer is null");
+    if (homcull_result r = check_no_task_list(*b, "homcull_buffer_set_job_system"); r != HOMCULL_OK) return r;
     b->jobs = ParallelFor{};
     if (jobs && jobs->run) b->jobs = ParallelFor{jobs->run, jobs->user, jobs->threads};
+    return HOMCULL_OK;
+}
+
+homcull_result homcull_buffer_begin_tasks(homcull_buffer* b) {
+    const char* const fn = "homcull_buffer_begin_tasks";
+    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        b->buffer.begin_tasks();
+        b->tasks = homcull_buffer::Tasks::recording;
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_close_tasks(homcull_buffer* b, size_t* task_count) {
+    const char* const fn = "homcull_buffer_close_tasks";
+    if (task_count) *task_count = 0;
+    if (!b || !task_count) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer or task_count is null", fn);
+    if (b->tasks != homcull_buffer::Tasks::recording)
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: no task list is recording (homcull_buffer_begin_tasks)", fn);
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        b->task_count = b->buffer.close_tasks();  // out of memory: the list stays recording, finish_tasks ends it
+        b->tasks = homcull_buffer::Tasks::closed;
+        *task_count = b->task_count;
+        return HOMCULL_OK;
+    });
+}
+
+// From the engine's threads, at once: reads the buffer's state, which no other call changes
+// while the list is closed.
+homcull_result homcull_buffer_run_task(homcull_buffer* b, size_t index) {
+    const char* const fn = "homcull_buffer_run_task";
+    if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
+    if (b->tasks != homcull_buffer::Tasks::closed)
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: the task list is not closed (homcull_buffer_close_tasks)", fn);
+    if (index >= b->task_count)
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: task %zu is not below the task count %zu", fn, index,
+                            b->task_count);
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        b->buffer.run_task(index);  // noexcept, allocates nothing
+        return HOMCULL_OK;
+    });
+}
+
+homcull_result homcull_buffer_finish_tasks(homcull_buffer* b) {
+    const char* const fn = "homcull_buffer_finish_tasks";
+    if (!b) return capi::report(nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer is null", fn);
+    if (b->tasks == homcull_buffer::Tasks::none)
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: no task list is open (homcull_buffer_begin_tasks)", fn);
+    const bool closed = b->tasks == homcull_buffer::Tasks::closed;
+    const std::size_t tasks = b->task_count;
+    std::size_t missing = 0;
+    const homcull_result r = capi::guarded(b->account, fn, [&]() -> homcull_result {
+        missing = b->buffer.finish_tasks(std::nothrow);
+        return HOMCULL_OK;
+    });
+    b->tasks = homcull_buffer::Tasks::none;
+    b->task_count = 0;
+    if (r != HOMCULL_OK) return r;
+    if (!closed)
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: the list was not closed (homcull_buffer_close_tasks): nothing was drawn", fn);
+    if (missing != 0)
+        return capi::report(b->account.context, HOMCULL_ERROR_INVALID_OPERATION,
+                            "%s: %zu of the %zu tasks did not run; the buffer holds those that did", fn, missing, tasks);
     return HOMCULL_OK;
 }
 
@@ -205,6 +285,7 @@ uint64_t homcull_buffer_allocated_bytes(const homcull_buffer* b) { return b ? b-
 homcull_result homcull_buffer_begin_frame(homcull_buffer* b, const homcull_view* view) {
     const char* const fn = "homcull_buffer_begin_frame";
     if (!b || !view) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: buffer or view is null", fn);
+    if (homcull_result open = check_no_task_list(*b, fn); open != HOMCULL_OK) return open;
     capi::ViewConventions conventions;
     const homcull_result r = capi::read_view(b->account.context, *view, conventions);
     if (r != HOMCULL_OK) {
@@ -225,7 +306,7 @@ homcull_result homcull_buffer_begin_frame(homcull_buffer* b, const homcull_view*
 
 homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* mesh, const float* model_matrices, size_t instance_count) {
     const char* const fn = "homcull_buffer_draw_mesh";
-    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    if (homcull_result r = check_frame(b, fn, true); r != HOMCULL_OK) return r;
     const homcull_context* context = b->account.context;
     if (!mesh) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: mesh is null", fn);
     if (!model_matrices && instance_count > 1)
@@ -242,7 +323,8 @@ homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* m
         for (std::size_t i = 0; i < instance_count; ++i) {
             in.model_to_clip = capi::float_clip_from_model(b->clip_from_world, read_model(*b, model_matrices ? model_matrices + 16 * i : nullptr));
             if (mesh->bounded && outside_view(mesh->bounds_min, mesh->bounds_max, in.model_to_clip, b->buffer.config().near_w)) continue;
-            b->buffer.render(in, b->jobs);  // a render that fails leaves what it drew: occluders all, so still conservative
+            if (b->tasks == homcull_buffer::Tasks::recording) b->buffer.record(in);  // a record that fails records nothing
+            else b->buffer.render(in, b->jobs);  // a render that fails leaves what it drew: occluders all, so still conservative
         }
         return HOMCULL_OK;
     });

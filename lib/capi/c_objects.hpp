@@ -67,6 +67,9 @@ struct homcull_buffer {
     glm::dvec4 far_row{0.0};  // in front of (or on) the far plane: dot(far_row, world clip) >= 0
     std::uint64_t draw_calls = 0, allocations_at_frame = 0;
     homcull::ParallelFor jobs;  // the engine's job system for draws (empty: the calling thread)
+    // A task list (homcull_buffer_begin_tasks): draws recorded, then tasks run by the engine.
+    enum class Tasks : std::uint8_t { none, recording, closed } tasks = Tasks::none;
+    std::size_t task_count = 0;
     homcull_buffer(homcull_context* context, const homcull::BufferConfig& config);
 };
 

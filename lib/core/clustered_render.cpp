@@ -11,6 +11,7 @@
 #include "raster/triangle_batch.hpp"
 
 #include <algorithm>
+#include <new>
 #include <string>
 #include <thread>
 
@@ -50,13 +51,13 @@ void OcclusionBuffer::place_cluster(const OccluderCluster& c, std::uint32_t numb
         out.fate = ClusterPlace::kEmpty;
         return;
     }
-    out.placed = {0.0f, number, 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};  // untestable: every sample, no test
+    out.placed = {0.0f, number, 0, 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};  // untestable: every sample, no test
     ScreenRect rect;
     Visibility decided = Visibility::visible;
     detail::RectQuery q;
     if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, model_to_clip, config_.near_w, rect, decided) &&
         prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
-        out.placed = {rect.w_min, number, q.i0, q.i1, q.j0, q.j1, q.d_near, true};
+        out.placed = {rect.w_min, number, 0, q.i0, q.i1, q.j0, q.j1, q.d_near, true};
     else if (decided != Visibility::visible)  // outside the view, or between sample centres
         out.fate = ClusterPlace::kOutside;
 }
@@ -71,12 +72,13 @@ void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFo
     render_clusters(input, parallel, true);
 }
 
-void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
+std::size_t OcclusionBuffer::place_clusters(const ClusteredInput& in, const ParallelFor& parallel) {
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
     const OccluderClusters& clusters = *in.clusters;
     if (in.shared_edges && !in.edge_apexes) throw Error("render: ClusteredInput::shared_edges needs edge_apexes");
     if (clusters.edge_apexes.size() != 3 * clusters.shared_edges.size())
         throw Error("render: OccluderClusters::edge_apexes must hold three per triangle (build_occluder_clusters makes them)");
+    if (clusters.clusters.size() > std::size_t(UINT32_MAX)) throw Error("render: more than 2^32 - 1 clusters");
 
     // Every cluster is checked before anything is drawn (a render that throws changes nothing).
     const std::size_t count = in.cluster_ids ? in.cluster_count : clusters.clusters.size();
@@ -111,166 +113,275 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
     };
     const std::size_t place_tasks = (count + kClustersPerPlacementTask - 1) / kClustersPerPlacementTask;
     detail::run_tasks(parallel, place_tasks, place_task, &place_job);
+    return count;
+}
 
-    // The clusters in view, in input order, then nearest first.
-    placed_clusters_.clear();
-    RasterStats frame;
-    std::size_t most_vertices = 0, most_triangles = 0;  // of the clusters in view: the scratch below holds them
+// The draw's clusters in view (cluster_places_' first `count`), in input order, then nearest
+// first, after those placed_clusters_ already holds; the others counted in `stats`. Allocates
+// before it changes anything.
+void OcclusionBuffer::append_placed(const ClusteredInput& in, std::size_t count, RasterStats& stats) {
+    const auto room_for = [](auto& v, std::size_t more) {  // doubling: many small draws append in linear time
+        if (v.capacity() < v.size() + more) v.reserve(std::max(v.size() + more, 2 * v.capacity()));
+    };
+    room_for(placed_clusters_, count);
+    room_for(recorded_draws_, 1);
+    const std::uint32_t draw = std::uint32_t(recorded_draws_.size());
+    recorded_draws_.push_back(in);
+    const std::size_t first = placed_clusters_.size();
     for (std::size_t n = 0; n < count; ++n) {
-        const ClusterPlace& place = cluster_places_[n];
+        ClusterPlace& place = cluster_places_[n];
         if (place.fate == ClusterPlace::kEmpty) continue;
         if (place.fate == ClusterPlace::kOutside) {
-            ++frame.clusters_outside;
+            ++stats.clusters_outside;
             continue;
         }
+        place.placed.draw = draw;
         placed_clusters_.push_back(place.placed);
-        const OccluderCluster& c = clusters.clusters[place.placed.cluster];
-        most_vertices = std::max(most_vertices, std::size_t(c.vertex_count));
-        most_triangles = std::max(most_triangles, std::size_t(c.triangle_count));
+        const OccluderCluster& c = in.clusters->clusters[place.placed.cluster];
+        task_list_vertices_ = std::max(task_list_vertices_, std::size_t(c.vertex_count));
     }
-    std::sort(placed_clusters_.begin(), placed_clusters_.end(), [](const PlacedCluster& a, const PlacedCluster& b) {
+    std::sort(placed_clusters_.begin() + std::ptrdiff_t(first), placed_clusters_.end(), [](const PlacedCluster& a, const PlacedCluster& b) {
         return a.nearest_w < b.nearest_w || (a.nearest_w == b.nearest_w && a.cluster < b.cluster);
     });
+}
 
+// What the serial loop and the band tasks share: a band's rows, whether a band draws a cluster,
+// a cluster's setup.
+struct OcclusionBuffer::ClusterPass {
+    OcclusionBuffer& b;
+    detail::HiddenTestKernel hidden_test = detail::selected_hidden_test();
+    detail::FrontEndKernels kernels = detail::selected_front_end_kernels();
+
+    std::size_t plane() const { return b.task_list_vertices_ + detail::kVertexClipPadding; }
     // Scratch for one cluster's transformed vertices (triangle_batch.hpp's cache), one per band.
-    const std::size_t bands = band_updated_.size();
-    const std::size_t plane = most_vertices + detail::kVertexClipPadding;
-    if (band_vertex_clip_.size() < bands * 4 * plane) band_vertex_clip_.resize(bands * 4 * plane);
-    if (band_vertex_outcode_.size() < bands * plane) band_vertex_outcode_.resize(bands * plane);
-    band_stats_.assign(bands, RasterStats{});
-    if (parallel.run) {  // each cluster in view: a slot for its set-up triangles
-        while (cluster_setups_.size() < placed_clusters_.size()) cluster_setups_.push_back(detail::make_hooked<ClusterSetup>());
-        for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
-            cluster_setups_[k]->state.store(ClusterSetup::kNotSetUp, std::memory_order_relaxed);
-            // Room for a cluster's triangles (clipped fans may still add some): after the first
-            // frames, the band tasks allocate nothing.
-            cluster_setups_[k]->triangles.reserve(most_triangles);
-        }
+    detail::VertexClip cache(std::size_t band) const {
+        double* clip = b.band_vertex_clip_.data() + band * 4 * plane();
+        return detail::VertexClip{clip, clip + plane(), clip + 2 * plane(), clip + 3 * plane(), b.band_vertex_outcode_.data() + band * plane()};
     }
-    if (clear_first) stats_ = RasterStats{};  // after every check and allocation: a render that throws changes nothing
-    reference_cells_current_ = false;  // the noted renders' cells no longer hold d0
-    const auto cache_of = [&](std::size_t band) {
-        double* clip = band_vertex_clip_.data() + band * 4 * plane;
-        return detail::VertexClip{clip, clip + plane, clip + 2 * plane, clip + 3 * plane, band_vertex_outcode_.data() + band * plane};
-    };
-    const auto band_rows = [&](std::size_t band, int& row_begin, int& row_end) {
+    void band_rows(std::size_t band, int& row_begin, int& row_end) const {
         row_begin = int(band) * kBandSubtileRows;
-        row_end = std::min(row_begin + kBandSubtileRows, subtiles_y_);
-    };
+        row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);
+    }
     // Whether a band draws a cluster (its box reaches the band and is not hidden there),
     // counting the answer in the band's statistics.
-    const detail::HiddenTestKernel hidden_test = detail::selected_hidden_test();
-    const auto band_draws = [&](const PlacedCluster& p, std::size_t band, const detail::SubtilePlanes& planes) {
+    bool draws(const PlacedCluster& p, std::size_t band, const detail::SubtilePlanes& planes) const {
         int row_begin, row_end;
         band_rows(band, row_begin, row_end);
         int ty0, ty1;
         if (!detail::subtile_rows_within(p.j0, p.j1, row_begin, row_end, ty0, ty1)) return false;
         if (p.testable && hidden_test(planes, p.i0 / kW, p.i1 / kW, ty0, ty1, p.d_near)) {
-            ++band_stats_[band].cluster_bands_hidden;
+            ++b.band_stats_[band].cluster_bands_hidden;
             return false;
         }
-        ++band_stats_[band].cluster_bands_drawn;
+        ++b.band_stats_[band].cluster_bands_drawn;
         return true;
-    };
-    const detail::FrontEndKernels kernels = detail::selected_front_end_kernels();
-    // drawn_into: as setup_triangle_range's (null when the triangles are kept for other bands).
-    const auto set_up = [&](const PlacedCluster& p, const detail::VertexClip& cache, const detail::RasterTarget* drawn_into,
-                            RasterStats& stats, auto&& emit) {
-        const TriangleInput t = cluster_input(clusters, clusters.clusters[p.cluster], in);
-        kernels.transform_vertices(t, double(config_.near_w), 0, t.vertex_count, cache);
-        detail::setup_triangle_range(t, &cache, 0, t.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_,
-                                     drawn_into, stats, emit);
-    };
+    }
+    // No per-triangle hidden test in the setup (drawn_into null): the cluster's box just passed
+    // one, and of its triangles fewer are hidden (on castle C0, 29 % against 65 % drawn as one
+    // input), too few to pay for the test (0.729 -> 0.743 ms).
+    template <typename Emit>
+    void set_up(const PlacedCluster& p, const detail::VertexClip& cache, RasterStats& stats, Emit&& emit) const {
+        const ClusteredInput& in = b.recorded_draws_[p.draw];
+        const TriangleInput t = cluster_input(*in.clusters, in.clusters->clusters[p.cluster], in);
+        kernels.transform_vertices(t, double(b.config_.near_w), 0, t.vertex_count, cache);
+        detail::setup_triangle_range(t, &cache, 0, t.triangle_count, b.config_.near_w, b.config_.edge_margin, b.sample_width_,
+                                     b.sample_height_, nullptr, stats, emit);
+    }
+};
 
-    if (parallel.run) {
-        // Each band walks the clusters in order and decides on its own rows, as the serial loop
-        // below does. A cluster is set up by the first band that draws it and its triangles
-        // kept for the others (which wait for them: a band setting one up depends on no other
-        // task, so the wait is short and cannot deadlock): no bins, and no cluster set up twice.
-        struct Job {
-            decltype(band_rows)* rows;
-            decltype(band_draws)* draws;
-            decltype(set_up)* set_up_cluster;
-            decltype(cache_of)* band_cache;
-            OcclusionBuffer* self;
-            bool clear_first;
-        } job{&band_rows, &band_draws, &set_up, &cache_of, this, clear_first};
-        detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
-            const Job& j = *static_cast<Job*>(data);
-            OcclusionBuffer& b = *j.self;
-            int row_begin, row_end;
-            (*j.rows)(band, row_begin, row_end);
-            if (j.clear_first) b.clear_rows(row_begin, row_end);
-            const detail::RasterTarget target = b.raster_target(row_begin, row_end);
-            const detail::VertexClip cache = (*j.band_cache)(band);
-            RasterStats& stats = b.band_stats_[band];
-            for (std::size_t k = 0; k < b.placed_clusters_.size(); ++k) {
-                if (!(*j.draws)(b.placed_clusters_[k], band, target.planes)) continue;
-                ClusterSetup& s = *b.cluster_setups_[k];
-                int expected = ClusterSetup::kNotSetUp;
-                if (s.state.compare_exchange_strong(expected, ClusterSetup::kSettingUp, std::memory_order_acquire)) {
-                    try {
-                        s.triangles.clear();
-                        s.stats = RasterStats{};
-                        (*j.set_up_cluster)(b.placed_clusters_[k], cache, nullptr, s.stats,
-                                            [&](const detail::RasterTriangle& tri) { s.triangles.push_back(tri); });
-                    } catch (...) {  // the bands waiting for it must not wait for ever
-                        s.state.store(ClusterSetup::kFailed, std::memory_order_release);
-                        throw;
-                    }
-                    s.state.store(ClusterSetup::kReady, std::memory_order_release);
-                } else {
-                    while ((expected = s.state.load(std::memory_order_acquire)) == ClusterSetup::kSettingUp) std::this_thread::yield();
-                    if (expected == ClusterSetup::kFailed) return;  // another band throws: the render fails
-                }
-                stats += s.stats;  // the setup's counts once per band that draws the cluster, as on one thread
-                for (const detail::RasterTriangle& tri : s.triangles) stats.subtiles_updated += target.kernel(target, tri);
-            }
-            b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
-        }, &job);
-        reduce_pyramid_above_bands();
-    } else {
-        // One thread: each cluster is set up once and rasterized in the runs of bands that draw
-        // it. The statistics are the bands': its triangles' counts once per band drawing it.
-        if (clear_first) clear_rows(0, subtiles_y_);
-        const detail::RasterTarget whole = raster_target(0, subtiles_y_);
-        const detail::VertexClip cache = cache_of(0);
-        auto& runs = cluster_row_runs_;  // subtile rows [first, second)
-        RasterStats serial;
-        detail::ChangedSubtiles changed;
-        for (const PlacedCluster& p : placed_clusters_) {
-            runs.clear();
-            std::uint64_t drawn = 0;
-            for (std::size_t band = std::size_t(p.j0 / kH / kBandSubtileRows); band <= std::size_t(p.j1 / kH / kBandSubtileRows); ++band) {
-                if (!band_draws(p, band, whole.planes)) continue;
-                ++drawn;
-                int row_begin, row_end;
-                band_rows(band, row_begin, row_end);
-                if (!runs.empty() && runs.back().second == row_begin) runs.back().second = row_end;
-                else runs.emplace_back(row_begin, row_end);
-            }
-            if (runs.empty()) continue;
-            RasterStats stats;
-            // No per-triangle hidden test in the setup (drawn_into null): the cluster's box just
-            // passed one, and of its triangles fewer are hidden (on castle C0, 29 % against 65 %
-            // drawn as one input), too few to pay for the test (0.729 -> 0.743 ms).
-            set_up(p, cache, nullptr, stats, [&](const detail::RasterTriangle& tri) {
-                detail::RasterTarget target = whole;
-                for (const auto& [row_begin, row_end] : runs) {
-                    target.row_begin = row_begin, target.row_end = row_end;
-                    const std::uint64_t n = target.kernel(target, tri);
-                    serial.subtiles_updated += n;
-                    if (n != 0) changed.add(tri, subtiles_x_, subtiles_y_);
-                }
-            });
-            for (std::uint64_t k = 0; k < drawn; ++k) serial += stats;
+void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
+    if (task_list_ != TaskList::none) throw Error("render: a task list is open (begin_tasks without finish_tasks)");
+    if (parallel.run) {  // a task list of one draw, its tasks run by the job system
+        begin_tasks(clear_first);
+        try {
+            record(in, parallel);
+            const std::size_t tasks = close_tasks();
+            detail::run_tasks(parallel, tasks, [](void* self, std::size_t band) { static_cast<OcclusionBuffer*>(self)->run_task(band); }, this);
+        } catch (...) {
+            finish_tasks(std::nothrow);  // what ran stays, with a pyramid to match
+            throw;
         }
-        band_stats_[0] += serial;
-        build_changed_pyramid(clear_first, changed);
+        finish_tasks();
+        return;
     }
 
+    // One thread: each cluster is set up once and rasterized in the runs of bands that draw it.
+    // The statistics are the bands': its triangles' counts once per band drawing it.
+    const std::size_t count = place_clusters(in, parallel);
+    placed_clusters_.clear();
+    recorded_draws_.clear();
+    task_list_vertices_ = 0;
+    RasterStats frame;
+    append_placed(in, count, frame);
+    const std::size_t bands = band_updated_.size();
+    const ClusterPass pass{*this};
+    if (band_vertex_clip_.size() < 4 * pass.plane()) band_vertex_clip_.resize(4 * pass.plane());
+    if (band_vertex_outcode_.size() < pass.plane()) band_vertex_outcode_.resize(pass.plane());
+    band_stats_.assign(bands, RasterStats{});
+    if (clear_first) stats_ = RasterStats{};  // after every check and allocation: a render that throws changes nothing
+    reference_cells_current_ = false;         // the noted renders' cells no longer hold d0
+
+    if (clear_first) clear_rows(0, subtiles_y_);
+    const detail::RasterTarget whole = raster_target(0, subtiles_y_);
+    const detail::VertexClip cache = pass.cache(0);
+    auto& runs = cluster_row_runs_;  // subtile rows [first, second)
+    RasterStats serial;
+    detail::ChangedSubtiles changed;
+    for (const PlacedCluster& p : placed_clusters_) {
+        runs.clear();
+        std::uint64_t drawn = 0;
+        for (std::size_t band = std::size_t(p.j0 / kH / kBandSubtileRows); band <= std::size_t(p.j1 / kH / kBandSubtileRows); ++band) {
+            if (!pass.draws(p, band, whole.planes)) continue;
+            ++drawn;
+            int row_begin, row_end;
+            pass.band_rows(band, row_begin, row_end);
+            if (!runs.empty() && runs.back().second == row_begin) runs.back().second = row_end;
+            else runs.emplace_back(row_begin, row_end);
+        }
+        if (runs.empty()) continue;
+        RasterStats stats;
+        pass.set_up(p, cache, stats, [&](const detail::RasterTriangle& tri) {
+            detail::RasterTarget target = whole;
+            for (const auto& [row_begin, row_end] : runs) {
+                target.row_begin = row_begin, target.row_end = row_end;
+                const std::uint64_t n = target.kernel(target, tri);
+                serial.subtiles_updated += n;
+                if (n != 0) changed.add(tri, subtiles_x_, subtiles_y_);
+            }
+        });
+        for (std::uint64_t k = 0; k < drawn; ++k) serial += stats;
+    }
+    band_stats_[0] += serial;
+    build_changed_pyramid(clear_first, changed);
     stats_ += frame;
     for (const RasterStats& s : band_stats_) stats_ += s;
+}
+
+// ---- Task lists ------------------------------------------------------------------------------
+
+void OcclusionBuffer::begin_tasks(bool clear_first) {
+    if (task_list_ != TaskList::none) throw Error("begin_tasks: a task list is already open (finish_tasks closes it)");
+    task_list_ = TaskList::recording;
+    task_list_clears_ = clear_first;
+    task_list_stats_ = RasterStats{};
+    task_list_vertices_ = 0;
+    placed_clusters_.clear();
+    recorded_draws_.clear();
+}
+
+void OcclusionBuffer::record(const ClusteredInput& draw, const ParallelFor& parallel) {
+    const detail::StandardFloatMode mode;
+    if (task_list_ != TaskList::recording) throw Error("record: no task list is recording (begin_tasks, then record before close_tasks)");
+    const std::size_t count = place_clusters(draw, parallel);
+    append_placed(draw, count, task_list_stats_);
+}
+
+std::size_t OcclusionBuffer::close_tasks() {
+    if (task_list_ != TaskList::recording) throw Error("close_tasks: no task list is recording (begin_tasks first)");
+    // Every allocation first (a close that throws leaves the list recording; finish_tasks drops it).
+    const std::size_t bands = band_updated_.size();
+    const ClusterPass pass{*this};
+    std::size_t room = 0;
+    for (const PlacedCluster& p : placed_clusters_) room += recorded_draws_[p.draw].clusters->clusters[p.cluster].triangle_count;
+    if (band_vertex_clip_.size() < bands * 4 * pass.plane()) band_vertex_clip_.resize(bands * 4 * pass.plane());
+    if (band_vertex_outcode_.size() < bands * pass.plane()) band_vertex_outcode_.resize(bands * pass.plane());
+    if (setup_triangles_.size() < room) setup_triangles_.resize(room);
+    if (cluster_setups_.size() < placed_clusters_.size()) cluster_setups_.resize(placed_clusters_.size());
+    band_stats_.assign(bands, RasterStats{});
+    band_ran_.assign(bands, 0);
+
+    std::size_t first = 0;
+    for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
+        const PlacedCluster& p = placed_clusters_[k];
+        ClusterSetup& s = cluster_setups_[k];
+        s.first = first, s.room = recorded_draws_[p.draw].clusters->clusters[p.cluster].triangle_count, s.count = 0;
+        s.stats = RasterStats{};
+        s.state.store(ClusterSetup::kNotSetUp, std::memory_order_relaxed);
+        first += s.room;
+    }
+    if (task_list_clears_) stats_ = RasterStats{};
+    reference_cells_current_ = false;  // the noted renders' cells no longer hold d0
+    task_list_ = TaskList::closed;
+    return bands;
+}
+
+// Band `band` walks the clusters in order and decides on its own rows, as the serial loop does.
+// A cluster is set up by the first band that draws it, its triangles kept for the others (which
+// wait for them: a band setting one up depends on no other task, so the wait is short and cannot
+// deadlock): no bins, and no cluster set up twice unless it outgrows its room.
+void OcclusionBuffer::run_task(std::size_t band) noexcept {
+    if (task_list_ != TaskList::closed || band >= band_ran_.size()) return;  // finish_tasks reports the bands that did not run
+    const detail::StandardFloatMode mode;
+    const ClusterPass pass{*this};
+    int row_begin, row_end;
+    pass.band_rows(band, row_begin, row_end);
+    if (task_list_clears_) clear_rows(row_begin, row_end);
+    const detail::RasterTarget target = raster_target(row_begin, row_end);
+    const detail::VertexClip cache = pass.cache(band);
+    RasterStats& stats = band_stats_[band];
+    const auto draw = [&](const detail::RasterTriangle& tri) { stats.subtiles_updated += target.kernel(target, tri); };
+    for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
+        const PlacedCluster& p = placed_clusters_[k];
+        if (!pass.draws(p, band, target.planes)) continue;
+        ClusterSetup& s = cluster_setups_[k];
+        int expected = ClusterSetup::kNotSetUp;
+        if (s.state.compare_exchange_strong(expected, ClusterSetup::kSettingUp, std::memory_order_acquire)) {
+            std::size_t made = 0;
+            pass.set_up(p, cache, s.stats, [&](const detail::RasterTriangle& tri) {
+                if (made < s.room) setup_triangles_[s.first + made] = tri;
+                ++made;
+            });
+            s.count = made;
+            expected = made <= s.room ? ClusterSetup::kReady : ClusterSetup::kEach;
+            s.state.store(expected, std::memory_order_release);
+        } else {
+            while ((expected = s.state.load(std::memory_order_acquire)) == ClusterSetup::kSettingUp) std::this_thread::yield();
+        }
+        if (expected == ClusterSetup::kEach) {  // set up again here, drawn as it comes
+            RasterStats own;
+            pass.set_up(p, cache, own, draw);
+            stats += own;
+            continue;
+        }
+        stats += s.stats;  // the setup's counts once per band that draws the cluster, as on one thread
+        for (std::size_t t = 0; t < s.count; ++t) draw(setup_triangles_[s.first + t]);
+    }
+    build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(levels_.size()) - 1));
+    band_ran_[band] = 1;
+}
+
+std::size_t OcclusionBuffer::finish_tasks(std::nothrow_t) noexcept {
+    if (task_list_ == TaskList::none) return 0;
+    if (task_list_ == TaskList::recording) {  // nothing ran: the buffer is as it was
+        task_list_ = TaskList::none;
+        return band_updated_.size();
+    }
+    const ClusterPass pass{*this};
+    std::size_t missing = 0;
+    for (std::size_t band = 0; band < band_updated_.size(); ++band) {
+        if (band < band_ran_.size() && band_ran_[band]) continue;
+        ++missing;
+        if (!task_list_clears_) continue;  // its rows, and their pyramid cells, are as they were
+        int row_begin, row_end;  // a frame's rows hold none of the frame before
+        pass.band_rows(band, row_begin, row_end);
+        clear_rows(row_begin, row_end);
+        build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(levels_.size()) - 1));
+    }
+    reduce_pyramid_above_bands();
+    stats_ += task_list_stats_;
+    for (const RasterStats& s : band_stats_) stats_ += s;
+    task_list_ = TaskList::none;
+    return missing;
+}
+
+void OcclusionBuffer::finish_tasks() {
+    if (task_list_ == TaskList::none) throw Error("finish_tasks: no task list is open");
+    const bool closed = task_list_ == TaskList::closed;
+    const std::size_t bands = band_updated_.size(), missing = finish_tasks(std::nothrow);
+    if (!closed) throw Error("finish_tasks: the task list was not closed (close_tasks); nothing was drawn");
+    if (missing != 0)
+        throw Error("finish_tasks: " + std::to_string(missing) + " of the " + std::to_string(bands) +
+                    " tasks did not run; the buffer holds those that did");
 }
 
 }  // namespace homcull

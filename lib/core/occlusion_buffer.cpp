@@ -225,16 +225,20 @@ void OcclusionBuffer::reserve(const BufferReserve& r) {
         at_least(vertex_clip_, 4 * (r.max_vertices + detail::kVertexClipPadding));
         at_least(vertex_outcode_, r.max_vertices);
     }
-    // Clustered input.
+    // Clustered input: one draw on one thread, or a task list (render_clusters, close_tasks).
     at_least(cluster_places_, r.max_clusters);
-    placed_clusters_.reserve(r.max_clusters);
+    placed_clusters_.reserve(std::max(r.max_clusters, r.max_task_list_clusters));
+    recorded_draws_.reserve(std::max<std::size_t>(1, r.max_task_list_draws));
     band_stats_.reserve(z.bands);
+    band_ran_.reserve(z.bands);
     cluster_row_runs_.reserve(z.bands);
-    if (r.max_clusters > 0) {
+    if (r.max_clusters > 0 || r.max_task_list_clusters > 0) {
         const std::size_t plane = r.max_cluster_vertices + detail::kVertexClipPadding;
         at_least(band_vertex_clip_, z.bands * 4 * plane);
         at_least(band_vertex_outcode_, z.bands * plane);
     }
+    at_least(cluster_setups_, r.max_task_list_clusters);
+    at_least(setup_triangles_, r.max_task_list_triangles);
 }
 
 void OcclusionBuffer::clear() {

@@ -54,6 +54,7 @@ struct ChangedSubtiles {
 struct OcclusionBuffer::PlacedCluster {
     float nearest_w;  // the order: nearest first (0 for untestable clusters), then by number
     std::uint32_t cluster;
+    std::uint32_t draw;  // its draw: recorded_draws_[draw]
     int i0, i1, j0, j1;
     float d_near;
     bool testable;
@@ -67,13 +68,23 @@ struct OcclusionBuffer::ClusterPlace {
     static constexpr std::uint8_t kInView = 0, kOutside = 1, kEmpty = 2;  // kEmpty: no triangles
 };
 
-// With a job system, a cluster in view is set up once, by the first band that draws it, and
-// its triangles kept here for the other bands that draw it (each waits until they are ready).
+// In a task list, a cluster in view is set up once, by the first band that draws it, into its
+// room in setup_triangles_ ([first, first + room): its triangle count), and drawn from there by
+// the others (each waits until it is ready). When clipping gives it more triangles than its room,
+// every band drawing it sets it up itself (kEach): the same triangles, so the same bits.
 struct OcclusionBuffer::ClusterSetup {
-    detail::Vector<detail::RasterTriangle> triangles;
+    std::size_t first = 0, room = 0, count = 0;
     RasterStats stats;          // the setup's counts
-    std::atomic<int> state{0};  // kNotSetUp, kSettingUp, kReady, or kFailed (the setup threw)
-    static constexpr int kNotSetUp = 0, kSettingUp = 1, kReady = 2, kFailed = 3;
+    std::atomic<int> state{0};  // kNotSetUp, kSettingUp, kReady or kEach
+    static constexpr int kNotSetUp = 0, kSettingUp = 1, kReady = 2, kEach = 3;
+    ClusterSetup() = default;
+    // Copied only on the calling thread, while no task runs (the vector grows in close_tasks).
+    ClusterSetup(const ClusterSetup& o) : first(o.first), room(o.room), count(o.count), stats(o.stats), state(o.state.load()) {}
+    ClusterSetup& operator=(const ClusterSetup& o) {
+        first = o.first, room = o.room, count = o.count, stats = o.stats;
+        state.store(o.state.load());
+        return *this;
+    }
 };
 
 }  // namespace homcull

@@ -4,8 +4,10 @@
  * row-major matrices). It walks a scene written by tests/test_engine_host.cpp: it registers
  * the meshes once, draws the occluders object by object, nearest first, and tests every
  * object's box each frame, then writes the answers for the test to check against Embree and
- * against the C++ interface. It draws the walk a second time through its own job system (tasks
- * taken in turn by two threads) and checks that the answers are the same.
+ * against the C++ interface. It draws the walk again through its own job system (tasks taken in
+ * turn by two threads), once called by the library and once as task lists it runs itself (the
+ * pull model), and checks that the answers are the same and that nothing allocates after the
+ * reserve.
  *
  *   engine_host WALK ANSWERS            the walk; exit 0, or 2 and a message when a call fails or
  *                                       the walk allocated after its reserve. ANSWERS.trace gets
@@ -300,6 +302,16 @@ static void run_jobs(void* user, size_t count, void (*task)(void* task_data, siz
     pthread_mutex_destroy(&b.lock);
 }
 
+/* The pull model: the buffer's tasks, run by the engine's job system. */
+static void run_buffer_task(void* buffer, size_t index) {
+    const homcull_result r = homcull_buffer_run_task((homcull_buffer*)buffer, index);
+    if (r != HOMCULL_OK) fail("homcull_buffer_run_task(%lu): %s (%s)", (unsigned long)index, homcull_result_name(r), homcull_last_error());
+}
+
+/* How a walk draws: on the calling thread, through the engine's job system (the library calls
+ * it), or as task lists the engine runs itself (the pull model). */
+enum { DRAW_ON_CALLER, DRAW_THROUGH_JOBS, DRAW_AS_TASKS };
+
 /* ---- The walk ------------------------------------------------------------------------------- */
 
 typedef struct {
@@ -325,7 +337,7 @@ static int acceptable(homcull_result r, int sweeping, const char* what) {
  * writing each frame's answers to `answers` (box_count each; all visible where nothing could
  * be answered). Returns the allocator's calls; *walk_allocations gets those after the reserve. */
 static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail_at, homcull_visibility* answers,
-                              unsigned long* walk_allocations, FILE* trace, int with_jobs) {
+                              unsigned long* walk_allocations, FILE* trace, int drawing) {
     EngineMemory memory;
     homcull_context_desc desc;
     homcull_context* context = NULL;
@@ -337,6 +349,7 @@ static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail
     unsigned long calls_after_reserve = 0;
     const int sweeping = fail_at != 0;
     uint32_t i, f, largest = 0;
+    size_t all_triangles = 0;
     int32_t width = 0, height = 0;
     double near_plane = 0.0;
 
@@ -375,9 +388,11 @@ static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail
         bd.near_distance = (float)w->frames[0].near_plane;
         if (acceptable(homcull_buffer_create(context, &bd, &buffer), sweeping, "homcull_buffer_create")) {
             memset(&reserve, 0, sizeof reserve);
+            for (i = 0; i < w->occluder_count; ++i) all_triangles += w->meshes[w->occluders[i].mesh].triangles;
             reserve.max_width = width, reserve.max_height = height, reserve.max_draw_triangles = largest;
+            reserve.max_task_list_draws = w->occluder_count, reserve.max_task_list_triangles = all_triangles;
             acceptable(homcull_buffer_reserve(buffer, &reserve), sweeping, "homcull_buffer_reserve");
-            if (with_jobs) {
+            if (drawing == DRAW_THROUGH_JOBS) {
                 homcull_job_system jobs;
                 memset(&jobs, 0, sizeof jobs);
                 jobs.run = run_jobs, jobs.threads = 2;
@@ -415,9 +430,19 @@ static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail
             ++n;
         }
         qsort(items, n, sizeof *items, nearest_first);
+        if (drawing == DRAW_AS_TASKS) acceptable(homcull_buffer_begin_tasks(buffer), sweeping, "homcull_buffer_begin_tasks");
         for (i = 0; i < n; ++i)
             acceptable(homcull_buffer_draw_mesh(buffer, meshes[items[i].occluder->mesh], items[i].occluder->model, 1), sweeping,
                        "homcull_buffer_draw_mesh");
+        if (drawing == DRAW_AS_TASKS) {
+            size_t tasks = 0;
+            if (acceptable(homcull_buffer_close_tasks(buffer, &tasks), sweeping, "homcull_buffer_close_tasks")) {
+                run_jobs(NULL, tasks, run_buffer_task, buffer);
+                acceptable(homcull_buffer_finish_tasks(buffer), sweeping, "homcull_buffer_finish_tasks");
+            } else if (homcull_buffer_finish_tasks(buffer) != HOMCULL_ERROR_INVALID_OPERATION) { /* ends the unclosed list */
+                fail("homcull_buffer_finish_tasks of an unclosed list did not say so");
+            }
+        }
         if (trace) { /* the camera and the draw order, for the test to replay through the C++ interface */
             if (fwrite(view.world_to_clip, sizeof view.world_to_clip, 1, trace) != 1 || fwrite(&n, 4, 1, trace) != 1) fail("cannot write the trace");
             for (i = 0; i < n; ++i) {
@@ -428,7 +453,7 @@ static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail
         r = test_boxes_on_two_threads(buffer, w, answers + (size_t)f * w->box_count);
         if (r != HOMCULL_OK) fail("homcull_buffer_test_boxes: %s (%s)", homcull_result_name(r), homcull_last_error());
         if (homcull_buffer_frame_stats(buffer, &stats) != HOMCULL_OK) fail("homcull_buffer_frame_stats failed");
-        if (!sweeping && !with_jobs && stats.allocations != 0) fail("frame %u allocated %lu times after the reserve", f, (unsigned long)stats.allocations);
+        if (!sweeping && stats.allocations != 0) fail("frame %u allocated %lu times after the reserve", f, (unsigned long)stats.allocations);
     }
     if (walk_allocations) *walk_allocations = memory.calls - calls_after_reserve;
 
@@ -469,18 +494,24 @@ int main(int argc, char** argv) {
         snprintf(trace_path, sizeof trace_path, "%s.trace", argv[2]);
         trace = fopen(trace_path, "wb");
         if (!trace) fail("cannot write %s", trace_path);
-        calls = run_walk(&walk, walk.frame_count, 0, answers, &after_reserve, trace, 0);
+        calls = run_walk(&walk, walk.frame_count, 0, answers, &after_reserve, trace, DRAW_ON_CALLER);
         fclose(trace);
-        {   /* The same walk drawn through the engine's job system: the same answers. */
+        if (after_reserve != 0) fail("the walk allocated %lu times after the reserve", after_reserve);
+        {   /* The same walk drawn through the engine's job system, and as task lists it runs itself:
+             * the same answers, and nothing allocated after the reserve. */
             homcull_visibility* threaded = (homcull_visibility*)checked_malloc((size_t)walk.frame_count * walk.box_count);
-            run_walk(&walk, walk.frame_count, 0, threaded, NULL, NULL, 1);
+            run_walk(&walk, walk.frame_count, 0, threaded, &after_reserve, NULL, DRAW_THROUGH_JOBS);
             if (memcmp(answers, threaded, (size_t)walk.frame_count * walk.box_count) != 0)
                 fail("the walk drawn through the job system answers differently from the calling thread");
+            if (after_reserve != 0) fail("the walk through the job system allocated %lu times after the reserve", after_reserve);
+            run_walk(&walk, walk.frame_count, 0, threaded, &after_reserve, NULL, DRAW_AS_TASKS);
+            if (memcmp(answers, threaded, (size_t)walk.frame_count * walk.box_count) != 0)
+                fail("the walk drawn as task lists answers differently from the calling thread");
+            if (after_reserve != 0) fail("the walk as task lists allocated %lu times after the reserve", after_reserve);
             free(threaded);
         }
-        if (after_reserve != 0) fail("the walk allocated %lu times after the reserve", after_reserve);
         printf("engine_host: %u frames, %u occluders drawn one by one, %u boxes; %lu allocations, none after the reserve; "
-               "the same answers through the job system\n",
+               "the same answers, and none after the reserve, through the job system and as task lists\n",
                walk.frame_count, walk.occluder_count, walk.box_count, calls);
         write_answers(argv[2], 1, walk.frame_count, walk.box_count, answers);
     } else {
@@ -489,10 +520,10 @@ int main(int argc, char** argv) {
         unsigned long total, k;
         homcull_visibility* all;
         answers = (homcull_visibility*)checked_malloc(per_run);
-        total = run_walk(&walk, walk.frame_count, 0, answers, NULL, NULL, 0);
+        total = run_walk(&walk, walk.frame_count, 0, answers, NULL, NULL, DRAW_ON_CALLER);
         free(answers);
         all = (homcull_visibility*)checked_malloc((total + 1) * per_run);
-        for (k = 1; k <= total + 1; ++k) run_walk(&walk, walk.frame_count, k, all + (k - 1) * per_run, NULL, NULL, 0);
+        for (k = 1; k <= total + 1; ++k) run_walk(&walk, walk.frame_count, k, all + (k - 1) * per_run, NULL, NULL, DRAW_ON_CALLER);
         printf("engine_host: %lu runs, each failing one allocation of %lu; every call returned OK or out of memory, every block came back\n",
                total + 1, total);
         write_answers(argv[3], (uint32_t)(total + 1), walk.frame_count, walk.box_count, all);

@@ -82,7 +82,7 @@ class homcull_buffer_desc(Structure):
 
 class homcull_reserve_desc(Structure):
     _fields_ = [("max_width", c_int32), ("max_height", c_int32), ("max_draw_triangles", c_size_t),
-                ("max_draw_vertices", c_size_t)]
+                ("max_draw_vertices", c_size_t), ("max_task_list_draws", c_size_t), ("max_task_list_triangles", c_size_t)]
 
 
 job_task_fn = CFUNCTYPE(None, c_void_p, c_size_t)
@@ -163,6 +163,10 @@ def bind(lib):
     f("homcull_buffer_test_boxes", homcull_result, buffer_p, POINTER(homcull_box), c_size_t, POINTER(c_float),
       POINTER(homcull_visibility))
     f("homcull_buffer_frame_stats", homcull_result, buffer_p, POINTER(homcull_frame_stats))
+    f("homcull_buffer_begin_tasks", homcull_result, buffer_p)
+    f("homcull_buffer_close_tasks", homcull_result, buffer_p, POINTER(c_size_t))
+    f("homcull_buffer_run_task", homcull_result, buffer_p, c_size_t)
+    f("homcull_buffer_finish_tasks", homcull_result, buffer_p)
 
 
 # ---- The checks -------------------------------------------------------------------------------------
@@ -338,6 +342,24 @@ def run(lib_path, header_path):
     check(r == HOMCULL_OK, f"homcull_buffer_test_boxes: {r} {lib.homcull_last_error()!r}")
     check(list(visibility) == expected, f"box answers {list(visibility)}, expected {expected}")
 
+    # The same frame as a task list the caller runs itself (here, its tasks in reverse order).
+    r = lib.homcull_buffer_begin_frame(buffer, ctypes.byref(view))
+    check(r == HOMCULL_OK, f"homcull_buffer_begin_frame: {r} {lib.homcull_last_error()!r}")
+    tasks = c_size_t(0)
+    for step, r in (("begin_tasks", lib.homcull_buffer_begin_tasks(buffer)),
+                    ("draw_mesh", lib.homcull_buffer_draw_mesh(buffer, mesh, None, 1)),
+                    ("close_tasks", lib.homcull_buffer_close_tasks(buffer, ctypes.byref(tasks)))):
+        check(r == HOMCULL_OK, f"homcull_buffer_{step}: {r} {lib.homcull_last_error()!r}")
+    check(tasks.value >= 1, f"homcull_buffer_close_tasks gave {tasks.value} tasks")
+    for i in reversed(range(tasks.value)):
+        r = lib.homcull_buffer_run_task(buffer, i)
+        check(r == HOMCULL_OK, f"homcull_buffer_run_task({i}): {r} {lib.homcull_last_error()!r}")
+    r = lib.homcull_buffer_finish_tasks(buffer)
+    check(r == HOMCULL_OK, f"homcull_buffer_finish_tasks: {r} {lib.homcull_last_error()!r}")
+    as_tasks = (homcull_visibility * 3)(255, 255, 255)
+    r = lib.homcull_buffer_test_boxes(buffer, boxes, 3, None, as_tasks)
+    check(r == HOMCULL_OK and list(as_tasks) == expected, f"box answers after a task list {list(as_tasks)}, expected {expected}")
+
     stats = homcull_frame_stats()
     r = lib.homcull_buffer_frame_stats(buffer, ctypes.byref(stats))
     check(r == HOMCULL_OK, f"homcull_buffer_frame_stats: {r} {lib.homcull_last_error()!r}")
@@ -376,7 +398,7 @@ def run(lib_path, header_path):
     print(f"homcull {parts['MAJOR']}.{parts['MINOR']}.{parts['PATCH']} (version {linked}) from {lib_path}")
     print(f"  {size_checks} struct sizes match the header ({8 * struct.calcsize('P')}-bit pointers)")
     print(f"  context isa {lib.homcull_isa_name(isa).decode()}, supported isas mask {isas:#x}")
-    print(f"  boxes: {list(visibility)} (occluded, visible, view-culled)")
+    print(f"  boxes: {list(visibility)} (occluded, visible, view-culled), the same after a task list of {tasks.value} tasks")
     print(f"  frame stats: {stats.triangles_in} in, {stats.triangles_drawn} drawn, {stats.triangles_skipped} skipped,"
           f" {stats.draw_calls} draw call(s), {stats.allocations} allocation(s)")
     print(f"  error: {lib.homcull_result_name(r).decode()}: {message.decode()}")

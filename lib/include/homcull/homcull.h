@@ -214,6 +214,9 @@ typedef struct homcull_reserve_desc {
     int32_t max_width, max_height;  /* largest resolution set_resolution will be asked for */
     size_t max_draw_triangles;      /* the most triangles one draw call carries (an instanced draw: per instance) */
     size_t max_draw_vertices;       /* the most vertices one homcull_buffer_draw_triangles call carries */
+    /* Task lists (homcull_buffer_begin_tasks): the most mesh draws (instances counted each) one
+     * list records, and the most triangles of all their meshes. */
+    size_t max_task_list_draws, max_task_list_triangles;
 } homcull_reserve_desc;
 
 typedef struct homcull_buffer homcull_buffer;
@@ -230,10 +233,8 @@ HOMCULL_API homcull_result homcull_buffer_reserve(homcull_buffer* buffer, const 
  * task(task_data, i) once for every i in [0, count), in any order, on any threads, and return
  * when every call has returned. Tasks never fail and never unwind (the library catches what
  * goes wrong inside one and reports it from the draw). The answers are the same bits as on the
- * calling thread. Null run: draws run on the calling thread (the default).
- * With a job system, a draw's per-band scratch may still grow after a reserve when clipping
- * makes a cluster's triangles outnumber the reserve's room (counted in
- * homcull_frame_stats.allocations, through the allocator). */
+ * calling thread. Null run: draws run on the calling thread (the default). A mesh draw is then
+ * a task list of one draw (homcull_buffer_begin_tasks), run through `run`. */
 typedef struct homcull_job_system {
     void (*run)(void* user, size_t count, void (*task)(void* task_data, size_t index), void* task_data);
     void* user;
@@ -241,6 +242,26 @@ typedef struct homcull_job_system {
     uint32_t reserved; /* 0 */
 } homcull_job_system;
 HOMCULL_API homcull_result homcull_buffer_set_job_system(homcull_buffer* buffer, const homcull_job_system* jobs);
+
+/* Draws as tasks the engine's job system schedules itself (the pull model, as masked occlusion
+ * culling's BinTriangles and RenderTrilist allow), beside homcull_job_system:
+ *     homcull_buffer_begin_tasks(buffer);
+ *     homcull_buffer_draw_mesh(buffer, ...);    any number: recorded on the calling thread
+ *     homcull_buffer_close_tasks(buffer, &count);
+ *     homcull_buffer_run_task(buffer, i);        for every i < count, once each, on any threads,
+ *                                                at once, in any order
+ *     homcull_buffer_finish_tasks(buffer);       after every run_task returned
+ * The buffer then holds the same bits as those draws made one after another without a list.
+ * A task never allocates and never fails; after a reserve (max_task_list_*) nothing in the list
+ * allocates. Between begin and finish, the meshes drawn must stay alive, and every other call
+ * on the buffer (homcull_buffer_draw_triangles, queries, a new frame or resolution) is
+ * HOMCULL_ERROR_INVALID_OPERATION (queries answer visible). finish_tasks always ends the list:
+ * when some task did not run it says so (HOMCULL_ERROR_INVALID_OPERATION), and the buffer holds
+ * the tasks that ran, which is conservative. */
+HOMCULL_API homcull_result homcull_buffer_begin_tasks(homcull_buffer* buffer);
+HOMCULL_API homcull_result homcull_buffer_close_tasks(homcull_buffer* buffer, size_t* task_count);
+HOMCULL_API homcull_result homcull_buffer_run_task(homcull_buffer* buffer, size_t index);
+HOMCULL_API homcull_result homcull_buffer_finish_tasks(homcull_buffer* buffer);
 
 /* Bytes of the context's allocator the buffer holds, and how many allocations it has made. */
 HOMCULL_API uint64_t homcull_buffer_allocated_bytes(const homcull_buffer* buffer);
@@ -330,7 +351,7 @@ HOMCULL_CHECK_SIZE_(allocator, homcull_allocator, 3 * sizeof(void*));
 HOMCULL_CHECK_SIZE_(context_desc, homcull_context_desc, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(mesh_desc, homcull_mesh_desc, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(triangles, homcull_triangles, 5 * sizeof(void*) + 8);
-HOMCULL_CHECK_SIZE_(reserve_desc, homcull_reserve_desc, 8 + 2 * sizeof(size_t));
+HOMCULL_CHECK_SIZE_(reserve_desc, homcull_reserve_desc, 8 + 4 * sizeof(size_t));
 HOMCULL_CHECK_SIZE_(job_system, homcull_job_system, 2 * sizeof(void*) + 8);
 
 #ifdef __cplusplus

@@ -100,6 +100,12 @@ public:
     [[nodiscard]] Result draw(const homcull_triangles& triangles, const float* model_matrix = nullptr) {
         return homcull_buffer_draw_triangles(handle_, &triangles, model_matrix);
     }
+    // Task lists, the pull model (homcull.h): begin_tasks, draws of meshes, close_tasks, then
+    // run_task(i) for every i < task_count on the engine's threads, then finish_tasks.
+    [[nodiscard]] Result begin_tasks() { return homcull_buffer_begin_tasks(handle_); }
+    [[nodiscard]] Result close_tasks(std::size_t& task_count) { return homcull_buffer_close_tasks(handle_, &task_count); }
+    [[nodiscard]] Result run_task(std::size_t index) { return homcull_buffer_run_task(handle_, index); }
+    [[nodiscard]] Result finish_tasks() { return homcull_buffer_finish_tasks(handle_); }
     // Answers into `visibility`, which must be as long as `boxes` (else an error).
     [[nodiscard]] Result test(Span<const homcull_box> boxes, Span<homcull_visibility> visibility, const float* model_matrix = nullptr) const {
         if (visibility.size < boxes.size) return homcull_buffer_test_boxes(handle_, boxes.data, boxes.size, model_matrix, nullptr);

@@ -27,6 +27,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -82,8 +83,11 @@ struct BufferReserve {
     int max_width = 0, max_height = 0;  // pixels (the samples per pixel stay the buffer's)
     std::size_t max_triangles = 0;      // per render call
     std::size_t max_vertices = 0;       // per render(TriangleInput) call
-    std::size_t max_clusters = 0;       // per render(ClusteredInput) call
+    std::size_t max_clusters = 0;       // per render(ClusteredInput) or record() call
     std::size_t max_cluster_vertices = 0;  // the largest OccluderCluster::vertex_count drawn
+    // Clustered draws with a job system, and record()ed task lists: the most clusters and the
+    // most triangles in them of one task list (a render with a job system is a list of one draw).
+    std::size_t max_task_list_draws = 0, max_task_list_clusters = 0, max_task_list_triangles = 0;
 };
 
 struct RasterStats {
@@ -301,6 +305,33 @@ public:
     void render(const ClusteredInput& input, const ParallelFor& parallel = {});
     void render_frame(const ClusteredInput& input, const ParallelFor& parallel = {});
 
+    // Clustered draws as tasks the caller's job system schedules itself (the pull model, as
+    // masked occlusion culling's BinTriangles and RenderTrilist allow), beside ParallelFor:
+    //     begin_tasks();                      // clear_first: as render_frame
+    //     record(draw) for each draw;         // on the calling thread: nothing drawn yet
+    //     n = close_tasks();                  // one task per band of subtile rows
+    //     run_task(i) for every i < n, once each, on any threads, at once, in any order;
+    //     finish_tasks();                     // after every run_task returned
+    // The buffer then holds the same bits as render(draw) called for each draw in turn, on one
+    // thread or with a job system: each band takes the draws in their order, and a draw's
+    // clusters nearest first, as those renders do. record() places the draw's clusters (in
+    // tasks of `parallel`, when given) and throws homcull::Error, like render(), before
+    // recording anything. A task allocates nothing and throws nothing: a cluster is set up by
+    // the first band that draws it, into room for its own triangle count, which the others
+    // then draw; one that clipping makes larger is set up by each band that draws it instead.
+    // Between begin_tasks and finish_tasks the buffer must not be rendered into, cleared or
+    // queried. finish_tasks throws homcull::Error when close_tasks' tasks did not all run (the
+    // buffer then holds the bands that ran, which is conservative, with a pyramid to match).
+    void begin_tasks(bool clear_first = false);
+    void record(const ClusteredInput& draw, const ParallelFor& parallel = {});
+    std::size_t close_tasks();
+    void run_task(std::size_t index) noexcept;
+    void finish_tasks();
+    // The same without throwing, whatever state the list is in (for a caller abandoning it):
+    // returns how many tasks did not run (every one when the list was not closed; nothing was
+    // drawn then, and nothing changes).
+    std::size_t finish_tasks(std::nothrow_t) noexcept;
+
     // Occludee tests. Thread-safe with each other (no render in flight): they only read the
     // buffer (RenderThreads.QueriesFromManyThreadsAnswerAsOneThread compares the answers of
     // four threads asking at once with one thread's).
@@ -439,11 +470,24 @@ private:
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
     bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
 
-    // Clustered input (clustered_render.cpp).
+    // Clustered input (clustered_render.cpp). With a job system a render is a task list of one
+    // draw (begin_tasks ... finish_tasks).
     void render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first);
+    // Checks a draw and places its clusters (cluster_places_), throwing before anything changes.
+    std::size_t place_clusters(const ClusteredInput& in, const ParallelFor& parallel);
+    void append_placed(const ClusteredInput& in, std::size_t count, RasterStats& stats);
+    struct ClusterPass;
     struct PlacedCluster;
     struct ClusterPlace;
     struct ClusterSetup;
+    enum class TaskList : std::uint8_t { none, recording, closed };
+    TaskList task_list_ = TaskList::none;
+    bool task_list_clears_ = false;
+    RasterStats task_list_stats_;               // the recorded draws' clusters outside the view
+    std::size_t task_list_vertices_ = 0;        // the most vertices of a cluster recorded (the band caches' size)
+    detail::Vector<ClusteredInput> recorded_draws_;  // PlacedCluster::draw numbers them
+    detail::Vector<std::uint8_t> band_ran_;     // per band: its task ran (finish_tasks checks them all)
+    detail::Vector<detail::RasterTriangle> setup_triangles_;  // each ClusterSetup's room, one after the other
     // Where a cluster's box lands (in view, outside, or no triangles). In job-system tasks: noexcept.
     void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
                        ClusterPlace& out) const noexcept;
@@ -485,7 +529,7 @@ private:
     detail::Vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
     detail::Vector<RasterStats> band_stats_;
     detail::Vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
-    detail::Vector<detail::HookPtr<ClusterSetup>> cluster_setups_;  // job system: one per cluster in view (never moved)
+    detail::Vector<ClusterSetup> cluster_setups_;  // task lists: one per cluster in view
     detail::Vector<double> band_vertex_clip_;         // per band: four planes of a cluster's vertices + padding
     detail::Vector<std::uint8_t> band_vertex_outcode_;
 
