@@ -92,7 +92,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             case 0: check(homcull_buffer_set_resolution(buffer, int(in.below(400)) - 2, int(in.below(300)) - 2)); break;
             case 1: check(homcull_buffer_set_near(buffer, in.take<float>())); break;
             case 2: {
-                const homcull_reserve_desc r{int(in.below(600)), int(in.below(400)), in.below(5000), in.below(5000)};
+                const homcull_reserve_desc r{int(in.below(600)), int(in.below(400)), in.below(5000), in.below(5000), in.below(9), in.below(5000)};
                 check(homcull_buffer_reserve(buffer, &r));
                 break;
             }
@@ -110,8 +110,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         float models[2][16];
         for (auto& model : models)
             for (float& m : model) m = in.flag() ? in.take<float>() : float(int(in.below(3)) - 1);
+        // Sometimes as a task list, its steps in or out of order, its tasks all, some or none run.
+        const bool as_tasks = in.flag();
+        if (as_tasks) check(homcull_buffer_begin_tasks(buffer));
         check(homcull_buffer_draw_mesh(buffer, mesh, in.flag() ? nullptr : &models[0][0], in.below(3)));
         check(homcull_buffer_draw_triangles(buffer, in.flag() ? &tris : nullptr, in.flag() ? nullptr : models[1]));
+        if (as_tasks) {
+            std::size_t tasks = 0;
+            if (in.flag()) check(homcull_buffer_close_tasks(buffer, in.flag() ? &tasks : nullptr));
+            const std::size_t run = in.flag() ? tasks : in.below(unsigned(tasks) + 2);
+            for (std::size_t i = run; i-- > 0;) check(homcull_buffer_run_task(buffer, i));
+            if (in.flag()) check(homcull_buffer_finish_tasks(buffer));  // else the list stays open into the queries and the next frame
+        }
         homcull_box boxes[4];
         for (homcull_box& b : boxes)
             for (int k = 0; k < 3; ++k) b.min[k] = in.take<float>(), b.max[k] = in.flag() ? b.min[k] + float(in.below(9)) : in.take<float>();
