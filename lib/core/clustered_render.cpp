@@ -1,9 +1,10 @@
-// OcclusionBuffer::render(ClusteredInput): clusters decided by their boxes, nearest first,
+// detail::BufferState::render(ClusteredInput): clusters decided by their boxes, nearest first,
 // band by band (see occlusion_buffer.hpp and occluder_clusters.hpp).
 #include <homcull/error.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/buffer_state.hpp"
 #include "core/rect_tests.hpp"
 #include "core/render_bands.hpp"
 #include "core/run_tasks.hpp"
@@ -44,7 +45,7 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
 
 // Runs in job-system tasks, which must not throw: every check that can fail stays in
 // render_clusters' serial loop, before the tasks.
-void OcclusionBuffer::place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
+void detail::BufferState::place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
                                     ClusterPlace& out) const noexcept {
     out.fate = ClusterPlace::kInView;
     if (c.triangle_count == 0) {
@@ -62,17 +63,17 @@ void OcclusionBuffer::place_cluster(const OccluderCluster& c, std::uint32_t numb
         out.fate = ClusterPlace::kOutside;
 }
 
-void OcclusionBuffer::render(const ClusteredInput& input, const ParallelFor& parallel) {
+void detail::BufferState::render(const ClusteredInput& input, const ParallelFor& parallel) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     render_clusters(input, parallel, false);
 }
 
-void OcclusionBuffer::render_frame(const ClusteredInput& input, const ParallelFor& parallel) {
+void detail::BufferState::render_frame(const ClusteredInput& input, const ParallelFor& parallel) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     render_clusters(input, parallel, true);
 }
 
-std::size_t OcclusionBuffer::place_clusters(const ClusteredInput& in, const ParallelFor& parallel) {
+std::size_t detail::BufferState::place_clusters(const ClusteredInput& in, const ParallelFor& parallel) {
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
     const OccluderClusters& clusters = *in.clusters;
     if (in.shared_edges && !in.edge_apexes) throw Error("render: ClusteredInput::shared_edges needs edge_apexes");
@@ -99,7 +100,7 @@ std::size_t OcclusionBuffer::place_clusters(const ClusteredInput& in, const Para
     // a job system, in tasks: the castle's 393 boxes took 0.04 ms of a 0.46 ms two-thread render.
     if (cluster_places_.size() < count) cluster_places_.resize(count);
     struct PlaceJob {
-        OcclusionBuffer* self;
+        detail::BufferState* self;
         const ClusteredInput* in;
         std::size_t count;
     } place_job{this, &in, count};
@@ -119,7 +120,7 @@ std::size_t OcclusionBuffer::place_clusters(const ClusteredInput& in, const Para
 // The draw's clusters in view (cluster_places_' first `count`), in input order, then nearest
 // first, after those placed_clusters_ already holds; the others counted in `stats`. Allocates
 // before it changes anything.
-void OcclusionBuffer::append_placed(const ClusteredInput& in, std::size_t count, RasterStats& stats) {
+void detail::BufferState::append_placed(const ClusteredInput& in, std::size_t count, RasterStats& stats) {
     const auto room_for = [](auto& v, std::size_t more) {  // doubling: many small draws append in linear time
         if (v.capacity() < v.size() + more) v.reserve(std::max(v.size() + more, 2 * v.capacity()));
     };
@@ -147,8 +148,8 @@ void OcclusionBuffer::append_placed(const ClusteredInput& in, std::size_t count,
 
 // What the serial loop and the band tasks share: a band's rows, whether a band draws a cluster,
 // a cluster's setup.
-struct OcclusionBuffer::ClusterPass {
-    OcclusionBuffer& b;
+struct detail::BufferState::ClusterPass {
+    detail::BufferState& b;
     detail::HiddenTestKernel hidden_test = detail::selected_hidden_test();
     detail::FrontEndKernels kernels = detail::selected_front_end_kernels();
 
@@ -189,14 +190,14 @@ struct OcclusionBuffer::ClusterPass {
     }
 };
 
-void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
+void detail::BufferState::render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first) {
     if (task_list_ != TaskList::none) throw Error("render: a task list is open (begin_tasks without finish_tasks)");
     if (parallel.run) {  // a task list of one draw, its tasks run by the job system
         begin_tasks(clear_first);
         try {
             record(in, parallel);
             const std::size_t tasks = close_tasks();
-            detail::run_tasks(parallel, tasks, [](void* self, std::size_t band) { static_cast<OcclusionBuffer*>(self)->run_task(band); }, this);
+            detail::run_tasks(parallel, tasks, [](void* self, std::size_t band) { static_cast<detail::BufferState*>(self)->run_task(band); }, this);
         } catch (...) {
             finish_tasks(std::nothrow);  // what ran stays, with a pyramid to match
             throw;
@@ -259,7 +260,7 @@ void OcclusionBuffer::render_clusters(const ClusteredInput& in, const ParallelFo
 
 // ---- Task lists ------------------------------------------------------------------------------
 
-void OcclusionBuffer::begin_tasks(bool clear_first) {
+void detail::BufferState::begin_tasks(bool clear_first) {
     if (task_list_ != TaskList::none) throw Error("begin_tasks: a task list is already open (finish_tasks closes it)");
     task_list_ = TaskList::recording;
     task_list_clears_ = clear_first;
@@ -269,14 +270,14 @@ void OcclusionBuffer::begin_tasks(bool clear_first) {
     recorded_draws_.clear();
 }
 
-void OcclusionBuffer::record(const ClusteredInput& draw, const ParallelFor& parallel) {
+void detail::BufferState::record(const ClusteredInput& draw, const ParallelFor& parallel) {
     const detail::StandardFloatMode mode;
     if (task_list_ != TaskList::recording) throw Error("record: no task list is recording (begin_tasks, then record before close_tasks)");
     const std::size_t count = place_clusters(draw, parallel);
     append_placed(draw, count, task_list_stats_);
 }
 
-std::size_t OcclusionBuffer::close_tasks() {
+std::size_t detail::BufferState::close_tasks() {
     if (task_list_ != TaskList::recording) throw Error("close_tasks: no task list is recording (begin_tasks first)");
     // Every allocation first (a close that throws leaves the list recording; finish_tasks drops it).
     const std::size_t bands = band_updated_.size();
@@ -309,7 +310,7 @@ std::size_t OcclusionBuffer::close_tasks() {
 // A cluster is set up by the first band that draws it, its triangles kept for the others (which
 // wait for them: a band setting one up depends on no other task, so the wait is short and cannot
 // deadlock): no bins, and no cluster set up twice unless it outgrows its room.
-void OcclusionBuffer::run_task(std::size_t band) noexcept {
+void detail::BufferState::run_task(std::size_t band) noexcept {
     if (task_list_ != TaskList::closed || band >= band_ran_.size()) return;  // finish_tasks reports the bands that did not run
     const detail::StandardFloatMode mode;
     const ClusterPass pass{*this};
@@ -350,7 +351,7 @@ void OcclusionBuffer::run_task(std::size_t band) noexcept {
     band_ran_[band] = 1;
 }
 
-std::size_t OcclusionBuffer::finish_tasks(std::nothrow_t) noexcept {
+std::size_t detail::BufferState::finish_tasks(std::nothrow_t) noexcept {
     if (task_list_ == TaskList::none) return 0;
     if (task_list_ == TaskList::recording) {  // nothing ran: the buffer is as it was
         task_list_ = TaskList::none;
@@ -374,7 +375,7 @@ std::size_t OcclusionBuffer::finish_tasks(std::nothrow_t) noexcept {
     return missing;
 }
 
-void OcclusionBuffer::finish_tasks() {
+void detail::BufferState::finish_tasks() {
     if (task_list_ == TaskList::none) throw Error("finish_tasks: no task list is open");
     const bool closed = task_list_ == TaskList::closed;
     const std::size_t bands = band_updated_.size(), missing = finish_tasks(std::nothrow);

@@ -2,6 +2,7 @@
 // whose first, coarse stage runs in SIMD lanes: rect_tests_simd.cpp) and world boxes.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/buffer_state.hpp"
 #include "core/float_mode.hpp"
 #include "core/min_pyramid.hpp"
 #include "core/rect_tests.hpp"
@@ -18,7 +19,7 @@ constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtil
 
 }  // namespace
 
-bool OcclusionBuffer::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, detail::RectQuery& q,
+bool detail::BufferState::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, detail::RectQuery& q,
                               Visibility& decided) const {
     if (!std::isfinite(ndc_min_x) || !std::isfinite(ndc_min_y) || !std::isfinite(ndc_max_x) || !std::isfinite(ndc_max_y) ||
         !std::isfinite(w_min) || !(ndc_min_x <= ndc_max_x) || !(ndc_min_y <= ndc_max_y)) {
@@ -47,12 +48,12 @@ bool OcclusionBuffer::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x,
     return true;
 }
 
-detail::SubtileView OcclusionBuffer::subtile_view() const {
+detail::SubtileView detail::BufferState::subtile_view() const {
     return {d0_.data(),       d1_.data(),     mask_.data(),      stride_, sample_depth_.empty() ? nullptr : sample_depth_.data(),
             sample_depth_stride_, pyramid_.data(), levels_.data(), int(levels_.size())};
 }
 
-Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y,
+Visibility detail::BufferState::test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y,
                                                  float w_min) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     detail::RectQuery q;
@@ -65,7 +66,7 @@ Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_
     return Visibility::occluded;
 }
 
-Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
+Visibility detail::BufferState::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     detail::RectQuery q;
     Visibility decided;
@@ -73,7 +74,7 @@ Visibility OcclusionBuffer::test_rect(float ndc_min_x, float ndc_min_y, float nd
     return test_prepared_rect(q);
 }
 
-Visibility OcclusionBuffer::test_prepared_rect(const detail::RectQuery& q) const {
+Visibility detail::BufferState::test_prepared_rect(const detail::RectQuery& q) const {
     const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
 
     // Coarse check: the level where the subtile range spans at most 2 x 2 cells. Their minimum
@@ -173,7 +174,7 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
 
 }  // namespace detail
 
-Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) const {
+Visibility detail::BufferState::test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
@@ -181,7 +182,7 @@ Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_ma
     return test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
 }
 
-void OcclusionBuffer::test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const {
+void detail::BufferState::test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     const detail::RectBlockKernel block = detail::selected_rect_block_kernel();
     if (!block) {  // the scalar reference
@@ -196,7 +197,7 @@ void OcclusionBuffer::test_rects(const ScreenRect* rects, std::size_t count, Vis
         block(view, subtiles, rects + base, std::min(detail::kRectBlock, count - base), results + base);
 }
 
-void OcclusionBuffer::test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& m, Visibility* results) const {
+void detail::BufferState::test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& m, Visibility* results) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     constexpr std::size_t kBlock = 64;
     ScreenRect rects[kBlock];

@@ -14,6 +14,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/buffer_state.hpp"
 #include "core/float_mode.hpp"
 #include "core/occludee_depth.hpp"
 #include "core/raised_vertex_plane.hpp"
@@ -253,7 +254,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
 
 }  // namespace
 
-OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInput& in, std::uint64_t tolerated_samples,
+OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const TriangleInput& in, std::uint64_t tolerated_samples,
                                                               std::size_t first_triangle) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     TriangleTest result;

@@ -1,6 +1,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/buffer_state.hpp"
 #include "core/float_mode.hpp"
 #include "core/render_bands.hpp"
 #include "core/run_tasks.hpp"
@@ -46,14 +47,14 @@ void prefetch_triangle(const detail::RasterTriangle& tri) {
 // they reach, in order: each band then reads its triangles sequentially. (Binning indices
 // into the chunk instead saves memory, but nearly every read of a band is then a cache miss:
 // 10 % slower on S1 even with prefetching.)
-struct OcclusionBuffer::Chunk {
+struct detail::BufferState::Chunk {
     detail::Vector<detail::Vector<detail::RasterTriangle>> bins;
     RasterStats stats;
 };
 
 // A part of a noted render's rows (draw_noted_part) and its scratch: room for a slice's
 // undecided triangles, and its statistics.
-struct OcclusionBuffer::NotedPart {
+struct detail::BufferState::NotedPart {
     detail::Vector<std::uint32_t> undecided;
     RasterStats stats;
     detail::ChangedSubtiles changed;  // the subtiles its render changed
@@ -61,11 +62,9 @@ struct OcclusionBuffer::NotedPart {
     bool drawn = false;              // its task ran (render_parts)
 };
 
-OcclusionBuffer::~OcclusionBuffer() = default;
-OcclusionBuffer::OcclusionBuffer(OcclusionBuffer&&) noexcept = default;
-OcclusionBuffer& OcclusionBuffer::operator=(OcclusionBuffer&&) noexcept = default;
+detail::BufferState::~BufferState() = default;
 
-OcclusionBuffer::OcclusionBuffer(const BufferConfig& config) { configure(config); }
+detail::BufferState::BufferState(const BufferConfig& config) { configure(config); }
 
 const char* buffer_config_problem(const BufferConfig& config) noexcept {
     if (config.width < 1 || config.height < 1 || config.width > 65536 || config.height > 65536)
@@ -128,7 +127,7 @@ detail::BufferSizes buffer_sizes(const BufferConfig& config) {
 }  // namespace
 
 // Room in the arrays whose size follows the configuration (reserve keeps their contents).
-void OcclusionBuffer::reserve_arrays(const detail::BufferSizes& z) {
+void detail::BufferState::reserve_arrays(const detail::BufferSizes& z) {
     d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
     sample_depth_.reserve(z.sample_depth);
     band_updated_.reserve(z.bands);
@@ -141,7 +140,7 @@ void OcclusionBuffer::reserve_arrays(const detail::BufferSizes& z) {
 // Everything that can fail (the checks, then every allocation: reserve keeps a vector's
 // contents) comes before anything changes, so that a configuration that throws leaves the buffer
 // as it was. Arrays that already hold enough keep their memory.
-void OcclusionBuffer::configure(const BufferConfig& config) {
+void detail::BufferState::configure(const BufferConfig& config) {
     validate_config(config);
     const detail::BufferSizes z = buffer_sizes(config);
     reserve_arrays(z);
@@ -178,7 +177,7 @@ void OcclusionBuffer::configure(const BufferConfig& config) {
     stats_ = RasterStats{};
 }
 
-void OcclusionBuffer::set_near_w(float near_w) {
+void detail::BufferState::set_near_w(float near_w) {
     BufferConfig config = config_;
     config.near_w = near_w;
     validate_config(config);
@@ -189,7 +188,7 @@ void OcclusionBuffer::set_near_w(float near_w) {
 // Sized as the renders size them (render_rows, transform_vertices, sort_nearest_first,
 // render_serial, render_clusters), for the largest input and buffer: those on one thread then
 // find every array large enough.
-void OcclusionBuffer::reserve(const BufferReserve& r) {
+void detail::BufferState::reserve(const BufferReserve& r) {
     BufferConfig largest = config_;
     largest.width = std::max(config_.width, r.max_width);
     largest.height = std::max(config_.height, r.max_height);
@@ -241,14 +240,14 @@ void OcclusionBuffer::reserve(const BufferReserve& r) {
     at_least(setup_triangles_, r.max_task_list_triangles);
 }
 
-void OcclusionBuffer::clear() {
+void detail::BufferState::clear() {
     reference_cells_current_ = false;
     clear_rows(0, subtiles_y_);
     std::fill(pyramid_.begin(), pyramid_.end(), 0.0f);
     stats_ = RasterStats{};
 }
 
-void OcclusionBuffer::clear_rows(int row_begin, int row_end) {
+void detail::BufferState::clear_rows(int row_begin, int row_end) {
     const auto zero = [](auto& plane, std::size_t begin, std::size_t end) {
         std::fill(plane.begin() + std::ptrdiff_t(begin), plane.begin() + std::ptrdiff_t(end), 0);
     };
@@ -262,18 +261,18 @@ void OcclusionBuffer::clear_rows(int row_begin, int row_end) {
              std::size_t(std::min(row_end * kH, sample_height_)) * sample_depth_stride_);
 }
 
-void OcclusionBuffer::build_pyramid_rows(int row_begin, int row_end, int last_level) {
+void detail::BufferState::build_pyramid_rows(int row_begin, int row_end, int last_level) {
     for (int ty = row_begin; ty < row_end; ++ty)
         std::copy_n(d0_.begin() + std::ptrdiff_t(at(0, ty)), subtiles_x_, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_);
     for (int level = 1; level <= last_level; ++level)
         reduce_pyramid_rows(level, row_begin >> level, std::min(levels_[std::size_t(level)].height, (row_end + (1 << level) - 1) >> level));
 }
 
-void OcclusionBuffer::reduce_pyramid_above_bands() {
+void detail::BufferState::reduce_pyramid_above_bands() {
     for (int level = kBandPyramidLevels + 1; level < int(levels_.size()); ++level) reduce_pyramid_rows(level, 0, levels_[std::size_t(level)].height);
 }
 
-void OcclusionBuffer::build_pyramid_rect(int x0, int x1, int y0, int y1) {
+void detail::BufferState::build_pyramid_rect(int x0, int x1, int y0, int y1) {
     if (x0 >= x1 || y0 >= y1) return;
     for (int ty = y0; ty < y1; ++ty)
         std::copy_n(d0_.begin() + std::ptrdiff_t(at(x0, ty)), x1 - x0, pyramid_.begin() + std::ptrdiff_t(ty) * subtiles_x_ + x0);
@@ -281,11 +280,11 @@ void OcclusionBuffer::build_pyramid_rect(int x0, int x1, int y0, int y1) {
         reduce_pyramid_cells(level, x0 >> level, ((x1 - 1) >> level) + 1, y0 >> level, ((y1 - 1) >> level) + 1);
 }
 
-void OcclusionBuffer::reduce_pyramid_rows(int level, int y_begin, int y_end) {
+void detail::BufferState::reduce_pyramid_rows(int level, int y_begin, int y_end) {
     reduce_pyramid_cells(level, 0, levels_[std::size_t(level)].width, y_begin, y_end);
 }
 
-void OcclusionBuffer::reduce_pyramid_cells(int level, int x_begin, int x_end, int y_begin, int y_end) {
+void detail::BufferState::reduce_pyramid_cells(int level, int x_begin, int x_end, int y_begin, int y_end) {
     const detail::PyramidLevel& below = levels_[std::size_t(level) - 1];
     const detail::PyramidLevel& here = levels_[std::size_t(level)];
     for (int y = y_begin; y < y_end; ++y)
@@ -300,12 +299,12 @@ void OcclusionBuffer::reduce_pyramid_cells(int level, int x_begin, int x_end, in
         }
 }
 
-void OcclusionBuffer::read_pyramid(std::vector<float>& cells) const {
+void detail::BufferState::read_pyramid(std::vector<float>& cells) const {
     const detail::PyramidLevel& top = levels_.back();
     cells.assign(pyramid_.begin(), pyramid_.begin() + std::ptrdiff_t(top.offset + std::size_t(top.width) * std::size_t(top.height)));
 }
 
-detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end,
+detail::ReferenceCells detail::BufferState::start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end,
                                                                bool cells_current) {
     const int height = detail::reference_cells_height(subtiles_y_);
     const std::size_t size = std::size_t(reference_cells_width_) * std::size_t(height);  // of the cells (table (0, 0))
@@ -329,7 +328,7 @@ detail::ReferenceCells OcclusionBuffer::start_reference_cells(bool clear_first, 
     return cells;
 }
 
-void OcclusionBuffer::refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end) {
+void detail::BufferState::refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end) {
     if (!cells.min_d0 || row_begin >= row_end) return;
     const detail::SubtilePlanes planes{d0_.data(), d1_.data(), mask_.data(), covered_.data(), stride_, nullptr, 0};
     const int cell_row_begin = row_begin >> detail::kReferenceCellShift, cell_row_end = ((row_end - 1) >> detail::kReferenceCellShift) + 1;
@@ -337,7 +336,7 @@ void OcclusionBuffer::refresh_reference_cells(const detail::ReferenceCells& cell
     detail::update_cell_blocks(cells, cell_row_begin, cell_row_end);
 }
 
-detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) {
+detail::RasterTarget detail::BufferState::raster_target(int row_begin, int row_end) {
     const detail::SubtilePlanes planes{d0_.data(),
                                        d1_.data(),
                                        mask_.data(),
@@ -348,7 +347,7 @@ detail::RasterTarget OcclusionBuffer::raster_target(int row_begin, int row_end) 
     return {planes, sample_width_, sample_height_, row_begin, row_end, detail::selected_rows_kernel(), detail::hidden_skip_enabled()};
 }
 
-bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache) {
+bool detail::BufferState::transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache) {
     if (!detail::use_vertex_cache(in)) return false;
     const std::size_t plane = in.vertex_count + detail::kVertexClipPadding;
     if (vertex_clip_.size() < 4 * plane) vertex_clip_.resize(4 * plane);
@@ -375,13 +374,13 @@ bool OcclusionBuffer::transform_vertices(const TriangleInput& in, const Parallel
     return true;
 }
 
-void OcclusionBuffer::render(const TriangleInput& in, const ParallelFor& parallel) {
+void detail::BufferState::render(const TriangleInput& in, const ParallelFor& parallel) {
     if (in.triangle_count == 0) return;
     const detail::StandardFloatMode mode;  // float_mode.hpp
     render_rows(in, parallel, false);
 }
 
-void OcclusionBuffer::render_frame(const TriangleInput& in, const ParallelFor& parallel) {
+void detail::BufferState::render_frame(const TriangleInput& in, const ParallelFor& parallel) {
     if (in.triangle_count == 0) {
         clear();
         return;
@@ -390,7 +389,7 @@ void OcclusionBuffer::render_frame(const TriangleInput& in, const ParallelFor& p
     render_rows(in, parallel, true);
 }
 
-void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first) {
+void detail::BufferState::render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first) {
     detail::check_triangle_input(in, "render");
     detail::check_draw_order(in);
     if (in.shared_edges && !in.edge_apexes)
@@ -424,7 +423,7 @@ void OcclusionBuffer::render_rows(const TriangleInput& in, const ParallelFor& pa
 // input order; nothing is binned. Every subtile sees the triangles in the same order as in
 // render_binned and render_parts, so all give the same bits. With cell records (a clip-space
 // soup drawn nearest first, reference_cells.hpp), the buffer is one part (draw_noted_part).
-void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list) {
+void detail::BufferState::render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list) {
     if (list.notes) {
         if (noted_parts_.empty()) noted_parts_.resize(1);
         if (noted_parts_[0].undecided.size() < kCellRefreshTriangles) noted_parts_[0].undecided.resize(kCellRefreshTriangles);
@@ -455,7 +454,7 @@ void OcclusionBuffer::render_serial(const TriangleInput& in, const detail::Verte
     build_changed_pyramid(clear_first, changed);
 }
 
-void OcclusionBuffer::build_changed_pyramid(bool cleared, const detail::ChangedSubtiles& changed) {
+void detail::BufferState::build_changed_pyramid(bool cleared, const detail::ChangedSubtiles& changed) {
     if (cleared) build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
     else build_pyramid_rect(changed.x0, changed.x1, changed.y0, changed.y1);
 }
@@ -467,7 +466,7 @@ void OcclusionBuffer::build_changed_pyramid(bool cleared, const detail::ChangedS
 // as the setup counts a hidden one (triangles_in and rasterized), and the setup counts the
 // others as it would for the whole buffer (a triangle outside the target's rows is hidden
 // there): so each part's statistics are the whole render's, but for subtiles_updated.
-void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin,
+void detail::BufferState::draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin,
                                       int row_end, bool cells_current) {
     NotedPart& scratch = noted_parts_[part];
     scratch.drawn = true;
@@ -511,7 +510,7 @@ void OcclusionBuffer::draw_noted_part(const TriangleInput& in, detail::DrawList 
 // the first time); they change no bit, only the balance. Part 0's statistics are the render's.
 // S1 at 1080p, two threads: 4.30 -> 3.02 ms against render_binned's waves (see
 // docs/occlusion-buffer.md, "Threads").
-void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list) {
+void detail::BufferState::render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list) {
     reference_cells_current_ = false;  // each part's copy has the other parts' rows infinite
     const int cell_rows = detail::reference_cells_height(subtiles_y_);
     const std::size_t parts = std::min(parallel.threads ? parallel.threads : 2, std::size_t(cell_rows));  // cell_rows >= 1
@@ -546,7 +545,7 @@ void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& p
     std::fill(cell_row_load_.begin(), cell_row_load_.end(), 0u);
 
     struct Job {
-        OcclusionBuffer* self;
+        detail::BufferState* self;
         const TriangleInput* in;
         detail::DrawList list;
         bool clear_first;
@@ -554,7 +553,7 @@ void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& p
     try {
         detail::run_tasks(parallel, parts, [](void* data, std::size_t p) {
             const Job& j = *static_cast<Job*>(data);
-            OcclusionBuffer& b = *j.self;
+            detail::BufferState& b = *j.self;
             const NotedPart& part = b.noted_parts_[p];
             b.draw_noted_part(*j.in, j.list, j.clear_first, p, part.row_begin, part.row_end);
             b.build_pyramid_rows(part.row_begin, part.row_end, std::min(detail::kReferenceCellShift, int(b.levels_.size()) - 1));
@@ -584,7 +583,7 @@ void OcclusionBuffer::render_parts(const TriangleInput& in, const ParallelFor& p
 // (hidden_in_target, as on one thread). Dropping them changes no bit, so the waves' sizes are
 // free; only the speed depends on them. (A clip-space soup with cell records goes to
 // render_parts instead.)
-void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
+void detail::BufferState::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
     reference_cells_current_ = false;
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_updated_.size();
@@ -592,7 +591,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
     std::fill(band_updated_.begin(), band_updated_.end(), std::uint64_t(0));
 
     struct Job {
-        OcclusionBuffer* self;
+        detail::BufferState* self;
         const TriangleInput* in;
         const detail::VertexClip* cache;
         std::size_t first_chunk, end_chunk, bands;
@@ -616,7 +615,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
                 if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
                 for (auto& bin : chunk.bins) bin.clear();
                 const std::size_t end_triangle = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
-                const OcclusionBuffer& b = *j.self;
+                const detail::BufferState& b = *j.self;
                 const auto bin = [&](const detail::RasterTriangle& tri) {
                     for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
                         chunk.bins[std::size_t(band)].push_back(tri);
@@ -627,7 +626,7 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
 
             detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
                 const Job& j = *static_cast<Job*>(data);
-                OcclusionBuffer& b = *j.self;
+                detail::BufferState& b = *j.self;
                 const int row_begin = int(band) * kBandSubtileRows, row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);
                 if (j.clear_first) b.clear_rows(row_begin, row_end);
                 const detail::RasterTarget target = b.raster_target(row_begin, row_end);
@@ -666,12 +665,12 @@ void OcclusionBuffer::render_binned(const TriangleInput& in, const ParallelFor& 
     for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
 }
 
-OcclusionBuffer::Subtile OcclusionBuffer::subtile(int tx, int ty) const {
+OcclusionBuffer::Subtile detail::BufferState::subtile(int tx, int ty) const {
     const std::size_t i = at(tx, ty);
     return {d0_[i], d1_[i], mask_[i], covered_[i]};
 }
 
-std::vector<OcclusionBuffer::Subtile> OcclusionBuffer::subtiles() const {
+std::vector<OcclusionBuffer::Subtile> detail::BufferState::subtiles() const {
     std::vector<Subtile> all;
     all.reserve(std::size_t(subtiles_x_) * std::size_t(subtiles_y_));
     for (int ty = 0; ty < subtiles_y_; ++ty)
@@ -679,7 +678,7 @@ std::vector<OcclusionBuffer::Subtile> OcclusionBuffer::subtiles() const {
     return all;
 }
 
-void OcclusionBuffer::read_coverage(std::vector<std::uint8_t>& covered) const {
+void detail::BufferState::read_coverage(std::vector<std::uint8_t>& covered) const {
     covered.assign(std::size_t(sample_width_) * std::size_t(sample_height_), 0);
     for (int y = 0; y < sample_height_; ++y)
         for (int x = 0; x < sample_width_; ++x) {
@@ -688,7 +687,7 @@ void OcclusionBuffer::read_coverage(std::vector<std::uint8_t>& covered) const {
         }
 }
 
-void OcclusionBuffer::read_depth(std::vector<float>& w) const {
+void detail::BufferState::read_depth(std::vector<float>& w) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     w.assign(std::size_t(sample_width_) * std::size_t(sample_height_), INFINITY);
     for (int y = 0; y < sample_height_; ++y)
@@ -702,7 +701,7 @@ void OcclusionBuffer::read_depth(std::vector<float>& w) const {
         }
 }
 
-void OcclusionBuffer::read_sample_depth(std::vector<float>& d) const {
+void detail::BufferState::read_sample_depth(std::vector<float>& d) const {
     d.clear();
     if (sample_depth_.empty()) return;
     d.reserve(std::size_t(sample_width_) * std::size_t(sample_height_));

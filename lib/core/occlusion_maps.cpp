@@ -10,6 +10,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_maps.hpp>
 
+#include "core/buffer_state.hpp"
 #include "core/float_mode.hpp"
 #include "core/opacity_pyramid.hpp"
 #include "core/rect_tests.hpp"
@@ -114,8 +115,9 @@ void OcclusionMaps::build(const OcclusionBuffer& buffer) {
     // Depth pyramids not made (depth_pyramids) are null here: the kernels skip them.
     float* const hzb = hzb_.empty() ? nullptr : hzb_.data();
     float* const nbz = nbz_.empty() ? nullptr : nbz_.data();
-    const detail::Level0Maps level0{buffer.covered_.data(), buffer.mask_.data(), buffer.d0_.data(), buffer.d1_.data(),
-                                    buffer.stride_,         buffer.subtiles_x(), buffer.subtiles_y(), width_,
+    const detail::BufferState& state = buffer.state();
+    const detail::Level0Maps level0{state.covered_.data(), state.mask_.data(), state.d0_.data(), state.d1_.data(),
+                                    state.stride_,         buffer.subtiles_x(), buffer.subtiles_y(), width_,
                                     height_,                samples_,            covered_.data(),      hzb,
                                     nbz};
     const detail::Level0Kernel level0_kernel = detail::selected_level0_kernel();
@@ -297,7 +299,7 @@ OccludeeAnswer OcclusionMaps::test_rect_within(const ScreenRect& rect, double& b
     const detail::StandardFloatMode mode;  // float_mode.hpp
     detail::RectQuery q;
     Visibility decided;
-    if (!built().prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
+    if (!built().state().prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
         return decided_answer(decided);
     OccludeeAnswer answer;
     double uncovered = 0.0;

@@ -16,6 +16,7 @@
 // In approximate mode holes are tolerated, and the depth maps ignore uncovered samples.
 #include <homcull/occlusion_maps.hpp>
 
+#include "core/buffer_state.hpp"
 #include "core/float_mode.hpp"
 #include "core/min_pyramid.hpp"
 #include "core/rect_tests.hpp"
@@ -80,7 +81,7 @@ bool OcclusionMaps::depth_hidden(int i0, int i1, int j0, int j1, float d_near) c
     const bool approximate = config_.hole_pixels > 0.0;
     switch (config_.depth) {
     case DepthTest::masked: {
-        if (!approximate) return buffer.test_prepared_rect({i0, i1, j0, j1, d_near}) == Visibility::occluded;
+        if (!approximate) return buffer.state().test_prepared_rect({i0, i1, j0, j1, d_near}) == Visibility::occluded;
         // Holes tolerated: every covered sample of the rectangle must be behind its bound.
         for (int ty = j0 / kH; ty <= j1 / kH; ++ty)
             for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {

@@ -1,10 +1,11 @@
 #pragma once
-// The coarse stage of the batched rectangle tests (OcclusionBuffer::test_rects), shared by
-// the scalar path (OcclusionBuffer::prepare and the start of test_rect) and the SIMD kernel
+// The coarse stage of the batched rectangle tests (detail::BufferState::test_rects), shared by
+// the scalar path (detail::BufferState::prepare and the start of test_rect) and the SIMD kernel
 // in rect_tests_simd.cpp, which must decide exactly the rectangles the scalar path decides
 // at that stage, with the same answers.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/buffer_state.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -25,7 +26,7 @@ struct CoarseRectView {
     float near_w;
 };
 
-// A rectangle test after OcclusionBuffer::prepare: the samples [i0, i1] x [j0, j1] whose
+// A rectangle test after detail::BufferState::prepare: the samples [i0, i1] x [j0, j1] whose
 // centres lie in it, and its nearest 1/w rounded up (an occluder hides it where its bound is
 // above d_near).
 struct RectQuery {

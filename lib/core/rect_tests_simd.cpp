@@ -1,7 +1,7 @@
-// The batched rectangle tests (OcclusionBuffer::test_rects) and the exact scan of one
+// The batched rectangle tests (detail::BufferState::test_rects) and the exact scan of one
 // rectangle, compiled per instruction set with Google Highway and chosen at run time.
 // - The coarse stage runs one rectangle per SIMD lane. Each lane repeats what
-//   OcclusionBuffer::prepare and the coarse check at the start of OcclusionBuffer::test_rect do
+//   detail::BufferState::prepare and the coarse check at the start of detail::BufferState::test_rect do
 //   for its rectangle, with the same double and float operations, so it decides exactly the
 //   rectangles they decide there, with the same answers. On S1 about three in four are decided
 //   here.
@@ -13,6 +13,7 @@
 
 #include <hwy/highway.h>
 
+#include "core/buffer_state.hpp"
 #include "core/rect_tests.hpp"
 #include "raster/lane_bits-inl.h"
 #include "raster/rasterize.hpp"

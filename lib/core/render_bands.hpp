@@ -3,6 +3,7 @@
 // clustered_render.cpp), and the clustered render's per-frame record of a cluster.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "core/buffer_state.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -49,9 +50,9 @@ struct ChangedSubtiles {
 }  // namespace detail
 
 // A cluster in view this frame: its box's samples [i0, i1] x [j0, j1] and nearest depth
-// (OcclusionBuffer::prepare's), or, when `testable` is false (its box crosses the near plane or
+// (detail::BufferState::prepare's), or, when `testable` is false (its box crosses the near plane or
 // is not finite), every sample and no test.
-struct OcclusionBuffer::PlacedCluster {
+struct detail::BufferState::PlacedCluster {
     float nearest_w;  // the order: nearest first (0 for untestable clusters), then by number
     std::uint32_t cluster;
     std::uint32_t draw;  // its draw: recorded_draws_[draw]
@@ -60,9 +61,9 @@ struct OcclusionBuffer::PlacedCluster {
     bool testable;
 };
 
-// Where a cluster's box lands this frame (OcclusionBuffer::place_cluster), one per cluster of
+// Where a cluster's box lands this frame (detail::BufferState::place_cluster), one per cluster of
 // the input, in its order.
-struct OcclusionBuffer::ClusterPlace {
+struct detail::BufferState::ClusterPlace {
     PlacedCluster placed;  // when in view
     std::uint8_t fate;
     static constexpr std::uint8_t kInView = 0, kOutside = 1, kEmpty = 2;  // kEmpty: no triangles
@@ -72,7 +73,7 @@ struct OcclusionBuffer::ClusterPlace {
 // room in setup_triangles_ ([first, first + room): its triangle count), and drawn from there by
 // the others (each waits until it is ready). When clipping gives it more triangles than its room,
 // every band drawing it sets it up itself (kEach): the same triangles, so the same bits.
-struct OcclusionBuffer::ClusterSetup {
+struct detail::BufferState::ClusterSetup {
     std::size_t first = 0, room = 0, count = 0;
     RasterStats stats;          // the setup's counts
     std::atomic<int> state{0};  // kNotSetUp, kSettingUp, kReady or kEach

@@ -4,9 +4,12 @@
 //   per object: each occluder object's registered mesh drawn with its own model matrix, one
 //               homcull_buffer_draw_mesh call each, nearest object first (as an engine's scene
 //               traversal draws them);
-//   merged:     every occluder's world triangles registered as one mesh, one call.
-// A frame is homcull_buffer_begin_frame and the draws. Rounds alternate the two (the order
-// flipped every other round); the medians and their ratio are printed per view.
+//   merged:     every occluder's world triangles registered as one mesh, one call;
+//   task list:  the per-object draws recorded in a task list (homcull_buffer_begin_tasks), its
+//               tasks then run in order on the calling thread: what the pull model costs on
+//               one thread.
+// A frame is homcull_buffer_begin_frame and the draws. Rounds alternate the three (the order
+// rotated every round); the medians and their ratios are printed per view.
 //
 //   draw_calls_bench SCENE.glb VIEWS.json [--rounds N] [--width W --height H]
 #include <homcull/homcull.hpp>
@@ -110,12 +113,13 @@ int main(int argc, char** argv) {
 
     api::Buffer buffer;
     check(api::Buffer::create(context, homcull_buffer_desc{width, height, 1, 1.0f, 0, 0}, buffer), "homcull_buffer_create");
-    check(buffer.reserve(homcull_reserve_desc{width, height, triangles, 0, 0, 0}), "homcull_buffer_reserve");
+    check(buffer.reserve(homcull_reserve_desc{width, height, triangles, 0, draws.size(), triangles}), "homcull_buffer_reserve");
 
     std::printf("%zu occluder objects (%zu triangles), %dx%d, %d rounds, instruction set %s\n", draws.size(), triangles, width, height, rounds,
                 homcull_isa_name(context.isa()));
-    std::printf("| view | per object (ms) | merged (ms) | per object / merged | calls | drawn per object | drawn merged |\n|---|---|---|---|---|---|---|\n");
-    double sum_objects = 0.0, sum_merged = 0.0;
+    std::printf("| view | per object (ms) | merged (ms) | task list (ms) | per object / merged | task list / per object | calls | drawn per object "
+                "| drawn merged |\n|---|---|---|---|---|---|---|---|---|\n");
+    double sum_objects = 0.0, sum_merged = 0.0, sum_list = 0.0;
     for (std::size_t v = 0; v < views.frames.size(); ++v) {
         Camera camera = views.frames[v];
         check(buffer.set_near(float(camera.near_plane)), "homcull_buffer_set_near");
@@ -143,23 +147,41 @@ int main(int argc, char** argv) {
             check(buffer.draw(merged), "homcull_buffer_draw_mesh");
             merged_stats = buffer.frame_stats();
         };
+        homcull_frame_stats list_stats{};
+        const auto task_list = [&] {
+            check(buffer.begin_frame(view), "homcull_buffer_begin_frame");
+            check(buffer.begin_tasks(), "homcull_buffer_begin_tasks");
+            for (const Draw& d : draws) check(buffer.draw(*d.mesh, d.model), "homcull_buffer_draw_mesh");
+            std::size_t tasks = 0;
+            check(buffer.close_tasks(tasks), "homcull_buffer_close_tasks");
+            for (std::size_t i = 0; i < tasks; ++i) check(buffer.run_task(i), "homcull_buffer_run_task");
+            check(buffer.finish_tasks(), "homcull_buffer_finish_tasks");
+            list_stats = buffer.frame_stats();
+        };
         const auto time = [](auto&& frame) {
             const auto t0 = std::chrono::steady_clock::now();
             frame();
             return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         };
-        per_object(), one_call();  // warm
-        std::vector<double> a, b;
-        for (int r = 0; r < rounds; ++r) {
-            if (r % 2 == 0) a.push_back(time(per_object)), b.push_back(time(one_call));
-            else b.push_back(time(one_call)), a.push_back(time(per_object));
-        }
-        const double ma = median(a), mb = median(b);
-        sum_objects += ma, sum_merged += mb;
-        std::printf("| C%zu | %.3f | %.3f | %.2f | %llu | %llu | %llu |\n", v, ma, mb, ma / mb, (unsigned long long)objects_stats.draw_calls,
-                    (unsigned long long)objects_stats.triangles_drawn, (unsigned long long)merged_stats.triangles_drawn);
-        if (objects_stats.allocations || merged_stats.allocations) std::printf("  (frames allocated after the reserve: a bug)\n");
+        per_object(), one_call(), task_list();  // warm
+        std::vector<double> a, b, c;
+        for (int r = 0; r < rounds; ++r)
+            for (int k = 0; k < 3; ++k) {
+                const int which = (r + k) % 3;
+                if (which == 0) a.push_back(time(per_object));
+                else if (which == 1) b.push_back(time(one_call));
+                else c.push_back(time(task_list));
+            }
+        const double ma = median(a), mb = median(b), mc = median(c);
+        sum_objects += ma, sum_merged += mb, sum_list += mc;
+        std::printf("| C%zu | %.3f | %.3f | %.3f | %.2f | %.2f | %llu | %llu | %llu |\n", v, ma, mb, mc, ma / mb, mc / ma,
+                    (unsigned long long)objects_stats.draw_calls, (unsigned long long)objects_stats.triangles_drawn,
+                    (unsigned long long)merged_stats.triangles_drawn);
+        if (objects_stats.allocations || merged_stats.allocations || list_stats.allocations)
+            std::printf("  (frames allocated after the reserve: a bug)\n");
+        if (list_stats.triangles_drawn != objects_stats.triangles_drawn) std::printf("  (the task list drew other triangles: a bug)\n");
     }
-    std::printf("| all | %.3f | %.3f | %.2f | | | |\n", sum_objects, sum_merged, sum_objects / sum_merged);
+    std::printf("| all | %.3f | %.3f | %.3f | %.2f | %.2f | | | |\n", sum_objects, sum_merged, sum_list, sum_objects / sum_merged,
+                sum_list / sum_objects);
     return 0;
 }

@@ -35,23 +35,13 @@
 namespace homcull {
 class OcclusionMaps;
 namespace detail {
+class BufferState;  // lib/core/buffer_state.hpp
 // One level of a pyramid stored level after level in one array: width x height cells from
 // `offset` on, row-major.
 struct PyramidLevel {
     int width, height;
     std::size_t offset;
 };
-struct RectQuery;
-struct SubtileView;
-struct RasterTarget;
-struct VertexClip;
-struct DrawList;
-struct RasterTriangle;
-struct DrawOrderScratch;
-struct ReferenceCells;
-struct CellRecord;
-struct ChangedSubtiles;
-struct BufferSizes;
 }  // namespace detail
 
 enum class Backface : std::uint8_t {
@@ -381,15 +371,15 @@ public:
     // occludee's visible triangle at once (frame-to-frame coherence).
     TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0, std::size_t first_triangle = 0) const;
 
-    const BufferConfig& config() const { return config_; }
-    int sample_width() const { return sample_width_; }
-    int sample_height() const { return sample_height_; }
-    const RasterStats& stats() const { return stats_; }
+    const BufferConfig& config() const;
+    int sample_width() const;
+    int sample_height() const;
+    const RasterStats& stats() const;
     // One subtile's state, and a row-major copy of all of them (for tests and dumps).
     Subtile subtile(int tx, int ty) const;
     std::vector<Subtile> subtiles() const;
-    int subtiles_x() const { return subtiles_x_; }
-    int subtiles_y() const { return subtiles_y_; }
+    int subtiles_x() const;
+    int subtiles_y() const;
 
     // Read-back per sample (row-major, top row first): whether an occluder covers it, and
     // the conservative occluder depth as clip w (infinity where nothing is known): the layers'
@@ -404,139 +394,19 @@ public:
     // ceil(subtiles_x / 2^l) x ceil(subtiles_y / 2^l) cells, row-major, down to 1 x 1.
     void read_pyramid(std::vector<float>& cells) const;
 
-private:
-    friend class OcclusionMaps;  // reads the subtiles and shares the rectangle preparation
-    BufferConfig config_;
-    int sample_width_ = 0, sample_height_ = 0;
-    int subtiles_x_ = 0, subtiles_y_ = 0;
-    // The subtiles as four planes (structure of arrays, so that SIMD kernels load a run of
-    // subtiles as one vector per field), row-major with a padded row stride: a full vector
-    // load starting at any subtile of a row stays within the row's padding.
-    std::size_t stride_ = 0;
-    detail::Vector<float> d0_, d1_;
-    detail::Vector<std::uint32_t> mask_, covered_;
-    detail::Vector<float> sample_depth_;  // 1/w per sample, row-major; empty unless config_.sample_depth
-    // Its row stride: the width plus room for a whole vector from any sample of the row, so that
-    // the SIMD kernel's vectors never reach into the next row (another band's, on another thread).
-    std::size_t sample_depth_stride_ = 0;
-    std::size_t at(int tx, int ty) const { return std::size_t(ty) * stride_ + std::size_t(tx); }
-    RasterStats stats_;
+    // The implementation (lib/core/buffer_state.hpp), for the library's own layers that read a
+    // buffer (the occlusion maps): not part of the interface.
+    const detail::BufferState& state() const { return *state_; }
 
-    // Farthest-depth pyramid: level l >= 1 holds, per cell of 2^l x 2^l subtiles, the minimum
-    // d0; brought up to date at the end of render() (on one thread, over the subtiles it changed).
-    detail::Vector<detail::PyramidLevel> levels_;
-    detail::Vector<float> pyramid_;
-    detail::Vector<std::int32_t> level_offset_, level_width_;  // levels_ as arrays, for SIMD gathers
-    // Level 0 for subtile rows [row_begin, row_end) and levels 1..last_level above them (row_begin
-    // a multiple of 2^last_level: each cell's subtiles are then among these rows).
-    void build_pyramid_rows(int row_begin, int row_end, int last_level);
-    // Rows [y_begin, y_end) of pyramid level `level` >= 1 from the level below.
-    void reduce_pyramid_rows(int level, int y_begin, int y_end);
-    // Room for the arrays sized by the configuration (configure, reserve): allocation only.
-    void reserve_arrays(const detail::BufferSizes& sizes);
-    // Every level's cells over the subtiles [x0, x1) x [y0, y1): after a render on one thread,
-    // the subtiles it changed (nothing when the rectangle is empty).
-    void build_pyramid_rect(int x0, int x1, int y0, int y1);
-    // After a render on one thread: the whole pyramid when it cleared the buffer first, else the
-    // cells over the subtiles it changed.
-    void build_changed_pyramid(bool cleared, const detail::ChangedSubtiles& changed);
-    // Cells [x_begin, x_end) x [y_begin, y_end) of pyramid level `level` >= 1 from the level below.
-    void reduce_pyramid_cells(int level, int x_begin, int x_end, int y_begin, int y_end);
-    // Zeroes the subtiles (and per-sample depths) of subtile rows [row_begin, row_end).
-    void clear_rows(int row_begin, int row_end);
-    float min_d0(int level, int x, int y) const {
-        const detail::PyramidLevel& l = levels_[std::size_t(level)];
-        return pyramid_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)];
-    }
-    // Shared by the rectangle tests: the sample range and nearest 1/w, or a decided answer.
-    bool prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, detail::RectQuery& q,
-                 Visibility& decided) const;
-    Visibility test_prepared_rect(const detail::RectQuery& q) const;
-    detail::SubtileView subtile_view() const;
-
-    // Rendering (occlusion_buffer.cpp): without a job system straight through, with one in
-    // parts of rows (a noted soup) or binned by bands of subtile rows; the same bits either way.
-    detail::RasterTarget raster_target(int row_begin, int row_end);
-    // clear_first: render_frame, which clears the rows where it rasterizes them.
-    void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
-    void render_serial(const TriangleInput& in, const detail::VertexClip* cache, bool clear_first, detail::DrawList list);
-    void render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, detail::DrawList list);
-    // Part `part` of a noted render: the list's triangles drawn into subtile rows [row_begin,
-    // row_end) with that part's cells; its statistics counted as for the whole buffer.
-    void draw_noted_part(const TriangleInput& in, detail::DrawList list, bool clear_first, std::size_t part, int row_begin, int row_end,
-                         bool cells_current = false);
-    void render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first);
-    // Transforms an indexed input's vertices to clip space into the scratch below and points
-    // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.
-    bool transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache);
-
-    // Clustered input (clustered_render.cpp). With a job system a render is a task list of one
-    // draw (begin_tasks ... finish_tasks).
-    void render_clusters(const ClusteredInput& in, const ParallelFor& parallel, bool clear_first);
-    // Checks a draw and places its clusters (cluster_places_), throwing before anything changes.
-    std::size_t place_clusters(const ClusteredInput& in, const ParallelFor& parallel);
-    void append_placed(const ClusteredInput& in, std::size_t count, RasterStats& stats);
-    struct ClusterPass;
-    struct PlacedCluster;
-    struct ClusterPlace;
-    struct ClusterSetup;
-    enum class TaskList : std::uint8_t { none, recording, closed };
-    TaskList task_list_ = TaskList::none;
-    bool task_list_clears_ = false;
-    RasterStats task_list_stats_;               // the recorded draws' clusters outside the view
-    std::size_t task_list_vertices_ = 0;        // the most vertices of a cluster recorded (the band caches' size)
-    detail::Vector<ClusteredInput> recorded_draws_;  // PlacedCluster::draw numbers them
-    detail::Vector<std::uint8_t> band_ran_;     // per band: its task ran (finish_tasks checks them all)
-    detail::Vector<detail::RasterTriangle> setup_triangles_;  // each ClusterSetup's room, one after the other
-    // Where a cluster's box lands (in view, outside, or no triangles). In job-system tasks: noexcept.
-    void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
-                       ClusterPlace& out) const noexcept;
-    // After the bands: the pyramid levels above those each band built (kBandPyramidLevels).
-    void reduce_pyramid_above_bands();
-
-    // The smallest d0 of each cell of 8 x 8 subtiles, valid only while a render draws
-    // (raster/reference_cells.hpp): a copy per part of the rows (render_parts; one thread: one
-    // part), the other parts' rows infinite in each. Sized with the buffer for one part.
-    detail::Vector<float> reference_cells_;
-    int reference_cells_width_ = 0;
-    struct NotedPart;
-    detail::Vector<NotedPart> noted_parts_;
-    // Per cell row: the triangles the last noted render drew there (each at its first row in its
-    // part), which places the next render's part bounds.
-    detail::Vector<std::uint32_t> cell_row_load_;
-    // The cells of part 0 hold the buffer's d0 over every row: the last render was a noted one on
-    // one thread and nothing changed the buffer since. The next such render then starts from them
-    // instead of recomputing them all (a render call costs what it draws).
-    bool reference_cells_current_ = false;
-    // At the start of a render with cell records (which render_rows asks the sort for only when
-    // hidden triangles are skipped and the instruction set has a refresh kernel): part `part`'s
-    // cells, those of subtile rows [row_begin, row_end) zeroed when the render clears the buffer
-    // first, else computed from d0, and the others infinite (every noted triangle is hidden
-    // there: another part draws them).
-    // cells_current: part 0's cells already hold d0 (reference_cells_current_ when the render began).
-    detail::ReferenceCells start_reference_cells(bool clear_first, std::size_t part, int row_begin, int row_end, bool cells_current);
-    // Refreshes the cells holding subtile rows [row_begin, row_end).
-    void refresh_reference_cells(const detail::ReferenceCells& cells, int row_begin, int row_end);
-
-    // Render scratch, reused across frames (grown, never shrunk).
-    struct Chunk;
-    detail::Vector<Chunk> chunks_;
-    detail::Vector<std::uint64_t> band_updated_;
-    detail::Vector<double> vertex_clip_;           // four planes of vertex_count + padding
-    detail::Vector<std::uint8_t> vertex_outcode_;
-    detail::HookPtr<detail::DrawOrderScratch> draw_order_;  // raster/draw_order.hpp; made by the first render
-    detail::Vector<ClusterPlace> cluster_places_;    // each input cluster's box this frame
-    detail::Vector<PlacedCluster> placed_clusters_;  // the frame's clusters in view, nearest first
-    detail::Vector<RasterStats> band_stats_;
-    detail::Vector<std::pair<int, int>> cluster_row_runs_;  // one thread: the subtile rows a cluster is drawn in
-    detail::Vector<ClusterSetup> cluster_setups_;  // task lists: one per cluster in view
-    detail::Vector<double> band_vertex_clip_;         // per band: four planes of a cluster's vertices + padding
-    detail::Vector<std::uint8_t> band_vertex_outcode_;
-
-public:
+    // Moves leave the source with no state: it may then only be assigned to or destroyed.
     ~OcclusionBuffer();
     OcclusionBuffer(OcclusionBuffer&&) noexcept;
     OcclusionBuffer& operator=(OcclusionBuffer&&) noexcept;
+
+private:
+    // Every array, scratch and setting lives there, so that this header, which engines and
+    // tools include, says what the buffer does and not how.
+    detail::HookPtr<detail::BufferState> state_;
 };
 
 // Instruction sets. Rendering runs SIMD kernels compiled for several instruction sets and
