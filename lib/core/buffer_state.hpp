@@ -6,6 +6,8 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include <cstddef>
+#include "core/min_pyramid.hpp"
+
 #include <cstdint>
 #include <new>
 #include <utility>

@@ -6,8 +6,16 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include <algorithm>
+#include <cstddef>
 
 namespace homcull::detail {
+
+// One level of a pyramid stored level after level in one array: width x height cells from
+// `offset` on, row-major.
+struct PyramidLevel {
+    int width, height;
+    std::size_t offset;
+};
 
 // Whether every level-0 cell of [x0, x1] x [y0, y1] under cell (x, y) of level k holds more
 // than d: a cell whose minimum is above d is done; one inside the range whose minimum is not

@@ -11,6 +11,7 @@
 #include <homcull/occlusion_maps.hpp>
 
 #include "core/buffer_state.hpp"
+#include "core/maps_state.hpp"
 #include "core/float_mode.hpp"
 #include "core/opacity_pyramid.hpp"
 #include "core/rect_tests.hpp"
@@ -27,7 +28,7 @@ constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtil
 
 }  // namespace
 
-OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config) : config_(config) {
+detail::MapsState::MapsState(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config) : config_(config) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     const BufferConfig& b = buffer.config();
     width_ = b.width;
@@ -88,23 +89,23 @@ OcclusionMaps::OcclusionMaps(const OcclusionBuffer& buffer, const OcclusionMapsC
     }
 }
 
-OcclusionMaps::CellSpan OcclusionMaps::cell_span(int k, int x, int y) const {
+detail::MapsState::CellSpan detail::MapsState::cell_span(int k, int x, int y) const {
     return {(x << k) * samples_, std::min((x + 1) << k, width_) * samples_ - 1, (y << k) * samples_,
             std::min((y + 1) << k, height_) * samples_ - 1};
 }
 
-std::uint32_t OcclusionMaps::cell_samples(int k, int x, int y) const {
+std::uint32_t detail::MapsState::cell_samples(int k, int x, int y) const {
     const CellSpan c = cell_span(k, x, y);
     return std::uint32_t(c.x1 - c.x0 + 1) * std::uint32_t(c.y1 - c.y0 + 1);
 }
 
-float OcclusionMaps::opacity(int k, int x, int y) const {
+float detail::MapsState::opacity(int k, int x, int y) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     const Level& l = levels_[std::size_t(k)];
     return float(covered_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)]) / float(cell_samples(k, x, y));
 }
 
-void OcclusionMaps::build(const OcclusionBuffer& buffer) {
+void detail::MapsState::build(const OcclusionBuffer& buffer) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     if (buffer.config().width != width_ || buffer.config().height != height_ || buffer.config().samples != samples_)
         throw Error("occlusion maps: build() needs a buffer shaped like the one the maps were made for");
@@ -148,14 +149,14 @@ void OcclusionMaps::build(const OcclusionBuffer& buffer) {
     built_ = &buffer;
 }
 
-const OcclusionBuffer& OcclusionMaps::built() const {
+const OcclusionBuffer& detail::MapsState::built() const {
     if (!built_) throw Error("occlusion maps: test before build()");
     return *built_;
 }
 
 // The overlap test's state: the rectangle in samples, the hole budget left (samples that may
 // stay uncovered), and how the test ended.
-struct OcclusionMaps::OverlapQuery {
+struct detail::MapsState::OverlapQuery {
     int i0, i1, j0, j1;
     double budget;
     OverlapExit exit = OverlapExit::passed;
@@ -177,7 +178,7 @@ std::uint32_t uncovered_samples(const OcclusionBuffer& b, int i0, int i1, int j0
 
 // One cell of the hierarchical overlap test (Zhang 5.3, Fig. 5.3). Returns false when the
 // rectangle is rejected (not inside the occluders' projection, within the hole budget).
-bool OcclusionMaps::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
+bool detail::MapsState::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
     const CellSpan cell = cell_span(k, x, y);
     const int ox0 = std::max(cell.x0, q.i0), ox1 = std::min(cell.x1, q.i1), oy0 = std::max(cell.y0, q.j0), oy1 = std::min(cell.y1, q.j1);
     if (ox0 > ox1 || oy0 > oy1) return true;  // the rectangle misses this cell
@@ -241,7 +242,7 @@ bool OcclusionMaps::overlap_cell(OverlapQuery& q, int k, int x, int y) const {
     return true;
 }
 
-void OcclusionMaps::overlap(int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer, double& uncovered) const {
+void detail::MapsState::overlap(int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer, double& uncovered) const {
     // Start at the finest level whose cells are at least as large as the rectangle's smaller
     // side, within the active levels.
     const int smaller_side = std::min(i1 - i0 + 1, j1 - j0 + 1);
@@ -272,7 +273,7 @@ void OcclusionMaps::overlap(int i0, int i1, int j0, int j1, double budget, Occlu
     uncovered = budget - q.budget;
 }
 
-double OcclusionMaps::hole_budget() const {
+double detail::MapsState::hole_budget() const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     return std::floor(config_.hole_pixels * samples_per_display_pixel_);
 }
@@ -289,13 +290,13 @@ OccludeeAnswer decided_answer(Visibility v) {
 
 }  // namespace
 
-OccludeeAnswer OcclusionMaps::test_rect(const ScreenRect& rect) const {
+OccludeeAnswer detail::MapsState::test_rect(const ScreenRect& rect) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     double budget = hole_budget();
     return test_rect_within(rect, budget);
 }
 
-OccludeeAnswer OcclusionMaps::test_rect_within(const ScreenRect& rect, double& budget) const {
+OccludeeAnswer detail::MapsState::test_rect_within(const ScreenRect& rect, double& budget) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     detail::RectQuery q;
     Visibility decided;
@@ -315,7 +316,7 @@ OccludeeAnswer OcclusionMaps::test_rect_within(const ScreenRect& rect, double& b
     return answer;
 }
 
-OccludeeAnswer OcclusionMaps::test_aabb(const Aabb& box, const std::array<float, 16>& m) const {
+OccludeeAnswer detail::MapsState::test_aabb(const Aabb& box, const std::array<float, 16>& m) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;

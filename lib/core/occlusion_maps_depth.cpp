@@ -17,6 +17,7 @@
 #include <homcull/occlusion_maps.hpp>
 
 #include "core/buffer_state.hpp"
+#include "core/maps_state.hpp"
 #include "core/float_mode.hpp"
 #include "core/min_pyramid.hpp"
 #include "core/rect_tests.hpp"
@@ -35,11 +36,11 @@ int deb_cell(int i, int samples, int cells) { return int(std::int64_t(i) * cells
 
 }  // namespace
 
-void OcclusionMaps::clear() { std::fill(deb_.begin(), deb_.end(), INFINITY); }
+void detail::MapsState::clear() { std::fill(deb_.begin(), deb_.end(), INFINITY); }
 
 // Zhang 6.2.1: the far rectangle of an occluder's box, the box's screen rectangle at its
 // farthest depth, lowers every depth estimation buffer cell it touches to that depth.
-void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16>& m) {
+void detail::MapsState::add_occluder_box(const Aabb& box, const std::array<float, 16>& m) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     const int gw = config_.deb_width, gh = config_.deb_height;
     const int sample_width = width_ * samples_, sample_height = height_ * samples_;
@@ -76,7 +77,7 @@ void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16
         }
 }
 
-bool OcclusionMaps::depth_hidden(int i0, int i1, int j0, int j1, float d_near) const {
+bool detail::MapsState::depth_hidden(int i0, int i1, int j0, int j1, float d_near) const {
     const OcclusionBuffer& buffer = *built_;
     const bool approximate = config_.hole_pixels > 0.0;
     switch (config_.depth) {

@@ -3,6 +3,8 @@
 #include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 
+#include "scene/scene_culler_state.hpp"
+
 #include "core/float_mode.hpp"
 #include "scene/scene_culler_frame.hpp"
 
@@ -67,7 +69,7 @@ OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config) {
     return config.maps.depth == DepthTest::masked ? OccludeeShape::samples : OccludeeShape::rectangles;
 }
 
-SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config)
+detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config)
     : scene_(&scene),
       config_(config),
       occluder_ids_(occluders),
@@ -125,7 +127,7 @@ SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& o
     }
 }
 
-void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     validate_camera(camera);
     // The near plane is the camera's: rebuild the buffer only when it changes.
@@ -179,7 +181,7 @@ void SceneCuller::cull(const Camera& camera, std::vector<OccludeeAnswer>& answer
 // sample centre, far beyond the margin's 2^-10 sample (near plane: the part of a triangle
 // before it is clipped away, and the edge with it). With a budget or temporal's choice,
 // neighbours may be missing: each object's own flags then.
-void SceneCuller::select_occluders(const Frame& frame) {
+void detail::SceneCullerState::select_occluders(const Frame& frame) {
     const auto start = Clock::now();
     const std::vector<std::uint32_t>* pool = &occluder_ids_;
     if (config_.strategy == CullStrategy::temporal && has_history_) {
@@ -201,7 +203,7 @@ void SceneCuller::select_occluders(const Frame& frame) {
 
 // The LODs' triangles in world space, after the candidates' own vertices, placed exactly as the
 // originals are (transform_point), with shared-edge flags within each LOD.
-void SceneCuller::gather_lods() {
+void detail::SceneCullerState::gather_lods() {
     lod_first_.assign(occluder_ids_.size() + 1, 0);
     if (!config_.lods) return;
     if (config_.lods->lod_of_mesh.size() != scene_->meshes.size())
@@ -234,7 +236,7 @@ void SceneCuller::gather_lods() {
 // that a frame draws the clusters of the candidates it picks), one after the other in clusters_,
 // with the flags within each object (own_shared_edges_): a cluster's apexes are then among its
 // candidate's vertices, so right whichever candidates a frame draws.
-void SceneCuller::build_clusters() {
+void detail::SceneCullerState::build_clusters() {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
     std::vector<std::uint32_t> local, local_apexes;  // the candidate's indices and apexes, relative to its first vertex
@@ -268,12 +270,12 @@ void SceneCuller::build_clusters() {
     frame_clusters_.reserve(clusters_.clusters.size());
 }
 
-bool SceneCuller::draws_lod(std::uint32_t id, const Camera& camera) const {
+bool detail::SceneCullerState::draws_lod(std::uint32_t id, const Camera& camera) const {
     const std::uint32_t k = candidate_of_[id];
     return lod_first_[k] < lod_first_[k + 1] && lod_usable(scene_->objects[id].world_bounds, camera);
 }
 
-void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, EdgeFlags edge_flags) {
+void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& camera, EdgeFlags edge_flags) {
     const std::uint32_t k = candidate_of_[id];
     const bool lod = draws_lod(id, camera);
     const bool own = edge_flags == EdgeFlags::own_object;
@@ -303,7 +305,7 @@ void SceneCuller::append_occluder(std::uint32_t id, const Camera& camera, EdgeFl
 // visible tested again. Hidden answers stay: drawing more only hides more. This is the second
 // phase of two-phase temporal occlusion culling (Haar and Aaltonen, "GPU-driven rendering
 // pipelines", SIGGRAPH 2015 course), here run only in frames where some candidate came into view.
-void SceneCuller::draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     auto start = Clock::now();
     const std::size_t budget = config_.occluder_budget.triangles;
     std::size_t left = budget == 0 ? ~std::size_t(0) : budget - std::min(budget, work_.occluder_triangles);
@@ -337,7 +339,7 @@ void SceneCuller::draw_newly_visible(const Frame& frame, std::vector<OccludeeAns
 
 // The clusters of frame_clusters_ and the triangles of frame_indices_ not rendered yet; the
 // frame's first render clears the buffer (render_frame clears each band where it rasterizes).
-void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel) {
+void detail::SceneCullerState::render_pending(const Frame& frame, const ParallelFor& parallel) {
     const std::size_t clusters = frame_clusters_.size() - frame_clusters_rendered_, count = frame_shared_.size() - frame_rendered_;
     if (clusters == 0 && count == 0) return;
     const auto start = Clock::now();
@@ -369,7 +371,7 @@ void SceneCuller::render_pending(const Frame& frame, const ParallelFor& parallel
 
 // The maps of what the buffer holds; the depth estimation buffer takes the rendered
 // occluders' boxes.
-void SceneCuller::build_maps(const Frame& frame) {
+void detail::SceneCullerState::build_maps(const Frame& frame) {
     const auto start = Clock::now();
     if (!frame_started_) buffer_.clear();  // nothing drawn yet this frame: it still holds the last one
     maps_.clear();

@@ -3,12 +3,14 @@
 // scene_traversal.cpp tests).
 #include <homcull/scene_culler.hpp>
 
+#include "scene/scene_culler_state.hpp"
+
 #include <array>
 #include <chrono>
 
 namespace homcull {
 
-struct SceneCuller::Frame {
+struct detail::SceneCullerState::Frame {
     const Camera* camera;
     std::array<float, 16> clip;  // anchored world (world minus the anchor) to clip, in float: the buffer's and the maps' input
     glm::dmat4 clip_double;      // world to clip in double, as ground truth transforms

@@ -2,6 +2,8 @@
 // its objects, and each remaining object's box, then (where the box is visible) its triangles.
 #include <homcull/scene_culler.hpp>
 
+#include "scene/scene_culler_state.hpp"
+
 #include "core/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 #include "scene/scene_culler_frame.hpp"
@@ -31,7 +33,7 @@ float farthest_distance2(const glm::dvec3& eye, const Aabb& box) {
 // culling needs so that near occluders are drawn before far nodes are tested). A node is
 // tested when the configuration asks for hierarchy tests and it holds more than one object;
 // if its box is outside the frustum or occluded, so is every object under it.
-void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+void detail::SceneCullerState::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     const auto start = std::chrono::steady_clock::now();
     const double flushes_before = timings_.render_ms + timings_.maps_ms;
     answers.assign(scene_->objects.size(), OccludeeAnswer{Visibility::view_culled, 0.0f, 0});
@@ -90,7 +92,7 @@ void SceneCuller::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answ
 }
 
 // The object's box, then, where the box is visible and the object small enough, its triangles.
-OccludeeAnswer SceneCuller::test_object(const Frame& frame, std::uint32_t id) {
+OccludeeAnswer detail::SceneCullerState::test_object(const Frame& frame, std::uint32_t id) {
     const Object& object = scene_->objects[id];
     OccludeeAnswer answer = maps_.test_aabb(object_boxes_[id], frame.clip);
     ++work_.objects_tested;
@@ -136,7 +138,7 @@ bool triangle_hidden(const OcclusionMaps& maps, float near_w, const glm::dvec4 c
 
 // Every triangle hidden (see triangle_hidden), corners transformed in double as ground truth
 // transforms them.
-bool SceneCuller::triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
+bool detail::SceneCullerState::triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const {
     const Mesh& mesh = scene_->meshes[object.mesh];
     const glm::dmat4 m = clip_from_world * object.world;
     double budget = maps_.hole_budget();  // approximate mode: L pixels of holes for the whole object
@@ -151,7 +153,7 @@ bool SceneCuller::triangle_rectangles_hidden(const Object& object, const glm::dm
 // The object's triangles sample by sample (OcclusionBuffer::test_triangles), tolerating the
 // maps' hole budget in approximate mode; its level of visibility is then the share of its
 // samples left visible.
-bool SceneCuller::triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) {
+bool detail::SceneCullerState::triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility) {
     const std::size_t first = occludee_first_vertex_[id];
     if (first == kNotGathered) return false;
     const Mesh& mesh = scene_->meshes[scene_->objects[id].mesh];

@@ -36,12 +36,6 @@ namespace homcull {
 class OcclusionMaps;
 namespace detail {
 class BufferState;  // lib/core/buffer_state.hpp
-// One level of a pyramid stored level after level in one array: width x height cells from
-// `offset` on, row-major.
-struct PyramidLevel {
-    int width, height;
-    std::size_t offset;
-};
 }  // namespace detail
 
 enum class Backface : std::uint8_t {

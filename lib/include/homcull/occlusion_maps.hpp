@@ -21,6 +21,9 @@
 #include <vector>
 
 namespace homcull {
+namespace detail {
+class MapsState;  // lib/core/maps_state.hpp
+}
 
 enum class DepthTest : std::uint8_t {
     masked,  // the buffer's own per-subtile layers, per sample (MOC's test; conservative)
@@ -114,55 +117,41 @@ public:
     double hole_budget() const;
     OccludeeAnswer test_rect_within(const ScreenRect& rect, double& budget) const;
 
-    const OcclusionMapsConfig& config() const { return config_; }
+    const OcclusionMapsConfig& config() const;
     // The opacity pyramid, for dumps and tests: level k is level_width(k) x level_height(k)
     // cells of 2^k x 2^k buffer pixels; covered_samples(k) and cell_samples(k) row-major.
-    int levels() const { return int(levels_.size()); }
-    int level_width(int k) const { return levels_[std::size_t(k)].width; }
-    int level_height(int k) const { return levels_[std::size_t(k)].height; }
-    const std::uint32_t* covered_samples(int k) const { return covered_.data() + levels_[std::size_t(k)].offset; }
+    int levels() const;
+    int level_width(int k) const;
+    int level_height(int k) const;
+    const std::uint32_t* covered_samples(int k) const;
     // Samples in a cell of level k inside the buffer (border cells may have fewer).
     std::uint32_t cell_samples(int k, int x, int y) const;
     float opacity(int k, int x, int y) const;
     // Per-level thresholds in force (Zhang 5.4): a cell with opacity >= opacity_threshold(k)
     // is opaque enough; one with opacity <= transparency_threshold(k) counts as empty.
-    double opacity_threshold(int k) const { return opacity_threshold_[std::size_t(k)]; }
-    double transparency_threshold(int k) const { return transparency_threshold_[std::size_t(k)]; }
+    double opacity_threshold(int k) const;
+    double transparency_threshold(int k) const;
     // Depth maps as 1/w per cell (larger is nearer; +inf where no occluder covers anything):
     // the farthest (hzb) and nearest (nbz) depth of the covered samples of each pixel, with
     // their min pyramids on the opacity pyramid's levels, and the depth estimation buffer.
     // A pyramid the maps do not make (OcclusionMapsConfig::depth_pyramids) is null.
-    const float* farthest_depth(int k) const { return hzb_.empty() ? nullptr : hzb_.data() + levels_[std::size_t(k)].offset; }
-    const float* nearest_depth(int k) const { return nbz_.empty() ? nullptr : nbz_.data() + levels_[std::size_t(k)].offset; }
-    const std::vector<float>& depth_estimation() const { return deb_; }
+    const float* farthest_depth(int k) const;
+    const float* nearest_depth(int k) const;
+    const std::vector<float>& depth_estimation() const;
     // The farthest covered depth of the whole buffer (the plane test's): +inf when nothing is
     // covered, and when the maps make no hzb pyramid.
-    float plane_depth() const { return plane_; }
+    float plane_depth() const;
+
+    // The implementation (lib/core/maps_state.hpp): not part of the interface.
+    const detail::MapsState& state() const { return *state_; }
+
+    // Moves leave the source with no state: it may then only be assigned to or destroyed.
+    ~OcclusionMaps();
+    OcclusionMaps(OcclusionMaps&&) noexcept;
+    OcclusionMaps& operator=(OcclusionMaps&&) noexcept;
 
 private:
-    using Level = detail::PyramidLevel;
-    OcclusionMapsConfig config_;
-    const OcclusionBuffer* built_ = nullptr;     // the buffer of the last build()
-    int width_ = 0, height_ = 0, samples_ = 1;  // buffer pixels and samples per axis
-    float near_w_ = 0.1f;
-    double samples_per_display_pixel_ = 1.0;
-    std::vector<Level> levels_;
-    std::vector<std::uint32_t> covered_;
-    std::vector<float> hzb_, nbz_, deb_;
-    float plane_ = 0.0f;
-    std::vector<double> opacity_threshold_, transparency_threshold_;
-    int start_max_level_ = 0;
-
-    // The samples of cell (x, y) of level k, clipped to the buffer: [x0, x1] x [y0, y1].
-    struct CellSpan {
-        int x0, x1, y0, y1;
-    };
-    CellSpan cell_span(int k, int x, int y) const;
-    struct OverlapQuery;
-    bool overlap_cell(OverlapQuery& q, int k, int x, int y) const;
-    void overlap(int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer, double& uncovered) const;
-    bool depth_hidden(int i0, int i1, int j0, int j1, float d_near) const;
-    const OcclusionBuffer& built() const;
+    detail::HookPtr<detail::MapsState> state_;  // every pyramid, threshold and setting
 };
 
 }  // namespace homcull

@@ -17,6 +17,9 @@
 #include <vector>
 
 namespace homcull {
+namespace detail {
+class SceneCullerState;  // lib/scene/scene_culler_state.hpp
+}
 
 enum class OccludeeShape : std::uint8_t {
     box,         // the world box alone
@@ -123,99 +126,32 @@ public:
     void cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
     // temporal: forget the last frame (after a camera cut), so that the next frame works as
     // one_pass.
-    void reset_history() { has_history_ = false; }
+    void reset_history();
 
-    const SceneCullerConfig& config() const { return config_; }
-    const Scene& scene() const { return *scene_; }
-    const OcclusionBuffer& buffer() const { return buffer_; }
-    const OcclusionMaps& maps() const { return maps_; }
-    const SceneCullTimings& timings() const { return timings_; }
-    const SceneCullWork& work() const { return work_; }
-    const OverlapExitCounts& overlap_exits() const { return exits_; }
+    const SceneCullerConfig& config() const;
+    const Scene& scene() const;
+    const OcclusionBuffer& buffer() const;
+    const OcclusionMaps& maps() const;
+    const SceneCullTimings& timings() const;
+    const SceneCullWork& work() const;
+    const OverlapExitCounts& overlap_exits() const;
     // The objects the last cull() drew as occluders (object ids, in drawing order).
-    const std::vector<std::uint32_t>& drawn_occluders() const { return frame_occluders_; }
-    const ObjectHierarchy& hierarchy() const { return hierarchy_; }
+    const std::vector<std::uint32_t>& drawn_occluders() const;
+    const ObjectHierarchy& hierarchy() const;
     // The occluder candidates, and their triangles.
-    std::size_t occluder_objects() const { return occluder_ids_.size(); }
-    std::size_t occluder_triangles() const { return occluders_.triangle_count(); }
+    std::size_t occluder_objects() const;
+    std::size_t occluder_triangles() const;
+
+    // The implementation (lib/scene/scene_culler_state.hpp): not part of the interface.
+    const detail::SceneCullerState& state() const { return *state_; }
+
+    // Moves leave the source with no state: it may then only be assigned to or destroyed.
+    ~SceneCuller();
+    SceneCuller(SceneCuller&&) noexcept;
+    SceneCuller& operator=(SceneCuller&&) noexcept;
 
 private:
-    const Scene* scene_;
-    SceneCullerConfig config_;
-    std::vector<std::uint32_t> occluder_ids_;
-    // Every float position and box the buffer and maps see is relative to this point
-    // (scene_anchor, as ground truth's), so that scenes far from the origin keep their precision.
-    glm::dvec3 anchor_;
-    std::vector<Aabb> object_boxes_, node_boxes_;  // world_bounds and the hierarchy's node bounds, anchored
-    WorldTriangles occluders_;  // shared-edge flags across the whole candidate set
-    // Per candidate k (occluder_ids_[k]): its triangles are [first_triangle_[k], first_triangle_[k + 1]).
-    std::vector<std::uint32_t> first_triangle_;
-    std::vector<std::uint32_t> candidate_of_;  // object id -> k, or kNone
-    // Shared-edge flags within each object only: right for any subset of the candidates (an edge
-    // shared with an object that is not drawn is a silhouette and needs its margin).
-    std::vector<std::uint8_t> own_shared_edges_;
-    std::vector<std::uint32_t> own_edge_apexes_;  // their apexes (3 per triangle, into occluders_.positions)
-    // Per candidate k: its LOD's triangles (indices into occluders_.positions, which hold the
-    // LODs' vertices after the originals') are lod_indices_[3 * lod_first_[k] .. 3 * lod_first_[k + 1]),
-    // with shared-edge flags within the LOD; an empty range when it has none.
-    std::vector<std::uint32_t> lod_first_, lod_indices_;
-    std::vector<std::uint8_t> lod_shared_edges_;
-    std::vector<std::uint32_t> lod_edge_apexes_;
-    // config_.occluder_clusters: candidate k's clusters are [cluster_first_[k], cluster_first_[k + 1])
-    // of clusters_, whose flags are own_shared_edges_' (a cluster's apexes are in its own vertices).
-    OccluderClusters clusters_;
-    std::vector<std::uint32_t> cluster_first_;
-    ObjectHierarchy hierarchy_;
-    OcclusionBuffer buffer_;
-    OcclusionMaps maps_;
-    SceneCullTimings timings_;
-    SceneCullWork work_;
-    OverlapExitCounts exits_;
-
-    // Per-frame state and scratch (reused, grown only).
-    std::vector<std::uint32_t> frame_occluders_;  // object ids drawn this frame
-    std::vector<std::uint32_t> frame_indices_;    // their triangles' indices into occluders_
-    std::vector<std::uint8_t> frame_shared_;      // and their shared-edge flags
-    std::vector<std::uint32_t> frame_apexes_;     // and the flags' apexes
-    std::size_t frame_rendered_ = 0;              // triangles of frame_indices_ already rendered
-    std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
-    std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
-    std::size_t frame_cluster_triangles_waiting_ = 0;
-    bool frame_started_ = false;                  // something was rendered this frame (the buffer is cleared)
-    std::vector<std::uint32_t> temporal_pool_;    // temporal: the candidates not occluded last frame
-    std::vector<std::uint32_t> ranked_;           // rank_occluders' choice
-    std::vector<std::pair<float, std::uint32_t>> rank_scratch_, node_heap_;
-    std::vector<Visibility> last_visibility_;
-    std::vector<std::uint8_t> drawn_;  // per candidate k: drawn this frame
-    bool has_history_ = false;
-
-    static constexpr std::uint32_t kNone = ~std::uint32_t(0);
-    struct Frame;
-    void select_occluders(const Frame& frame);
-    // Which shared-edge flags an occluder is drawn with (docs/scene-culling.md, "Shared edges").
-    enum class EdgeFlags : std::uint8_t { own_object, across_objects };
-    // Appends an occluder's triangles (or clusters), its LOD's when it has one usable from this
-    // camera, with those flags (an LOD always has its own).
-    void append_occluder(std::uint32_t id, const Camera& camera, EdgeFlags edge_flags);
-    bool draws_lod(std::uint32_t id, const Camera& camera) const;
-    void gather_lods();
-    void build_clusters();
-    // Triangles appended and not rendered yet (progressive draws every batch of them).
-    std::size_t triangles_waiting() const { return frame_shared_.size() - frame_rendered_ + frame_cluster_triangles_waiting_; }
-    void render_pending(const Frame& frame, const ParallelFor& parallel);
-    void build_maps(const Frame& frame);
-    void draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
-    void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
-    OccludeeAnswer test_object(const Frame& frame, std::uint32_t id);
-    // Occludee triangles in world space (transformed as ground truth transforms them) for the
-    // samples test: object id -> its first vertex in occludee_positions_, or kNotGathered.
-    static constexpr std::size_t kNotGathered = ~std::size_t(0);
-    std::vector<float> occludee_positions_;
-    std::vector<std::size_t> occludee_first_vertex_;
-    bool triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const;
-    // Per object, the triangle that found it visible last time: the next test starts there.
-    std::vector<std::uint32_t> first_visible_triangle_;
-    bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
+    detail::HookPtr<detail::SceneCullerState> state_;  // the scene's occluders, buffer, maps and per-frame scratch
 };
 
 // The samples per buffer pixel axis that SceneCullerConfig::samples = 0 stands for: the largest
