@@ -43,16 +43,25 @@ bool exact_clip_triangle(const TriangleInput& in, std::size_t t, std::array<std:
         std::memcpy(p, bytes + v * in.position_stride, std::size_t(in.position_components) * sizeof(float));
         for (float c : p)
             if (!std::isfinite(c)) return false;
-        const int rows[3] = {0, 1, 3};  // x, y, w
-        for (int r = 0; r < 3; ++r) {
-            mpq_class sum = 0;
+        mpq_class row[4];  // x, y, z, w
+        for (int r = 0; r < 4; ++r) {
+            row[r] = 0;
             for (int c = 0; c < 4; ++c) {
-                const float m = in.model_to_clip[std::size_t(4 * c + rows[r])];
+                const float m = in.model_to_clip[std::size_t(4 * c + r)];
                 if (!std::isfinite(m)) return false;
-                sum += exact(m) * exact(p[c]);
+                row[r] += exact(m) * exact(p[c]);
             }
-            clip[std::size_t(k)][std::size_t(r)] = sum;
         }
+        if (in.orthographic) {
+            // The orthographic representative (x, y, w) / h, h = (3w - z) / 2, exactly: the same
+            // point with 1/w' the depth (3 - z/w) / 2. The buffer drops points with w <= 0 or
+            // h < 2^-8 w; so does the oracle (a dropped occluder backs no claim, and a dropped
+            // occludee makes the buffer answer visible).
+            const mpq_class h = (3 * row[3] - row[2]) / 2;
+            if (!(row[3] > 0) || h < row[3] / 256) return false;
+            for (int r : {0, 1, 3}) row[r] /= h;
+        }
+        clip[std::size_t(k)] = {row[0], row[1], row[3]};
     }
     return true;
 }

@@ -13,6 +13,7 @@
 #include <homcull/truth/ray_scene.hpp>
 #include <homcull/world_triangles.hpp>
 
+#include <glm/ext/matrix_clip_space.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -477,6 +478,53 @@ TEST(ClusteredRender, TaskListMisuseIsAnErrorAndMissingTasksStayConservative) {
         ASSERT_EQ(drawn[i], INFINITY) << "sample " << i << " of the band that did not run";
     buffer.read_pyramid(pyramid);
     EXPECT_TRUE(pyramid == test::pyramid_by_definition(buffer));
+}
+
+// An orthographic view (BufferConfig::orthographic) of walls as clusters, indexed (through the
+// vertex cache) and drawn with and without a job system: every instruction set gives the
+// scalar bits, boxes behind the nearest wall are occluded and those before it visible, and a
+// perspective input into it is refused.
+TEST(ClusteredRender, OrthographicViewsGiveTheSameBitsEverywhereAndHideWhatIsBehind) {
+    OccluderClusters clusters;
+    for (int k = 0; k < 90; ++k) {
+        const float x = -30.0f + 0.7f * float(k), z = -10.0f - 3.0f * float(k % 9), half = 1.0f + float(k % 5);
+        append_quad(clusters, {x - half, -20.0f, z}, {x + half, -20.0f, z}, {x + half, 20.0f, z}, {x - half, 20.0f, z});
+    }
+    // Looking down -z from the origin at a 40 x 24 window, near 1, far 60 (OpenGL's z range).
+    const std::array<float, 16> ortho = float_matrix(glm::ortho(-20.0, 20.0, -12.0, 12.0, 1.0, 60.0));
+    BufferConfig config = test::buffer_config(333, 197, 2, 0.1f);
+    config.orthographic = true;
+    ClusteredInput in{&clusters, ortho, Backface::cw};
+    in.orthographic = true;
+    select_isa("scalar");
+    OcclusionBuffer reference(config);
+    reference.render_frame(in);
+    EXPECT_EQ(reference.config().near_w, 0.5f);  // the near plane's, whatever was asked
+    EXPECT_GT(reference.stats().rasterized, 50u);
+    std::mt19937_64 order_rng(2);
+    const ParallelFor tbb = test::parallel_jobs(), shuffled{test::run_shuffled, &order_rng};
+    for (const std::string& isa : available_isas())
+        for (const ParallelFor& parallel : {ParallelFor{}, tbb, shuffled}) {
+            select_isa(isa);
+            OcclusionBuffer buffer(config);
+            buffer.render_frame(in, parallel);
+            EXPECT_TRUE(reference.stats() == buffer.stats()) << isa;
+            EXPECT_TRUE(test::same_subtiles(reference, buffer)) << isa;
+            EXPECT_TRUE(test::same_pyramid(reference, buffer)) << isa;
+        }
+    select_isa("best");
+    const auto box = [&](float z0, float z1) {
+        const float lo[3] = {-2.0f, -2.0f, z0}, hi[3] = {2.0f, 2.0f, z1};
+        return reference.test_aabb(lo, hi, ortho);
+    };
+    EXPECT_EQ(box(-50.0f, -45.0f), Visibility::occluded);  // behind every wall
+    EXPECT_EQ(box(-8.0f, -5.0f), Visibility::visible);     // before them
+    EXPECT_EQ(box(-3.0f, 0.5f), Visibility::visible);      // across the near plane (view z = -1)
+    EXPECT_EQ(box(-0.5f, 3.0f), Visibility::view_culled);  // before it
+    EXPECT_EQ(box(-200.0f, -190.0f), Visibility::visible);  // beyond twice the far distance: not answered
+    ClusteredInput perspective = in;
+    perspective.orthographic = false;
+    EXPECT_THROW(reference.render(perspective), Error);
 }
 
 // More clusters than one placement task takes (64), drawn as a subset in another order, with

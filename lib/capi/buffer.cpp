@@ -55,10 +55,10 @@ glm::dvec4 far_row_in_model(const homcull_buffer& b, const glm::dmat4& model) {
 // Whether a box lies wholly outside the view: before the near plane, or its screen rectangle
 // (conservative: it holds every projected point of the box) beyond a side of the screen. Its
 // triangles then cover no sample: skipping them changes no bit of the buffer.
-bool outside_view(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w) {
+bool outside_view(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w, bool orthographic) {
     ScreenRect r;
     Visibility decided;
-    if (!detail::box_rectangle(box_min, box_max, model_to_clip, near_w, r, decided)) return decided == Visibility::view_culled;
+    if (!detail::box_rectangle(box_min, box_max, model_to_clip, near_w, orthographic, r, decided)) return decided == Visibility::view_culled;
     return r.ndc_max_x < -1.0f || r.ndc_min_x > 1.0f || r.ndc_max_y < -1.0f || r.ndc_min_y > 1.0f;
 }
 
@@ -322,7 +322,7 @@ homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* m
         in.backface = b->backface;
         for (std::size_t i = 0; i < instance_count; ++i) {
             in.model_to_clip = capi::float_clip_from_model(b->clip_from_world, read_model(*b, model_matrices ? model_matrices + 16 * i : nullptr));
-            if (mesh->bounded && outside_view(mesh->bounds_min, mesh->bounds_max, in.model_to_clip, b->buffer.config().near_w)) continue;
+            if (mesh->bounded && outside_view(mesh->bounds_min, mesh->bounds_max, in.model_to_clip, b->buffer.config().near_w, in.orthographic)) continue;
             if (b->tasks == homcull_buffer::Tasks::recording) b->buffer.record(in);  // a record that fails records nothing
             else b->buffer.render(in, b->jobs);  // a render that fails leaves what it drew: occluders all, so still conservative
         }

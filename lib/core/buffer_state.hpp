@@ -70,6 +70,8 @@ public:
     int subtiles_x() const { return subtiles_x_; }
     int subtiles_y() const { return subtiles_y_; }
     ~BufferState();
+    // Throws homcull::Error when an input's projection is not the buffer's.
+    void check_projection(bool orthographic, const char* caller) const;
 
     BufferConfig config_;
     int sample_width_ = 0, sample_height_ = 0;

@@ -36,6 +36,7 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
     t.triangle_count = c.triangle_count;
     t.model_to_clip = in.model_to_clip;
     t.backface = in.backface;
+    t.orthographic = in.orthographic;
     t.shared_edges = (in.shared_edges ? in.shared_edges : clusters.shared_edges.data()) + c.first_triangle;
     t.edge_apexes = (in.shared_edges ? in.edge_apexes : clusters.edge_apexes.data()) + 3 * std::size_t(c.first_triangle);
     return t;
@@ -56,7 +57,7 @@ void detail::BufferState::place_cluster(const OccluderCluster& c, std::uint32_t 
     ScreenRect rect;
     Visibility decided = Visibility::visible;
     detail::RectQuery q;
-    if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, model_to_clip, config_.near_w, rect, decided) &&
+    if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, model_to_clip, config_.near_w, config_.orthographic, rect, decided) &&
         prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
         out.placed = {rect.w_min, number, 0, q.i0, q.i1, q.j0, q.j1, q.d_near, true};
     else if (decided != Visibility::visible)  // outside the view, or between sample centres
@@ -75,6 +76,7 @@ void detail::BufferState::render_frame(const ClusteredInput& input, const Parall
 
 std::size_t detail::BufferState::place_clusters(const ClusteredInput& in, const ParallelFor& parallel) {
     if (!in.clusters) throw Error("render: ClusteredInput::clusters is null");
+    check_projection(in.orthographic, "render");
     const OccluderClusters& clusters = *in.clusters;
     if (in.shared_edges && !in.edge_apexes) throw Error("render: ClusteredInput::shared_edges needs edge_apexes");
     if (clusters.edge_apexes.size() != 3 * clusters.shared_edges.size())

@@ -125,6 +125,26 @@ double box_corners(const float box_min[3], const float box_max[3], const std::ar
     return 0x1.0p-50 * std::max({magnitude.x, magnitude.y, magnitude.z, magnitude.w});
 }
 
+double orthographic_corners(glm::dvec4 corners[8], double error) {
+    // Each corner's h = (3w - z) / 2 is off by at most (3 + 1) / 2 of the corners' error, plus
+    // its own rounding; x / h by (error h + |x| dh) / (h (h - dh)) for x and h off by error and
+    // dh, largest at the smallest h (it falls as h grows past 2 dh); and each division rounds
+    // by 2^-53 of its result.
+    double h_min = HUGE_VAL, magnitude = 0.0, largest = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec4& c = corners[k];
+        h_min = std::min(h_min, (3.0 * c.w - c.z) * 0.5);
+        magnitude = std::max({magnitude, std::abs(c.x), std::abs(c.y), std::abs(c.z), std::abs(c.w)});
+    }
+    for (int k = 0; k < 8; ++k) {
+        corners[k] = orthographic_representative(corners[k]);
+        largest = std::max({largest, std::abs(corners[k].x), std::abs(corners[k].y), std::abs(corners[k].w)});
+    }
+    const double dh = 2.0 * error + 0x1.0p-50 * magnitude;
+    if (!(h_min > 2.0 * dh)) return HUGE_VAL;  // no bound to reason with: the box is visible
+    return (error * h_min + (magnitude + error) * dh) / (h_min * (h_min - dh)) + 0x1.0p-52 * largest;
+}
+
 double ndc_error_bound(double error, double max_abs_ndc, double min_w) {
     if (!(min_w > error)) return HUGE_VAL;
     return error * (1.0 + max_abs_ndc) / (min_w - error) + 0x1.0p-52 * max_abs_ndc;
@@ -150,10 +170,11 @@ ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w) {
     return b;
 }
 
-bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, ScreenRect& rect,
+bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, bool orthographic, ScreenRect& rect,
                    Visibility& decided) {
     glm::dvec4 corners[8];
-    const double error = box_corners(box_min, box_max, m, corners);
+    double error = box_corners(box_min, box_max, m, corners);
+    if (orthographic) error = orthographic_corners(corners, error);
     const ClipBounds b = clip_bounds(corners, 8, double(near_w));
     if (!b.finite || b.behind > 0) {  // nothing to reason with, or crossing the near plane: visible
         decided = b.finite && b.behind == 8 ? Visibility::view_culled : Visibility::visible;
@@ -178,7 +199,7 @@ Visibility detail::BufferState::test_aabb(const float box_min[3], const float bo
     const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
-    if (!detail::box_rectangle(box_min, box_max, m, config_.near_w, r, decided)) return decided;
+    if (!detail::box_rectangle(box_min, box_max, m, config_.near_w, config_.orthographic, r, decided)) return decided;
     return test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
 }
 
@@ -207,7 +228,8 @@ void detail::BufferState::test_aabbs(const Aabb* boxes, std::size_t count, const
         const std::size_t n = std::min(kBlock, count - base);
         std::size_t pending = 0;
         for (std::size_t k = 0; k < n; ++k)
-            if (detail::box_rectangle(&boxes[base + k].min.x, &boxes[base + k].max.x, m, config_.near_w, rects[pending], results[base + k]))
+            if (detail::box_rectangle(&boxes[base + k].min.x, &boxes[base + k].max.x, m, config_.near_w, config_.orthographic, rects[pending],
+                                      results[base + k]))
                 index[pending++] = base + k;
         test_rects(rects, pending, answers);
         for (std::size_t p = 0; p < pending; ++p) results[index[p]] = answers[p];

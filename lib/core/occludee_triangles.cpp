@@ -260,6 +260,13 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
     TriangleTest result;
     if (in.triangle_count == 0) return result;
     detail::check_triangle_input(in, "test_triangles");
+    check_projection(in.orthographic, "test_triangles");
+    // The rounding bounds below (clip_error) are those of a perspective transform; an
+    // orthographic buffer's representatives have others, not derived yet: visible.
+    if (config_.orthographic) {
+        result.visibility = Visibility::visible;
+        return result;
+    }
 
     const detail::SubtileView view = subtile_view();
     const double near_w = config_.near_w;

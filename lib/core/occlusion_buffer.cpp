@@ -72,7 +72,7 @@ const char* buffer_config_problem(const BufferConfig& config) noexcept {
     if (config.samples != 1 && config.samples != 2 && config.samples != 4) return "samples per pixel axis must be 1, 2 or 4";
     // Depths are stored as float 1/w: below 2^-126 (subnormal) 1/near_w overflows float, and the
     // draw order's and the cells' float depths stop agreeing with the setup's double ones.
-    if (!(config.near_w >= 0x1.0p-126f) || !std::isfinite(config.near_w))
+    if (!config.orthographic && (!(config.near_w >= 0x1.0p-126f) || !std::isfinite(config.near_w)))
         return "near_w must be a finite number of at least 2^-126 (1.2e-38)";
     if (!(config.edge_margin >= 0.0 && config.edge_margin < 0.5)) return "the edge margin must be in [0, 0.5) samples";
     const double sample_width = double(config.width) * config.samples, sample_height = double(config.height) * config.samples;
@@ -146,6 +146,7 @@ void detail::BufferState::configure(const BufferConfig& config) {
     reserve_arrays(z);
 
     config_ = config;
+    if (config.orthographic) config_.near_w = detail::kOrthographicNearW;  // the near plane, z = -1
     sample_width_ = z.sample_width, sample_height_ = z.sample_height;
     subtiles_x_ = z.subtiles_x, subtiles_y_ = z.subtiles_y;
     stride_ = z.stride;
@@ -181,7 +182,7 @@ void detail::BufferState::set_near_w(float near_w) {
     BufferConfig config = config_;
     config.near_w = near_w;
     validate_config(config);
-    config_.near_w = near_w;
+    if (!config_.orthographic) config_.near_w = near_w;  // an orthographic buffer's is its near plane's
     clear();
 }
 
@@ -238,6 +239,12 @@ void detail::BufferState::reserve(const BufferReserve& r) {
     }
     at_least(cluster_setups_, r.max_task_list_clusters);
     at_least(setup_triangles_, r.max_task_list_triangles);
+}
+
+void detail::BufferState::check_projection(bool orthographic, const char* caller) const {
+    if (orthographic != config_.orthographic)
+        throw Error(std::string(caller) + (config_.orthographic ? ": the buffer is orthographic and the input is not (TriangleInput, ClusteredInput::orthographic)"
+                                                               : ": the input is orthographic and the buffer is not (BufferConfig::orthographic)"));
 }
 
 void detail::BufferState::clear() {
@@ -391,6 +398,7 @@ void detail::BufferState::render_frame(const TriangleInput& in, const ParallelFo
 
 void detail::BufferState::render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first) {
     detail::check_triangle_input(in, "render");
+    check_projection(in.orthographic, "render");
     detail::check_draw_order(in);
     if (in.shared_edges && !in.edge_apexes)
         throw Error("render: shared_edges needs edge_apexes (compute_shared_edges writes both): each flag is kept only where its "

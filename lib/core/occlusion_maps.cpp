@@ -29,6 +29,7 @@ constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtil
 }  // namespace
 
 detail::MapsState::MapsState(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config) : config_(config) {
+    if (buffer.config().orthographic) throw Error("occlusion maps: orthographic buffers are not supported (their depth maps would need clip z)");
     const detail::StandardFloatMode mode;  // float_mode.hpp
     const BufferConfig& b = buffer.config();
     width_ = b.width;
@@ -320,7 +321,7 @@ OccludeeAnswer detail::MapsState::test_aabb(const Aabb& box, const std::array<fl
     const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
-    if (!detail::box_rectangle(&box.min.x, &box.max.x, m, built().config().near_w, r, decided)) return decided_answer(decided);
+    if (!detail::box_rectangle(&box.min.x, &box.max.x, m, built().config().near_w, false, r, decided)) return decided_answer(decided);
     return test_rect(r);
 }
 

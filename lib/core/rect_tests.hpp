@@ -113,8 +113,15 @@ ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w);
 // outwards, with its nearest w lowered by that bound and rounded down; or,
 // returning false, the answer when it needs none (non-finite corners: visible; entirely
 // before the near plane: view-culled; crossing it: visible).
+// orthographic: the buffer's BufferConfig::orthographic, whose corners are taken as their
+// orthographic representatives (orthographic_corners).
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,
-                   ScreenRect& rect, Visibility& decided);
+                   bool orthographic, ScreenRect& rect, Visibility& decided);
+// Replaces the eight corners by their orthographic representatives (triangle_setup.hpp) and
+// returns a bound on the error of their coordinates, from `error`, the corners' own bound
+// (box_corners); infinite when the corners come too near h = 0 to bound it (or beyond twice
+// the far distance, where the representatives are NaN).
+double orthographic_corners(glm::dvec4 corners[8], double error);
 
 // The coarse stage's code for a rectangle it leaves to the exact stage.
 constexpr std::uint8_t kUndecided = 0xFF;

@@ -137,11 +137,12 @@ void bucket_range(const TriangleInput& in, const VertexClip* cache, const std::u
     const auto* positions = static_cast<const float*>(in.positions);
     const bool float_aligned = reinterpret_cast<std::uintptr_t>(in.positions) % alignof(float) == 0 && in.position_stride % sizeof(float) == 0;
     const std::size_t stride = in.position_stride / sizeof(float);
-    if (!cache && !in.indices && float_aligned && stride == std::size_t(in.position_components)) {
+    // (An orthographic input's w' needs its z too: it takes the double pass.)
+    if (!cache && !in.orthographic && !in.indices && float_aligned && stride == std::size_t(in.position_components)) {
         bucket_packed_soup(positions, in.position_components, begin, end, row, float(near_w), bucket, count, spec, noted);
         return;
     }
-    if (!cache && in.indices && float_aligned && in.vertex_count > 0 && in.vertex_count <= (std::size_t(1) << 31) / stride) {
+    if (!cache && !in.orthographic && in.indices && float_aligned && in.vertex_count > 0 && in.vertex_count <= (std::size_t(1) << 31) / stride) {
         bucket_indexed(positions, stride, in.position_components, in.indices, in.indices_16bit, in.vertex_count, begin, end, row, float(near_w),
                        bucket, count);
         return;
@@ -152,6 +153,11 @@ void bucket_range(const TriangleInput& in, const VertexClip* cache, const std::u
         const std::size_t byte_stride = in.position_stride;
         const auto with = [&](auto&& w_of) { bucket_triangles(indices, begin, end, in.vertex_count, near_w, w_of, bucket, count); };
         if (cache) with([&](std::uint32_t v) { return cache->w[v]; });
+        else if (in.orthographic) with([&](std::uint32_t v) {
+            float p[4];
+            read_position(in, v, p);
+            return input_to_clip(in, p[0], p[1], p[2], p[3]).w;
+        });
         else if (in.position_components == 4) with([&](std::uint32_t v) { return clip_w<4>(in.model_to_clip, bytes + v * byte_stride); });
         else with([&](std::uint32_t v) { return clip_w<3>(in.model_to_clip, bytes + v * byte_stride); });
     });
@@ -250,7 +256,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     // Notes for the cells: bucket_range's pass over a packed soup of 4 floats per vertex in clip
     // space, without shared-edge flags, drawn through a list (with or without a job system:
     // with notes, the list's scattered reads are mostly of the notes).
-    const bool clip_space_soup = list && records && !cache && !in.indices && !in.shared_edges && is_identity(in.model_to_clip) &&
+    const bool clip_space_soup = list && records && !cache && !in.indices && !in.shared_edges && !in.orthographic && is_identity(in.model_to_clip) &&
                                  in.position_stride == 4 * sizeof(float);
     const bool listed = (may_list || clip_space_soup) && list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
     const bool noting = clip_space_soup && listed;

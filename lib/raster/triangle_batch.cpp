@@ -78,7 +78,7 @@ void transform_vertices_reference(const TriangleInput& in, double near_w, std::s
     for (std::size_t v = begin; v < end; ++v) {
         float p[4];
         read_position(in, std::uint32_t(v), p);
-        const glm::dvec4 c = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
+        const glm::dvec4 c = input_to_clip(in, p[0], p[1], p[2], p[3]);
         cache.x[v] = c.x, cache.y[v] = c.y, cache.z[v] = c.z, cache.w[v] = c.w;
         cache.outcode[v] = outcode(c, near_w);
     }
@@ -117,8 +117,8 @@ template <bool kPlain>
 void transform_batch_with(const TriangleInput& in, TriangleBatch& batch) {
     for (int t = 0; t < TriangleBatch::kSize; ++t)
         for (int k = 0; k < 3; ++k) {
-            const glm::dvec4 c = kPlain ? transform_to_clip_plain(in.model_to_clip, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t])
-                                        : transform_to_clip(in.model_to_clip, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t]);
+            const glm::dvec4 c = kPlain ? input_to_clip_plain(in, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t])
+                                        : input_to_clip(in, batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t]);
             batch.cx[k][t] = c.x, batch.cy[k][t] = c.y, batch.cz[k][t] = c.z, batch.cw[k][t] = c.w;
         }
 }

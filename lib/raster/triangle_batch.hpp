@@ -203,7 +203,7 @@ inline bool vertex_clip(const TriangleInput& in, const VertexClip* cache, std::u
     } else {
         float p[4];
         read_position(in, v, p);
-        out = transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
+        out = input_to_clip(in, p[0], p[1], p[2], p[3]);
     }
     return true;
 }

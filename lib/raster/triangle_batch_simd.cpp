@@ -48,14 +48,26 @@ HWY_INLINE V ClipRow(D d, const std::array<float, 16>& m, int r, V x, V y, V z, 
     return hn::Add(s3, error);
 }
 
+// orthographic_representative (triangle_setup.hpp) lane by lane, in its order of operations.
+HWY_INLINE void OrthographicRepresentative(D d, V& x, V& y, V z, V& w) {
+    const V h = hn::Mul(hn::Sub(hn::Mul(hn::Set(d, 3.0), w), z), hn::Set(d, 0.5));
+    const auto valid = hn::And(hn::Gt(w, hn::Zero(d)), hn::Ge(h, hn::Mul(hn::Set(d, 0x1.0p-8), w)));
+    const V nan = hn::Set(d, std::numeric_limits<double>::quiet_NaN());
+    x = hn::IfThenElse(valid, hn::Div(x, h), nan);
+    y = hn::IfThenElse(valid, hn::Div(y, h), nan);
+    w = hn::IfThenElse(valid, hn::Div(w, h), nan);
+}
+
 // Transforms the lanes' positions (count of them, from vertex `at`) and stores their clip
 // coordinates and outcodes into the cache.
 HWY_INLINE void StoreVertexClips(const TriangleInput& in, V near, V px, V py, V pz, V pw, std::size_t at, std::size_t count,
                                  const VertexClip& cache) {
     const D d;
     const hn::Rebind<std::int32_t, D> di;
-    const V x = ClipRow(d, in.model_to_clip, 0, px, py, pz, pw), y = ClipRow(d, in.model_to_clip, 1, px, py, pz, pw);
-    const V z = ClipRow(d, in.model_to_clip, 2, px, py, pz, pw), w = ClipRow(d, in.model_to_clip, 3, px, py, pz, pw);
+    V x = ClipRow(d, in.model_to_clip, 0, px, py, pz, pw), y = ClipRow(d, in.model_to_clip, 1, px, py, pz, pw);
+    const V z = ClipRow(d, in.model_to_clip, 2, px, py, pz, pw);
+    V w = ClipRow(d, in.model_to_clip, 3, px, py, pz, pw);
+    if (in.orthographic) OrthographicRepresentative(d, x, y, z, w);
     hn::StoreU(x, d, cache.x + at);  // whole vectors: the planes are padded by kVertexClipPadding
     hn::StoreU(y, d, cache.y + at);
     hn::StoreU(z, d, cache.z + at);
@@ -150,7 +162,7 @@ template <bool kPlain>
 HWY_INLINE void TransformBatchWith(const TriangleInput& in, TriangleBatch& batch) {
     const D d;
     const int lanes = int(hn::Lanes(d));
-    if (is_identity(in.model_to_clip)) {
+    if (is_identity(in.model_to_clip) && !in.orthographic) {
         // Positions already in clip space (S1, and engines that transform their own vertices,
         // as MOC's API allows): the product is the position itself, bit for bit, but for a
         // position with a coordinate that is not finite, where the product's zero terms make
@@ -175,10 +187,14 @@ HWY_INLINE void TransformBatchWith(const TriangleInput& in, TriangleBatch& batch
         for (int k = 0; k < 3; ++k) {
             const V px = hn::Load(d, batch.px[k] + g), py = hn::Load(d, batch.py[k] + g), pz = hn::Load(d, batch.pz[k] + g),
                     pw = hn::Load(d, batch.pw[k] + g);
-            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 0, px, py, pz, pw), d, batch.cx[k] + g);
-            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 1, px, py, pz, pw), d, batch.cy[k] + g);
-            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 2, px, py, pz, pw), d, batch.cz[k] + g);
-            hn::Store(ClipRow<kPlain>(d, in.model_to_clip, 3, px, py, pz, pw), d, batch.cw[k] + g);
+            V x = ClipRow<kPlain>(d, in.model_to_clip, 0, px, py, pz, pw), y = ClipRow<kPlain>(d, in.model_to_clip, 1, px, py, pz, pw);
+            const V z = ClipRow<kPlain>(d, in.model_to_clip, 2, px, py, pz, pw);
+            V w = ClipRow<kPlain>(d, in.model_to_clip, 3, px, py, pz, pw);
+            if (in.orthographic) OrthographicRepresentative(d, x, y, z, w);
+            hn::Store(x, d, batch.cx[k] + g);
+            hn::Store(y, d, batch.cy[k] + g);
+            hn::Store(z, d, batch.cz[k] + g);
+            hn::Store(w, d, batch.cw[k] + g);
         }
 }
 

@@ -33,8 +33,7 @@ bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 mode
         float p[4];
         read_position(in, index[k], p);
         model[k] = {p[0], p[1], p[2], p[3]};
-        clip[k] = plain ? transform_to_clip_plain(in.model_to_clip, p[0], p[1], p[2], p[3])
-                        : transform_to_clip(in.model_to_clip, p[0], p[1], p[2], p[3]);
+        clip[k] = plain ? input_to_clip_plain(in, p[0], p[1], p[2], p[3]) : input_to_clip(in, p[0], p[1], p[2], p[3]);
         valid = valid && finite_clip(clip[k]);
     }
     return valid;

@@ -6,6 +6,7 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include <cmath>
+#include <limits>
 #include <cstdint>
 #include <cstring>
 
@@ -59,6 +60,23 @@ inline glm::dvec4 transform_to_clip_plain(const std::array<float, 16>& m, double
     return r;
 }
 
+// The representative an orthographic buffer takes of a clip point (BufferConfig::orthographic):
+// (x, y, z, w) / h with h = (3w - z) / 2, the same point on the screen (x/w, y/w) with
+// 1/w' = h / w = (3 - z/w) / 2, the depth g that is affine on the screen as 1/w is for a
+// perspective view. For points with h > 0 the homogeneous segment between two representatives
+// is the image of the segment between the points, with 1/w' along it the depth g there, so
+// clipping at w' >= 0.5 (z/w >= -1, the near plane) and the rest of the setup hold unchanged.
+// Points with w <= 0 or g < 2^-8 (beyond twice the far distance) get NaN, which makes their
+// triangles invalid (skipped as occluders) and their occludees visible. One fixed order of
+// operations, as the SIMD kernels have it: the same bits on every instruction set.
+inline glm::dvec4 orthographic_representative(const glm::dvec4& c) {
+    const double h = (3.0 * c.w - c.z) * 0.5;
+    if (!(c.w > 0.0) || !(h >= 0x1.0p-8 * c.w)) return glm::dvec4(std::numeric_limits<double>::quiet_NaN());
+    return {c.x / h, c.y / h, c.z, c.w / h};
+}
+// The near plane of an orthographic buffer: w' = 1 / g >= 0.5 is z >= -1.
+constexpr float kOrthographicNearW = 0.5f;
+
 // Whether m is the identity (a -0 counts as 0): transform_to_clip then returns the position,
 // but for the sign of a zero and for a position with a coordinate that is not finite (all NaN).
 inline bool is_identity(const std::array<float, 16>& m) {
@@ -68,6 +86,17 @@ inline bool is_identity(const std::array<float, 16>& m) {
 }
 
 inline bool finite_clip(const glm::dvec4& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.w); }
+
+// A position of the input in clip space as the buffer takes it: transform_to_clip (or _plain),
+// then the orthographic representative for an orthographic input.
+inline glm::dvec4 input_to_clip(const TriangleInput& in, double x, double y, double z, double w) {
+    const glm::dvec4 c = transform_to_clip(in.model_to_clip, x, y, z, w);
+    return in.orthographic ? orthographic_representative(c) : c;
+}
+inline glm::dvec4 input_to_clip_plain(const TriangleInput& in, double x, double y, double z, double w) {
+    const glm::dvec4 c = transform_to_clip_plain(in.model_to_clip, x, y, z, w);
+    return in.orthographic ? orthographic_representative(c) : c;
+}
 
 // Throws homcull::Error, naming `caller`, for input no triangle can be read from: 3 or 4
 // components, positions and a stride of at least one position, and without indices, enough

@@ -52,6 +52,18 @@ struct BufferConfig {
     // Triangles are clipped at clip w >= near_w (the camera's near distance for a standard
     // perspective projection). Occludees reaching w < near_w are visible. At least 2^-126.
     float near_w = 0.1f;
+    // An orthographic projection (clip w = 1 everywhere), whose depth comes from clip z instead
+    // of 1/w, in OpenGL's range: z = -1 at the near plane, 1 at the far plane. Depth is then
+    // kept as g = (3 - z) / 2 (2 at the near plane, 1 at the far one, 0 at twice the far
+    // distance), and every clip point is taken as (x, y, z, w) / h with h = (3w - z) / 2 (the
+    // same point on the screen, with 1/w' = g: docs/occlusion-buffer.md, "Orthographic
+    // projections"), so that the rest of the buffer works as for a perspective one. near_w is
+    // then 0.5 (the near plane, z = -1) whatever it was set to. What lies beyond twice the far
+    // distance (g < 2^-8) is not drawn and not answered: occluder triangles reaching it are
+    // skipped (counted as invalid), occludees reaching it are visible. Inputs must say they are
+    // orthographic (TriangleInput, ClusteredInput::orthographic); test_triangles answers
+    // visible, and occlusion maps refuse such a buffer.
+    bool orthographic = false;
     // Inner margin of coverage, in samples: see "Conservative" above.
     double edge_margin = 1.0 / 1024.0;
     // Also keep a conservative depth per sample: at each covered sample, the nearest of the
@@ -157,6 +169,9 @@ struct TriangleInput {
     // read only where the edge's bit is set. A number not below vertex_count drops the flag.
     const std::uint32_t* edge_apexes = nullptr;
     DrawOrder order = DrawOrder::nearest_first;
+    // model_to_clip is an orthographic projection (BufferConfig::orthographic): it must match
+    // the buffer's (render and test_triangles throw homcull::Error otherwise).
+    bool orthographic = false;
 };
 
 // Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
@@ -190,6 +205,7 @@ struct ClusteredInput {
     // flags computed within each object only); the apexes number OccluderClusters::positions.
     const std::uint8_t* shared_edges = nullptr;
     const std::uint32_t* edge_apexes = nullptr;
+    bool orthographic = false;  // as TriangleInput::orthographic
 };
 
 // The caller's job system, for render(): run(user, count, task, task_data) must call
