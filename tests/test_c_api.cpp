@@ -101,7 +101,10 @@ void store(const glm::dmat4& m, homcull_matrix_layout layout, double out[16]) {
 }
 
 // The scene's camera as engines of different conventions would give it.
-enum class Engine { opengl, d3d_reversed_lh, d3d_reversed_infinite_lh, vulkan_y_down };
+enum class Engine { opengl, d3d_reversed_lh, d3d_reversed_infinite_lh, vulkan_y_down, opengl_ortho, d3d_reversed_ortho_lh, vulkan_ortho_y_down };
+// The orthographic engines' window: 80 x 45 world units, so that the scene's boxes land where
+// the perspective views put them (in view, beside it, behind the wall) and the answers match.
+constexpr double kOrthoHalfWidth = 40.0, kOrthoHalfHeight = 22.5;
 homcull_view engine_view(Engine e) {
     homcull_view v{};
     v.front_face = HOMCULL_FRONT_CCW;
@@ -139,6 +142,26 @@ homcull_view engine_view(Engine e) {
             glm::dmat4 flip(1.0);
             flip[1][1] = -1.0;
             m = flip * glm::perspectiveRH_ZO(kFovY, kAspect, kNear, kFar) * rh_view;
+            v.layout = HOMCULL_COLUMN_MAJOR, v.depth_range = HOMCULL_DEPTH_ZERO_TO_ONE, v.flags = HOMCULL_VIEW_Y_DOWN;
+            break;
+        }
+        case Engine::opengl_ortho:
+            m = glm::orthoRH_NO(-kOrthoHalfWidth, kOrthoHalfWidth, -kOrthoHalfHeight, kOrthoHalfHeight, kNear, kFar) * rh_view;
+            v.layout = HOMCULL_COLUMN_MAJOR, v.depth_range = HOMCULL_DEPTH_MINUS_ONE_TO_ONE;
+            break;
+        case Engine::d3d_reversed_ortho_lh: {
+            glm::dmat4 r(1.0);  // z' = w - z: near at 1, far at 0
+            r[2] = glm::dvec4(0, 0, -1, 0);
+            r[3] = glm::dvec4(0, 0, 1, 1);
+            m = r * glm::orthoLH_ZO(-kOrthoHalfWidth, kOrthoHalfWidth, -kOrthoHalfHeight, kOrthoHalfHeight, kNear, kFar) * lh_view;
+            m = 2.0 * m;  // a w of 2 everywhere: still orthographic
+            v.layout = HOMCULL_ROW_MAJOR, v.depth_range = HOMCULL_DEPTH_ZERO_TO_ONE, v.flags = HOMCULL_VIEW_REVERSED_Z;
+            break;
+        }
+        case Engine::vulkan_ortho_y_down: {
+            glm::dmat4 flip(1.0);
+            flip[1][1] = -1.0;
+            m = flip * glm::orthoRH_ZO(-kOrthoHalfWidth, kOrthoHalfWidth, -kOrthoHalfHeight, kOrthoHalfHeight, kNear, kFar) * rh_view;
             v.layout = HOMCULL_COLUMN_MAJOR, v.depth_range = HOMCULL_DEPTH_ZERO_TO_ONE, v.flags = HOMCULL_VIEW_Y_DOWN;
             break;
         }
@@ -219,9 +242,12 @@ TEST(CApi, ErrorsAreResultsWithMessages) {
     homcull_mesh* mesh = nullptr;
     EXPECT_EQ(homcull_mesh_create(context, &md, &mesh), HOMCULL_ERROR_INVALID_ARGUMENT);
     EXPECT_NE(std::string(homcull_last_error()).find("index 9 of triangle 1"), std::string::npos) << homcull_last_error();
-    homcull_view ortho = engine_view(Engine::opengl);
-    store(glm::orthoRH_NO(-10.0, 10.0, -10.0, 10.0, 0.1, 100.0), HOMCULL_COLUMN_MAJOR, ortho.world_to_clip);
-    EXPECT_EQ(homcull_buffer_begin_frame(buffer, &ortho), HOMCULL_ERROR_UNSUPPORTED);
+    homcull_view ortho = engine_view(Engine::opengl_ortho);
+    ortho.flags = HOMCULL_VIEW_INFINITE_FAR;  // an orthographic projection has a far plane
+    EXPECT_EQ(homcull_buffer_begin_frame(buffer, &ortho), HOMCULL_ERROR_INVALID_ARGUMENT);
+    ortho = engine_view(Engine::opengl_ortho);
+    ortho.world_to_clip[15] = -1.0;  // w must be positive
+    EXPECT_EQ(homcull_buffer_begin_frame(buffer, &ortho), HOMCULL_ERROR_INVALID_ARGUMENT);
     homcull_view nan_view = engine_view(Engine::opengl);
     nan_view.world_to_clip[5] = std::nan("");
     EXPECT_EQ(homcull_buffer_begin_frame(buffer, &nan_view), HOMCULL_ERROR_INVALID_ARGUMENT);
@@ -240,7 +266,8 @@ TEST(CApi, ErrorsAreResultsWithMessages) {
 // The same camera in four engines' conventions gives the answers known by construction.
 TEST(CApi, EngineConventionsGiveTheSameAnswers) {
     const Scene scene;
-    for (Engine e : {Engine::opengl, Engine::d3d_reversed_lh, Engine::d3d_reversed_infinite_lh, Engine::vulkan_y_down}) {
+    for (Engine e : {Engine::opengl, Engine::d3d_reversed_lh, Engine::d3d_reversed_infinite_lh, Engine::vulkan_y_down, Engine::opengl_ortho,
+                     Engine::d3d_reversed_ortho_lh, Engine::vulkan_ortho_y_down}) {
         Culler culler(scene, make_context());
         const std::vector<homcull_visibility> answers = culler.frame(scene, engine_view(e));
         for (std::size_t k = 0; k < answers.size(); ++k) {
@@ -251,10 +278,48 @@ TEST(CApi, EngineConventionsGiveTheSameAnswers) {
     }
 }
 
+// Orthographic frames, one after another with perspective ones on the same buffer (each
+// switch reconfigures it, allocating nothing after a reserve): the boxes' answers, rectangles
+// given their nearest clip z, and the occludee-triangle test refused (answered visible).
+TEST(CApi, OrthographicFramesBetweenPerspectiveOnes) {
+    const Scene scene;
+    EngineMemory memory;
+    {
+        Culler culler(scene, make_context(&memory));
+        const homcull_reserve_desc reserve{320, 180, 8, 0, 0, 0};
+        ASSERT_EQ(homcull_buffer_reserve(culler.buffer, &reserve), HOMCULL_OK);
+        const std::size_t before = memory.calls;
+        for (Engine e : {Engine::opengl_ortho, Engine::opengl, Engine::vulkan_ortho_y_down, Engine::d3d_reversed_lh, Engine::d3d_reversed_ortho_lh}) {
+            EXPECT_EQ(culler.frame(scene, engine_view(e)), scene.expected) << "engine " << int(e);
+            const bool ortho = e == Engine::opengl_ortho || e == Engine::vulkan_ortho_y_down || e == Engine::d3d_reversed_ortho_lh;
+            if (!ortho) continue;
+            // The wall's middle, given the clip z of points behind and before it (z = -10 and
+            // the near plane at 0.1, far at 100, in the view's depth range).
+            const auto clip_z = [&](double distance) {
+                const double t = (distance - kNear) / (kFar - kNear);  // 0 at near, 1 at far
+                return float(e == Engine::opengl_ortho ? 2.0 * t - 1.0 : e == Engine::d3d_reversed_ortho_lh ? 1.0 - t : t);
+            };
+            const homcull_rect rects[3] = {{-0.1f, -0.1f, 0.1f, 0.1f, clip_z(12.0)}, {-0.1f, -0.1f, 0.1f, 0.1f, clip_z(8.0)},
+                                           {-0.1f, -0.1f, 0.1f, 0.1f, clip_z(250.0)}};
+            homcull_visibility answers[3];
+            ASSERT_EQ(homcull_buffer_test_rects(culler.buffer, rects, 3, answers), HOMCULL_OK);
+            EXPECT_EQ(answers[0], HOMCULL_OCCLUDED) << "engine " << int(e);
+            EXPECT_EQ(answers[1], HOMCULL_VISIBLE) << "engine " << int(e);
+            EXPECT_EQ(answers[2], HOMCULL_VISIBLE) << "engine " << int(e);  // beyond twice the far distance: not answered
+            const homcull_triangles triangles{scene.positions.data(), 12, scene.positions.size() / 3, scene.indices.data(), 2, 0, 8};
+            homcull_visibility v = 99;
+            EXPECT_EQ(homcull_buffer_test_triangles(culler.buffer, &triangles, nullptr, &v), HOMCULL_ERROR_UNSUPPORTED);
+            EXPECT_EQ(v, HOMCULL_VISIBLE);
+        }
+        EXPECT_EQ(memory.calls, before);
+    }
+    EXPECT_EQ(memory.live, 0u);
+}
+
 // Back faces are named by the engine's winding: the wall faces the camera counter-clockwise.
 TEST(CApi, FrontFaceWindingDecidesWhatIsCulled) {
     const Scene scene;
-    for (Engine e : {Engine::opengl, Engine::d3d_reversed_lh, Engine::vulkan_y_down})
+    for (Engine e : {Engine::opengl, Engine::d3d_reversed_lh, Engine::vulkan_y_down, Engine::d3d_reversed_ortho_lh, Engine::vulkan_ortho_y_down})
         for (homcull_winding front : {HOMCULL_FRONT_CCW, HOMCULL_FRONT_CW})
             for (homcull_cull cull : {HOMCULL_CULL_BACK, HOMCULL_CULL_FRONT, HOMCULL_CULL_NONE}) {
                 Culler culler(scene, make_context());

@@ -111,7 +111,18 @@ homcull_result triangle_input(const homcull_buffer& b, const homcull_triangles* 
     in.triangle_count = t->triangle_count;
     in.model_to_clip = capi::float_clip_from_model(b.clip_from_world, read_model(b, model));
     in.backface = b.backface;
+    in.orthographic = b.orthographic;
     return HOMCULL_OK;
+}
+
+// An orthographic view's nearest clip z (in its depth range) as the w' the buffer compares
+// (BufferConfig::orthographic): 2 / (3 - z_gl), rounded towards the eye. Beyond twice the far
+// distance, or not a number: 0, before the near plane, which the rectangle test answers visible.
+float orthographic_nearest_w(const homcull_buffer& b, float z) {
+    const double z_gl = b.ortho_z_scale * double(z) + b.ortho_z_offset, h = (3.0 - z_gl) * 0.5;
+    if (!(h >= 0x1.0p-8)) return 0.0f;
+    const float w = float(1.0 / h);
+    return double(w) > 1.0 / h ? std::nextafter(w, 0.0f) : w;
 }
 
 homcull_visibility as_c(Visibility v) {
@@ -124,7 +135,8 @@ void all_visible(homcull_visibility* visibility, std::size_t count) {
 
 }  // namespace
 
-homcull_buffer::homcull_buffer(homcull_context* context, const BufferConfig& config) : account(context), buffer(make_buffer(account, config)) {}
+homcull_buffer::homcull_buffer(homcull_context* context, const BufferConfig& config)
+    : account(context), buffer(make_buffer(account, config)), near_distance(config.near_w) {}
 
 extern "C" {
 
@@ -175,7 +187,8 @@ homcull_result homcull_buffer_set_near(homcull_buffer* b, float near_distance) {
     const homcull_result valid = check_config(b->account.context, fn, config);
     if (valid != HOMCULL_OK) return valid;
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
-        b->buffer.set_near_w(near_distance);
+        b->buffer.set_near_w(near_distance);  // an orthographic buffer keeps its own
+        b->near_distance = near_distance;
         b->frame_begun = false;
         return HOMCULL_OK;
     });
@@ -292,7 +305,23 @@ homcull_result homcull_buffer_begin_frame(homcull_buffer* b, const homcull_view*
         b->frame_begun = false;  // answers nothing until a frame begins
         return r;
     }
+    if (conventions.orthographic != b->buffer.config().orthographic) {
+        // The same sizes in the other projection: configure allocates nothing (arrays only grow).
+        BufferConfig config = b->buffer.config();
+        config.orthographic = conventions.orthographic;
+        config.near_w = b->near_distance;
+        const homcull_result switched = capi::guarded(b->account, fn, [&]() -> homcull_result {
+            b->buffer.configure(config);
+            return HOMCULL_OK;
+        });
+        if (switched != HOMCULL_OK) {
+            b->frame_begun = false;
+            return switched;
+        }
+    }
     b->buffer.clear();  // allocates nothing
+    b->orthographic = conventions.orthographic;
+    b->ortho_z_scale = conventions.ortho_z_scale, b->ortho_z_offset = conventions.ortho_z_offset;
     b->view = *view;
     b->clip_from_world = conventions.clip_from_world;
     b->backface = conventions.backface;
@@ -320,6 +349,7 @@ homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* m
         ClusteredInput in;
         in.clusters = &mesh->clusters;
         in.backface = b->backface;
+        in.orthographic = b->orthographic;
         for (std::size_t i = 0; i < instance_count; ++i) {
             in.model_to_clip = capi::float_clip_from_model(b->clip_from_world, read_model(*b, model_matrices ? model_matrices + 16 * i : nullptr));
             if (mesh->bounded && outside_view(mesh->bounds_min, mesh->bounds_max, in.model_to_clip, b->buffer.config().near_w, in.orthographic)) continue;
@@ -395,8 +425,9 @@ homcull_result homcull_buffer_test_rects(const homcull_buffer* b, const homcull_
             const std::size_t n = std::min(kBlock, count - base);
             for (std::size_t k = 0; k < n; ++k) {
                 const homcull_rect& r = rects[base + k];
-                block[k] = y_down ? ScreenRect{r.min_x, -r.max_y, r.max_x, -r.min_y, r.nearest_w}
-                                  : ScreenRect{r.min_x, r.min_y, r.max_x, r.max_y, r.nearest_w};
+                const float nearest = b->orthographic ? orthographic_nearest_w(*b, r.nearest_w) : r.nearest_w;
+                block[k] = y_down ? ScreenRect{r.min_x, -r.max_y, r.max_x, -r.min_y, nearest}
+                                  : ScreenRect{r.min_x, r.min_y, r.max_x, r.max_y, nearest};
             }
             b->buffer.test_rects(block, n, answers);
             for (std::size_t k = 0; k < n; ++k) visibility[base + k] = as_c(answers[k]);
@@ -413,6 +444,8 @@ homcull_result homcull_buffer_test_triangles(const homcull_buffer* b, const homc
     if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
     TriangleInput in;
     if (homcull_result r = triangle_input(*b, triangles, model_matrix, fn, in); r != HOMCULL_OK) return r;
+    if (b->orthographic)
+        return capi::report(b->account.context, HOMCULL_ERROR_UNSUPPORTED, "%s: not supported in orthographic frames yet (answered visible)", fn);
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
         *visibility = as_c(b->buffer.test_triangles(in).visibility);
         return HOMCULL_OK;

@@ -43,11 +43,26 @@ homcull_result read_view(const homcull_context* context, const homcull_view& vie
         return report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: unknown flags 0x%x", fn, unsigned(view.flags));
 
     glm::dmat4 m = read_matrix(view.world_to_clip, view.layout);
-    // Clip w must be the view depth: a projection whose w row ignores the position (w the same
-    // everywhere) is orthographic, which the buffer's 1/w depth cannot order.
-    if (m[0][3] == 0.0 && m[1][3] == 0.0 && m[2][3] == 0.0)
-        return report(context, HOMCULL_ERROR_UNSUPPORTED,
-                      "%s: orthographic projections (clip w the same everywhere) are not supported yet; the buffer orders depth by 1/w", fn);
+    // A projection whose w row ignores the position (w the same everywhere) is orthographic.
+    // The buffer then takes w = 1 and OpenGL's z (BufferConfig::orthographic): the matrix is
+    // divided by w, and its z row mapped from the view's depth range.
+    out.orthographic = m[0][3] == 0.0 && m[1][3] == 0.0 && m[2][3] == 0.0;
+    if (out.orthographic) {
+        const double w = m[3][3];
+        if (!(w > 0.0))
+            return report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: an orthographic projection needs a positive clip w, got %g", fn, w);
+        if (view.flags & HOMCULL_VIEW_INFINITE_FAR)
+            return report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: an orthographic projection has a far plane (no HOMCULL_VIEW_INFINITE_FAR)", fn);
+        // z_gl = scale * z + offset: near -> -1, far -> 1.
+        const bool zero_to_one = view.depth_range == HOMCULL_DEPTH_ZERO_TO_ONE, reversed = (view.flags & HOMCULL_VIEW_REVERSED_Z) != 0;
+        double scale = zero_to_one ? 2.0 : 1.0, offset = zero_to_one ? -1.0 : 0.0;
+        if (reversed) scale = -scale, offset = -offset;
+        out.ortho_z_scale = scale, out.ortho_z_offset = offset;
+        for (int c = 0; c < 4; ++c) {
+            for (int r = 0; r < 4; ++r) m[c][r] /= w;
+            m[c][2] = scale * m[c][2] + offset * m[c][3];
+        }
+    }
     if (view.flags & HOMCULL_VIEW_Y_DOWN)
         for (int c = 0; c < 4; ++c) m[c][1] = -m[c][1];  // the library's clip y points up
     out.clip_from_world = m;
@@ -63,7 +78,8 @@ homcull_result read_view(const homcull_context* context, const homcull_view& vie
     // with it. far_row is taken against (x, y, z, w) of the engine's clip space, whose z the
     // y flip leaves alone.
     out.far_plane = !(view.flags & HOMCULL_VIEW_INFINITE_FAR);
-    if (!(view.flags & HOMCULL_VIEW_REVERSED_Z)) out.far_row = {0.0, 0.0, -1.0, 1.0};
+    if (out.orthographic) out.far_row = {0.0, 0.0, -1.0, 1.0};  // z <= w in the OpenGL z it was mapped to
+    else if (!(view.flags & HOMCULL_VIEW_REVERSED_Z)) out.far_row = {0.0, 0.0, -1.0, 1.0};
     else if (view.depth_range == HOMCULL_DEPTH_ZERO_TO_ONE) out.far_row = {0.0, 0.0, 1.0, 0.0};
     else out.far_row = {0.0, 0.0, 1.0, 1.0};
     return HOMCULL_OK;

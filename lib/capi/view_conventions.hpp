@@ -20,11 +20,16 @@ struct ViewConventions {
     bool far_plane = false;
     // In front of the far plane, or on it: dot(far_row, clip_from_world * p) >= 0.
     glm::dvec4 far_row{0.0};
+    // Orthographic: clip_from_world has w = 1 and OpenGL's z (-1 at the near plane, 1 at the
+    // far one), as BufferConfig::orthographic takes it; the engine's clip z is then
+    // (z - ortho_z_offset) / ortho_z_scale of it.
+    bool orthographic = false;
+    double ortho_z_scale = 1.0, ortho_z_offset = 0.0;
 };
 
 // Reads a view, or returns an error result naming what is wrong (through capi::report): a
-// non-finite matrix, an unknown enum value, an orthographic projection (clip w the same
-// everywhere: not supported yet).
+// non-finite matrix, an unknown enum value, an orthographic projection whose w is not positive
+// or that claims an infinite far plane.
 homcull_result read_view(const homcull_context* context, const homcull_view& view, ViewConventions& out);
 
 // 16 numbers in a homcull_matrix_layout as a glm matrix (glm is column-major).

@@ -179,10 +179,13 @@ enum {
     HOMCULL_VIEW_Y_DOWN = 4u       /* clip y points down the screen (Vulkan without a flipped viewport) */
 };
 
-/* A frame's camera. The projection must be a perspective one whose clip w is the view depth
- * (every standard perspective matrix, left- or right-handed, reversed or infinite); clip w at
- * least the buffer's near distance is in front of the near plane. Orthographic projections are
- * not supported yet: HOMCULL_ERROR_UNSUPPORTED.
+/* A frame's camera: a perspective projection whose clip w is the view depth (every standard
+ * perspective matrix, left- or right-handed, reversed or infinite; clip w at least the buffer's
+ * near distance is in front of the near plane), or an orthographic one (its w row (0, 0, 0, c),
+ * c > 0; its near and far planes are those of its depth range, and it has a far plane: no
+ * HOMCULL_VIEW_INFINITE_FAR). An orthographic frame culls what lies beyond its far plane, and
+ * leaves what lies beyond twice the far distance visible; its occludee-triangle test is
+ * HOMCULL_ERROR_UNSUPPORTED (answered visible).
  * The winding is the one the engine's own rasterizer calls front, as it sees the screen. */
 typedef struct homcull_view {
     double world_to_clip[16];       /* projection * view, in `layout` */
@@ -309,7 +312,8 @@ typedef struct homcull_box {
 } homcull_box;
 
 /* A screen rectangle in normalized device coordinates (in the view's y direction) and the
- * nearest view depth (clip w) of what it stands for. */
+ * nearest view depth (clip w) of what it stands for; for an orthographic view, the nearest clip
+ * z instead, in the view's depth range. */
 typedef struct homcull_rect {
     float min_x, min_y, max_x, max_y;
     float nearest_w;
