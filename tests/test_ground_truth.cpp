@@ -42,6 +42,30 @@ TEST(GroundTruth, BoxFullyHidesAnotherBox) {
     EXPECT_GT(cast(moved, camera_down_minus_z(60.0), {64, 48}).objects[back].visible_samples, 0u);
 }
 
+// An orthographic camera's rays are parallel: a box behind a smaller one shows round its edges
+// however far it is (a perspective view shrinks it behind), one behind a larger one never does,
+// and one beside the view's rectangle is outside its frustum (a box, not a pyramid).
+TEST(GroundTruth, OrthographicRaysAreParallel) {
+    Scene scene;
+    const auto front = add_box(scene, "front", {-1, -1, -6}, {1, 1, -4});
+    const auto larger = add_box(scene, "larger behind", {-1.25f, -1.25f, -40}, {1.25f, 1.25f, -38});
+    const auto smaller = add_box(scene, "smaller behind", {-0.9f, 3.1f, -40}, {0.9f, 4.9f, -38});
+    add_box(scene, "cover", {-1, 3, -6}, {1, 5, -4});
+    const auto beside = add_box(scene, "beside", {15, -1, -51}, {15.5f, 1, -50});  // |x/z| about 0.3: in the perspective view
+    Camera camera = camera_down_minus_z(60.0);
+    const TruthResult perspective = cast(scene, camera, {64, 48});
+    EXPECT_EQ(perspective.objects[larger].visible_samples, 0u);  // 1.25 / 39 is well inside 1 / 5
+    camera.ortho_height = 12.0;                                  // 16 x 12 world units
+    const TruthResult ortho = cast(scene, camera, {64, 48});
+    EXPECT_GT(ortho.objects[front].visible_samples, 0u);
+    EXPECT_GT(ortho.objects[larger].visible_samples, 0u);
+    EXPECT_EQ(ortho.objects[smaller].visible_samples, 0u);
+    EXPECT_TRUE(ortho.objects[smaller].in_frustum);
+    EXPECT_FALSE(ortho.objects[beside].in_frustum);  // x in [15, 15.5], the orthographic view's in [-8, 8]
+    EXPECT_EQ(ortho.objects[beside].visible_samples, 0u);
+    EXPECT_GT(perspective.objects[beside].visible_samples, 0u);
+}
+
 // Two occluders at view depth 1 leave a gap exactly one pixel wide: with fov 90 and a square
 // 64x64 display, x_ndc equals x_world at depth 1 and a pixel is 1/32 wide. The gap
 // [0, 1/32] holds the centres of column 32 only, so the wall behind is seen by exactly

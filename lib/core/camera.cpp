@@ -30,6 +30,8 @@ void validate_camera(const Camera& c) {
                     std::to_string(c.fov_y_degrees));
     if (!(c.near_plane > 0.0) || !std::isfinite(c.near_plane))
         throw Error("camera: near must be a positive number, got " + std::to_string(c.near_plane));
+    if (!(c.ortho_height >= 0.0) || !std::isfinite(c.ortho_height))
+        throw Error("camera: ortho_height must be 0 (perspective) or a positive height, got " + std::to_string(c.ortho_height));
     if (!(c.far_plane > c.near_plane) || !std::isfinite(c.far_plane))
         throw Error("camera: far must be finite and greater than near (" +
                     std::to_string(c.near_plane) + "), got " + std::to_string(c.far_plane));
@@ -64,6 +66,15 @@ glm::dmat4 view_matrix(const Camera& c) {
 }
 
 glm::dmat4 projection_matrix(const Camera& c, double aspect) {
+    if (c.ortho_height > 0.0) {
+        const double n = c.near_plane, f = c.far_plane;
+        glm::dmat4 m(1.0);
+        m[0][0] = 2.0 / (c.ortho_height * aspect);
+        m[1][1] = 2.0 / c.ortho_height;
+        m[2][2] = -2.0 / (f - n);
+        m[3][2] = -(f + n) / (f - n);
+        return m;
+    }
     const double focal = 1.0 / std::tan(glm::radians(c.fov_y_degrees) * 0.5);
     const double n = c.near_plane, f = c.far_plane;
     glm::dmat4 m(0.0);
@@ -81,8 +92,15 @@ glm::dvec2 pixel_to_ndc(Resolution r, double pixel_x, double pixel_y) {
 }
 
 glm::dvec3 ray_direction(const Camera& c, const CameraBasis& b, double aspect, glm::dvec2 ndc) {
+    if (c.ortho_height > 0.0) return b.forward;
     const double tan_half = std::tan(glm::radians(c.fov_y_degrees) * 0.5);
     return b.forward + (ndc.x * tan_half * aspect) * b.right + (ndc.y * tan_half) * b.up;
+}
+
+glm::dvec3 ray_origin(const Camera& c, const CameraBasis& b, double aspect, glm::dvec2 ndc) {
+    if (!(c.ortho_height > 0.0)) return c.eye;
+    const double half = 0.5 * c.ortho_height;
+    return c.eye + (ndc.x * half * aspect) * b.right + (ndc.y * half) * b.up;
 }
 
 std::string format_vec3(const glm::dvec3& v) {

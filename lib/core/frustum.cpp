@@ -12,8 +12,10 @@ Frustum make_frustum(const Camera& c, double aspect) {
     const double depths[2] = {c.near_plane, c.far_plane};
     for (int k = 0; k < 2; ++k) {
         const glm::dvec3 centre = c.eye + depths[k] * b.forward;
-        const glm::dvec3 half_up = depths[k] * tan_half * b.up;
-        const glm::dvec3 half_right = depths[k] * tan_half * aspect * b.right;
+        // An orthographic camera's frustum is a box: the same rectangle at every depth.
+        const double half_height = c.ortho_height > 0.0 ? 0.5 * c.ortho_height : depths[k] * tan_half;
+        const glm::dvec3 half_up = half_height * b.up;
+        const glm::dvec3 half_right = half_height * aspect * b.right;
         fr.corners[4 * k + 0] = centre - half_right - half_up;
         fr.corners[4 * k + 1] = centre + half_right - half_up;
         fr.corners[4 * k + 2] = centre + half_right + half_up;

@@ -61,15 +61,15 @@ AnswerOverlay render_answer_overlay(const RayScene& rays, const Camera& camera, 
     const int w = resolution.width, h = resolution.height;
     const double aspect = resolution.aspect();
     const CameraBasis basis = camera_basis(camera);
-    const glm::dvec3 eye = camera.eye;
     std::vector<std::uint32_t> ids(std::size_t(w) * std::size_t(h), kNoObject);
     std::vector<float> shade(ids.size(), 0.0f);
     // The same rays as ground truth: pixel centres, t from the near to the far plane.
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
         for (int y = rows.begin(); y < rows.end(); ++y)
             for (int x = 0; x < w; ++x) {
-                const glm::vec3 d(ray_direction(camera, basis, aspect, pixel_to_ndc(resolution, x + 0.5, y + 0.5)));
-                const RayHit hit = rays.intersect(eye, d, float(camera.near_plane), float(camera.far_plane));
+                const glm::dvec2 ndc = pixel_to_ndc(resolution, x + 0.5, y + 0.5);
+                const glm::vec3 d(ray_direction(camera, basis, aspect, ndc));
+                const RayHit hit = rays.intersect(ray_origin(camera, basis, aspect, ndc), d, float(camera.near_plane), float(camera.far_plane));
                 const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
                 ids[i] = hit.object;
                 const float n = glm::length(hit.normal) * glm::length(d);

@@ -76,6 +76,7 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
     // The eye relative to the Embree vertices' anchor, in double, then rounded.
     const glm::vec3 eye(camera.eye - rays.anchor());
     const float origin[3] = {eye.x, eye.y, eye.z};
+    const bool orthographic = camera.ortho_height > 0.0;
     const float tie_lo = float(1.0 - options.tie_relative_depth), tie_hi = float(1.0 + options.tie_relative_depth);
 
     // Per sample: the object seen, and whether another object lies within the tie window.
@@ -103,9 +104,14 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
                     valid[k] = x < tile.cols().end() ? -1 : 0;
                     const glm::dvec2 ndc = pixel_to_ndc(display, (x + 0.5) / S, pixel_y);
                     const glm::vec3 d(ray_direction(camera, basis, aspect, ndc));
-                    rh.ray.org_x[k] = origin[0];
-                    rh.ray.org_y[k] = origin[1];
-                    rh.ray.org_z[k] = origin[2];
+                    if (orthographic) {  // parallel rays from the eye's plane, relative to the anchor in double
+                        const glm::vec3 o(ray_origin(camera, basis, aspect, ndc) - rays.anchor());
+                        rh.ray.org_x[k] = o.x, rh.ray.org_y[k] = o.y, rh.ray.org_z[k] = o.z;
+                    } else {
+                        rh.ray.org_x[k] = origin[0];
+                        rh.ray.org_y[k] = origin[1];
+                        rh.ray.org_z[k] = origin[2];
+                    }
                     rh.ray.dir_x[k] = d.x;
                     rh.ray.dir_y[k] = d.y;
                     rh.ray.dir_z[k] = d.z;

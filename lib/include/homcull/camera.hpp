@@ -27,6 +27,9 @@ struct Camera {
     double fov_y_degrees = 60.0;
     double near_plane = 0.1;
     double far_plane = 10000.0;
+    // Above 0: an orthographic camera whose view is this many world units high (and the aspect
+    // times that wide), its rays parallel to the view direction; fov_y_degrees is then unused.
+    double ortho_height = 0.0;
 };
 
 struct CameraBasis {
@@ -46,7 +49,8 @@ CameraBasis camera_basis(const Camera& camera);
 
 // World to view space (the camera looks down -z, as glm::lookAt).
 glm::dmat4 view_matrix(const Camera& camera);
-// View to clip space, OpenGL convention (NDC z in [-1, 1]); clip w equals the view depth.
+// View to clip space, OpenGL convention (NDC z in [-1, 1]); clip w equals the view depth (an
+// orthographic camera: w = 1, glm::ortho's matrix).
 glm::dmat4 projection_matrix(const Camera& camera, double aspect);
 
 // NDC of a continuous pixel position: (i + 0.5, j + 0.5) is the centre of pixel (i, j).
@@ -57,6 +61,9 @@ glm::dvec2 pixel_to_ndc(Resolution resolution, double pixel_x, double pixel_y);
 // depth range [near, far] is the ray interval [near, far].
 glm::dvec3 ray_direction(const Camera& camera, const CameraBasis& basis, double aspect,
                          glm::dvec2 ndc);
+// Where that ray starts: the eye, or for an orthographic camera the point of the eye's plane
+// in front of the NDC point (its direction is then the view direction).
+glm::dvec3 ray_origin(const Camera& camera, const CameraBasis& basis, double aspect, glm::dvec2 ndc);
 
 // "x,y,z" with enough digits to read back the same double.
 std::string format_vec3(const glm::dvec3& v);

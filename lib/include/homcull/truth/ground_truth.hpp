@@ -1,6 +1,7 @@
 #pragma once
 // Exact per-object visibility by ray casting (DESIGN.md, "The occlusion representation").
-// Rays go from the eye through S x S sample positions per pixel, a regular grid at
+// Rays go from the eye (an orthographic camera: from the eye's plane, parallel to the view
+// direction: Camera::ortho_height) through S x S sample positions per pixel, a regular grid at
 // ((i + (a + 0.5)/S), (j + (b + 0.5)/S)) for a, b in [0, S): S = 1 is the pixel centre.
 // A sample sees the closest surface with view depth in [near, far]; back faces count.
 #include <homcull/camera.hpp>
