@@ -123,14 +123,23 @@ HostWalk castle_walk(const Scene& castle, const std::vector<std::uint32_t>& occl
     return w;
 }
 
-// The cameras relative to the anchor back in the scene's world, for ground truth.
-Camera world_camera(Camera c, const Scene& scene) {
+// The orthographic walk's cameras are as high as the perspective ones at this distance (world
+// units: about a courtyard of the castle).
+constexpr double kOrthographicDistance = 60.0;
+
+// The cameras relative to the anchor back in the scene's world, for ground truth; orthographic:
+// as engine_host --orthographic D makes its cameras.
+Camera world_camera(Camera c, const Scene& scene, bool orthographic = false) {
     const glm::dvec3 anchor = scene_anchor(scene);
+    if (orthographic) c.ortho_height = 2.0 * std::tan(glm::radians(c.fov_y_degrees) * 0.5) * kOrthographicDistance;
     c.eye += anchor, c.target += anchor;
     return c;
 }
 
-TEST(EngineHost, CastleWalkFromAC99Host) {
+// The host's castle walk, perspective or orthographic: zero false culls against Embree at every
+// frame's resolution, most hidden objects culled, and the same answers as the C++ interface
+// given the host's cameras and draw order.
+void check_castle_walk_from_c99_host(bool orthographic) {
     const std::string file = test::shared_scene("intel_castle.glb");
     if (file.empty()) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
     const Scene castle = load_scene(file);
@@ -139,9 +148,11 @@ TEST(EngineHost, CastleWalkFromAC99Host) {
     options.frames = 24;
     options.seed = 7;
     const HostWalk walk = castle_walk(castle, occluder_candidates(castle, OccluderFilter::role), walk_path(rays, castle, options));
-    const std::string dir = test::temp_dir("EngineHost.CastleWalk");
+    const std::string dir = test::temp_dir(orthographic ? "EngineHost.OrthographicCastleWalk" : "EngineHost.CastleWalk");
     write_walk(dir + "/castle.walk", castle, walk);
-    const std::string command = std::string(HOMCULL_ENGINE_HOST) + " " + dir + "/castle.walk " + dir + "/answers";
+    const std::string command =
+        std::string(HOMCULL_ENGINE_HOST) + (orthographic ? " --orthographic " + std::to_string(kOrthographicDistance) + " " : " ") + dir +
+        "/castle.walk " + dir + "/answers";
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
     std::uint32_t runs, frames, boxes;
     const std::vector<std::uint8_t> answers = read_answers(dir + "/answers", runs, frames, boxes);
@@ -154,7 +165,7 @@ TEST(EngineHost, CastleWalkFromAC99Host) {
     for (std::uint32_t f = 0; f < frames; ++f) {
         TruthOptions truth_options;
         truth_options.resolution = walk.resolutions[f];
-        const TruthResult truth = compute_ground_truth(rays, castle, world_camera(walk.cameras[f], castle), truth_options);
+        const TruthResult truth = compute_ground_truth(rays, castle, world_camera(walk.cameras[f], castle, orthographic), truth_options);
         for (std::uint32_t id = 0; id < boxes; ++id) {
             const std::uint8_t a = answers[std::size_t(f) * boxes + id];
             const ObjectVisibility& t = truth.objects[id];
@@ -169,8 +180,11 @@ TEST(EngineHost, CastleWalkFromAC99Host) {
         }
     }
     EXPECT_EQ(false_culls, 0u);
-    EXPECT_GT(culled_hidden, hidden / 2) << "the walk culls little: " << culled_hidden << " of " << hidden;
-    std::printf("engine host walk: %zu of %zu objects hidden outright culled, %zu false culls\n", culled_hidden, hidden, false_culls);
+    // An orthographic view's near plane is as wide as its view: every box that the eye's plane
+    // cuts (walls and houses beside the walker) is answered visible, so it culls less.
+    EXPECT_GT(culled_hidden, orthographic ? hidden / 4 : hidden / 2) << "the walk culls little: " << culled_hidden << " of " << hidden;
+    std::printf("engine host %s walk: %zu of %zu objects hidden outright culled, %zu false culls\n", orthographic ? "orthographic" : "perspective",
+                culled_hidden, hidden, false_culls);
 
     // The C++ interface, given the host's cameras and draw order (its trace), answers the same.
     std::ifstream trace(dir + "/answers.trace", std::ios::binary);
@@ -192,7 +206,10 @@ TEST(EngineHost, CastleWalkFromAC99Host) {
         view.cull = HOMCULL_CULL_BACK, view.flags = HOMCULL_VIEW_REVERSED_Z;
         capi::ViewConventions conventions;
         ASSERT_EQ(capi::read_view(nullptr, view, conventions), HOMCULL_OK);
-        OcclusionBuffer buffer(test::buffer_config(walk.resolutions[f].width, walk.resolutions[f].height, 1, float(walk.cameras[f].near_plane)));
+        BufferConfig config = test::buffer_config(walk.resolutions[f].width, walk.resolutions[f].height, 1, float(walk.cameras[f].near_plane));
+        config.orthographic = conventions.orthographic;
+        ASSERT_EQ(conventions.orthographic, orthographic);
+        OcclusionBuffer buffer(config);
         std::uint32_t draws = 0;
         trace.read(reinterpret_cast<char*>(&draws), 4);
         const glm::dmat4 mirror = glm::scale(glm::dmat4(1.0), glm::dvec3(1, 1, -1));  // the host's left-handed world
@@ -205,6 +222,7 @@ TEST(EngineHost, CastleWalkFromAC99Host) {
             ClusteredInput in;
             in.clusters = &clusters[walk.occluder_mesh[i]];
             in.backface = conventions.backface;
+            in.orthographic = conventions.orthographic;
             in.model_to_clip = capi::float_clip_from_model(conventions.clip_from_world, mirror * model);
             buffer.render(in);
         }
@@ -226,16 +244,20 @@ TEST(EngineHost, CastleWalkFromAC99Host) {
     EXPECT_EQ(differing, 0u) << "answers that differ from the C++ interface's";
 }
 
+TEST(EngineHost, CastleWalkFromAC99Host) { check_castle_walk_from_c99_host(false); }
+// The same walk with orthographic cameras (the host's engine_view, --orthographic).
+TEST(EngineHost, OrthographicCastleWalkFromAC99Host) { check_castle_walk_from_c99_host(true); }
+
 // The objects the host answers hidden that Embree sees, over every frame of every run in the
 // answers file (runs x frames x boxes); `culled` counts the hidden answers.
 std::size_t false_culls(const RayScene& rays, const Scene& scene, const HostWalk& walk, const std::vector<std::uint8_t>& answers,
-                        std::uint32_t runs, std::size_t& culled) {
+                        std::uint32_t runs, std::size_t& culled, bool orthographic = false) {
     const std::uint32_t frames = std::uint32_t(walk.cameras.size()), boxes = std::uint32_t(scene.objects.size());
     std::size_t wrong = 0;
     for (std::uint32_t f = 0; f < frames; ++f) {
         TruthOptions truth_options;
         truth_options.resolution = walk.resolutions[f];
-        const TruthResult truth = compute_ground_truth(rays, scene, world_camera(walk.cameras[f], scene), truth_options);
+        const TruthResult truth = compute_ground_truth(rays, scene, world_camera(walk.cameras[f], scene, orthographic), truth_options);
         for (std::uint32_t run = 0; run < runs; ++run)
             for (std::uint32_t id = 0; id < boxes; ++id) {
                 const std::uint8_t a = answers[(std::size_t(run) * frames + f) * boxes + id];
@@ -247,8 +269,9 @@ std::size_t false_culls(const RayScene& rays, const Scene& scene, const HostWalk
 }
 
 // Random views (the eye anywhere in the free space, any direction) at an odd resolution, on the
-// castle, sponza and the castle moved 10^5 from the origin: no false cull.
-TEST(EngineHost, RandomViewsOnSharedScenesFromAC99Host) {
+// castle, sponza and the castle moved 10^5 from the origin, perspective and orthographic: no
+// false cull.
+void check_random_views_from_c99_host(bool orthographic) {
     struct Case {
         const char* file;
         glm::dvec3 offset;
@@ -263,18 +286,23 @@ TEST(EngineHost, RandomViewsOnSharedScenesFromAC99Host) {
         const HostWalk walk = castle_walk(scene, occluder_candidates(scene, OccluderFilter::size), random_views(rays, scene, 8, 11), {643, 359});
         const std::string dir = test::temp_dir("EngineHost.RandomViews");
         write_walk(dir + "/views.walk", scene, walk);
-        const std::string command = std::string(HOMCULL_ENGINE_HOST) + " " + dir + "/views.walk " + dir + "/answers";
+        const std::string command = std::string(HOMCULL_ENGINE_HOST) +
+                                    (orthographic ? " --orthographic " + std::to_string(kOrthographicDistance) + " " : " ") + dir +
+                                    "/views.walk " + dir + "/answers";
         ASSERT_EQ(std::system(command.c_str()), 0) << command;
         std::uint32_t runs, frames, boxes;
         const std::vector<std::uint8_t> answers = read_answers(dir + "/answers", runs, frames, boxes);
         ASSERT_EQ(boxes, scene.objects.size());
         std::size_t culled = 0;
-        EXPECT_EQ(false_culls(rays, scene, walk, answers, runs, culled), 0u) << c.file << " moved by " << format_vec3(c.offset);
-        std::printf("engine host, %s moved by %s: 8 random views at 643x359, %zu objects answered hidden\n", c.file,
-                    format_vec3(c.offset).c_str(), culled);
+        EXPECT_EQ(false_culls(rays, scene, walk, answers, runs, culled, orthographic), 0u) << c.file << " moved by " << format_vec3(c.offset);
+        std::printf("engine host, %s moved by %s: 8 random %s views at 643x359, %zu objects answered hidden\n", c.file,
+                    format_vec3(c.offset).c_str(), orthographic ? "orthographic" : "perspective", culled);
     }
     if (scenes == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
 }
+
+TEST(EngineHost, RandomViewsOnSharedScenesFromAC99Host) { check_random_views_from_c99_host(false); }
+TEST(EngineHost, RandomOrthographicViewsOnSharedScenesFromAC99Host) { check_random_views_from_c99_host(true); }
 
 // For every k, the host's walk (a few frames of a part of the castle) with an allocator that
 // fails on its k-th call: every call returns OK or out of memory, every block comes back (the

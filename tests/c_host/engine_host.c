@@ -9,7 +9,9 @@
  * pull model), and checks that the answers are the same and that nothing allocates after the
  * reserve.
  *
- *   engine_host WALK ANSWERS            the walk; exit 0, or 2 and a message when a call fails or
+ *   engine_host [--orthographic D] WALK ANSWERS
+ *                                       the walk (with orthographic cameras: see engine_view);
+ *                                       exit 0, or 2 and a message when a call fails or
  *                                       the walk allocated after its reserve. ANSWERS.trace gets
  *                                       each frame's world_to_clip (16 f64) and draw order (u32
  *                                       count, u32 occluder numbers)
@@ -199,6 +201,10 @@ static void cross3(const double a[3], const double b[3], double out[3]) {
 }
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+/* --orthographic D: every frame's camera is orthographic, its view as high as the perspective
+ * one's at distance D (2 tan(fov_y / 2) D), as the test's cameras are. 0: perspective. */
+static double orthographic_distance = 0.0;
+
 /* world_to_clip = projection * view, row-major. */
 static void engine_view(const Frame* fr, homcull_view* v) {
     double f[3], s[3], u[3], view[16], proj[16];
@@ -217,11 +223,20 @@ static void engine_view(const Frame* fr, homcull_view* v) {
     view[0 * 4 + 3] = -dot3(s, fr->eye), view[1 * 4 + 3] = -dot3(u, fr->eye), view[2 * 4 + 3] = -dot3(f, fr->eye);
     view[15] = 1.0;
     memset(proj, 0, sizeof proj);
-    proj[0] = x_scale;
-    proj[5] = y_scale;
-    proj[10] = -n / (fa - n); /* reversed: z/w is 1 at the near plane, 0 at the far one */
-    proj[11] = n * fa / (fa - n);
-    proj[14] = 1.0; /* w = view depth */
+    if (orthographic_distance > 0.0) {
+        const double half_height = orthographic_distance / y_scale; /* tan(fov_y / 2) D */
+        proj[0] = 1.0 / (half_height * aspect);
+        proj[5] = 1.0 / half_height;
+        proj[10] = -1.0 / (fa - n); /* reversed: z is 1 at the near plane, 0 at the far one */
+        proj[11] = fa / (fa - n);
+        proj[15] = 1.0; /* w = 1 */
+    } else {
+        proj[0] = x_scale;
+        proj[5] = y_scale;
+        proj[10] = -n / (fa - n); /* reversed: z/w is 1 at the near plane, 0 at the far one */
+        proj[11] = n * fa / (fa - n);
+        proj[14] = 1.0; /* w = view depth */
+    }
     for (r = 0; r < 4; ++r)
         for (c = 0; c < 4; ++c) {
             double sum = 0.0;
@@ -479,9 +494,15 @@ static void write_answers(const char* path, uint32_t runs, uint32_t frames, uint
 int main(int argc, char** argv) {
     Walk walk;
     homcull_visibility* answers;
-    const int sweep = argc == 4 && strcmp(argv[1], "--fail-sweep") == 0;
+    int sweep;
+    if (argc > 2 && strcmp(argv[1], "--orthographic") == 0) {
+        orthographic_distance = atof(argv[2]);
+        if (!(orthographic_distance > 0.0)) fail("--orthographic needs a positive distance, got %s", argv[2]);
+        argc -= 2, argv += 2;
+    }
+    sweep = argc == 4 && strcmp(argv[1], "--fail-sweep") == 0;
     if (argc != 3 && !sweep) {
-        fprintf(stderr, "usage: engine_host [--fail-sweep] WALK ANSWERS\n");
+        fprintf(stderr, "usage: engine_host [--orthographic D] [--fail-sweep] WALK ANSWERS\n");
         return 1;
     }
     if (homcull_version() != HOMCULL_VERSION) fail("built with homcull.h %d, linked with %u", HOMCULL_VERSION, homcull_version());
