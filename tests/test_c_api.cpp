@@ -280,7 +280,7 @@ TEST(CApi, EngineConventionsGiveTheSameAnswers) {
 
 // Orthographic frames, one after another with perspective ones on the same buffer (each
 // switch reconfigures it, allocating nothing after a reserve): the boxes' answers, rectangles
-// given their nearest clip z, and the occludee-triangle test refused (answered visible).
+// given their nearest clip z, and occludee triangles.
 TEST(CApi, OrthographicFramesBetweenPerspectiveOnes) {
     const Scene scene;
     EngineMemory memory;
@@ -306,10 +306,15 @@ TEST(CApi, OrthographicFramesBetweenPerspectiveOnes) {
             EXPECT_EQ(answers[0], HOMCULL_OCCLUDED) << "engine " << int(e);
             EXPECT_EQ(answers[1], HOMCULL_VISIBLE) << "engine " << int(e);
             EXPECT_EQ(answers[2], HOMCULL_VISIBLE) << "engine " << int(e);  // beyond twice the far distance: not answered
-            const homcull_triangles triangles{scene.positions.data(), 12, scene.positions.size() / 3, scene.indices.data(), 2, 0, 8};
-            homcull_visibility v = 99;
-            EXPECT_EQ(homcull_buffer_test_triangles(culler.buffer, &triangles, nullptr, &v), HOMCULL_ERROR_UNSUPPORTED);
-            EXPECT_EQ(v, HOMCULL_VISIBLE);
+            // Occludee triangles: a square behind the wall's middle, and the same before it.
+            const float behind[12] = {-1, -1, -12, 1, -1, -12, 1, 1, -12, -1, 1, -12}, in_front[12] = {-1, -1, -8, 1, -1, -8, 1, 1, -8, -1, 1, -8};
+            const std::uint16_t square[6] = {0, 1, 2, 0, 2, 3};
+            for (const float* positions : {behind, in_front}) {
+                const homcull_triangles triangles{positions, 12, 4, square, 2, 0, 2};
+                homcull_visibility v = 99;
+                ASSERT_EQ(homcull_buffer_test_triangles(culler.buffer, &triangles, nullptr, &v), HOMCULL_OK) << homcull_last_error();
+                EXPECT_EQ(v, positions == behind ? HOMCULL_OCCLUDED : HOMCULL_VISIBLE) << "engine " << int(e);
+            }
         }
         EXPECT_EQ(memory.calls, before);
     }

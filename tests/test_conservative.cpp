@@ -257,10 +257,11 @@ void check_cases_against_exact_arithmetic(bool orthographic, long& claims_checke
         }
         for (int k = 0; k < 16; ++k) {
             std::vector<float> tri;
-            const float wc = w(rng), cx = ndc(rng), cy = ndc(rng), r = half(rng);
+            const float wc = orthographic ? z(rng) : w(rng), cx = ndc(rng), cy = ndc(rng), r = half(rng);
             for (int v = 0; v < 3; ++v) {
-                const float wv = wc * (1.0f + 0.2f * half(rng));
-                tri.insert(tri.end(), {(cx + r * float(v == 1)) * wv + c.origin[0], (cy + r * float(v == 2)) * wv + c.origin[1], wv + c.origin[2]});
+                // Perspective: x and y scaled by the vertex's w; orthographic: by nothing, z spread.
+                const float wv = orthographic ? wc + 0.2f * half(rng) : wc * (1.0f + 0.2f * half(rng)), scale = orthographic ? 1.0f : wv;
+                tri.insert(tri.end(), {(cx + r * float(v == 1)) * scale + c.origin[0], (cy + r * float(v == 2)) * scale + c.origin[1], wv + c.origin[2]});
             }
             TriangleInput occludee = in;
             occludee.shared_edges = nullptr, occludee.edge_apexes = nullptr;
@@ -287,7 +288,7 @@ TEST(Conservative, ClaimsAndAnswersHoldAtEverySampleCentreAgainstExactArithmetic
 
 // The same cases drawn with an orthographic projection (each clip point at the same spot on the
 // screen, its depth from clip z): the same promises, against the same exact arithmetic on the
-// orthographic representatives (exact_oracle.cpp). Occludee triangles answer visible there.
+// orthographic representatives (exact_oracle.cpp), for rectangles, boxes and occludee triangles.
 TEST(Conservative, OrthographicClaimsAndAnswersHoldAgainstExactArithmetic) {
     long claims_checked = 0, occluded_checked = 0;
     check_cases_against_exact_arithmetic(true, claims_checked, occluded_checked);

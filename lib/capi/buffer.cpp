@@ -444,8 +444,6 @@ homcull_result homcull_buffer_test_triangles(const homcull_buffer* b, const homc
     if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
     TriangleInput in;
     if (homcull_result r = triangle_input(*b, triangles, model_matrix, fn, in); r != HOMCULL_OK) return r;
-    if (b->orthographic)
-        return capi::report(b->account.context, HOMCULL_ERROR_UNSUPPORTED, "%s: not supported in orthographic frames yet (answered visible)", fn);
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
         *visibility = as_c(b->buffer.test_triangles(in).visibility);
         return HOMCULL_OK;

@@ -59,6 +59,35 @@ ClipError clip_error(const std::array<float, 16>& m, const glm::dvec4 model[3]) 
     return e;
 }
 
+// The same for an orthographic input, whose clip coordinates are the representatives
+// (x, y, w) / h, h = (3w - z) / 2 (orthographic_representative): with x, z, w off by their
+// ClipError-style bounds, h is off by dh = (3 ew + ez) / 2 and x / h by
+// (ex h + |x| dh) / (h (h - dh)), largest at each vertex's own h; plus the division's rounding.
+// Infinite where h comes within 2 dh of 0 (nothing to reason with: the occludee is visible).
+ClipError orthographic_clip_error(const std::array<float, 16>& m, const glm::dvec4 model[3]) {
+    ClipError e;
+    for (int k = 0; k < 3; ++k) {
+        double magnitude[4] = {0.0, 0.0, 0.0, 0.0};
+        for (int row = 0; row < 4; ++row)
+            for (int i = 0; i < 4; ++i) magnitude[row] += std::abs(double(m[std::size_t(4 * i + row)]) * model[k][i]);
+        const glm::dvec4 c = detail::transform_to_clip_plain(m, model[k].x, model[k].y, model[k].z, model[k].w);
+        const double ex = 0x1.0p-22 * magnitude[0], ey = 0x1.0p-22 * magnitude[1], ez = 0x1.0p-22 * magnitude[2],
+                     ew = 0x1.0p-22 * magnitude[3];
+        const double h = (3.0 * c.w - c.z) * 0.5, dh = (3.0 * ew + ez) * 0.5 + 0x1.0p-50 * (3.0 * std::abs(c.w) + std::abs(c.z));
+        if (!(h > 2.0 * dh)) return {HUGE_VAL, HUGE_VAL, HUGE_VAL};
+        const auto bound = [&](double v, double ev) { return (ev * h + std::abs(v) * dh) / (h * (h - dh)) + 0x1.0p-52 * std::abs(v / h); };
+        e.x = std::max(e.x, bound(c.x, ex));
+        e.y = std::max(e.y, bound(c.y, ey));
+        e.w = std::max(e.w, bound(c.w, ew));
+    }
+    return e;
+}
+
+// The input's ClipError: clip_error, or orthographic_clip_error for an orthographic input.
+ClipError input_clip_error(const TriangleInput& in, const glm::dvec4 model[3]) {
+    return in.orthographic ? orthographic_clip_error(in.model_to_clip, model) : clip_error(in.model_to_clip, model);
+}
+
 // Whether all three vertices lie beyond one side plane by more than the rounding of the plain
 // transform (clip_error's bound, taken without products: each term |m p| is at most |m| times
 // the largest |p|), so that the exact triangle lies beyond it too. The rounded coordinates alone
@@ -261,12 +290,6 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
     if (in.triangle_count == 0) return result;
     detail::check_triangle_input(in, "test_triangles");
     check_projection(in.orthographic, "test_triangles");
-    // The rounding bounds below (clip_error) are those of a perspective transform; an
-    // orthographic buffer's representatives have others, not derived yet: visible.
-    if (config_.orthographic) {
-        result.visibility = Visibility::visible;
-        return result;
-    }
 
     const detail::SubtileView view = subtile_view();
     const double near_w = config_.near_w;
@@ -284,6 +307,10 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
     for (int row = 0; row < 4; ++row)
         for (int i = 0; i < 4; ++i) rows[row] += 0x1.0p-22 * std::abs(double(in.model_to_clip[std::size_t(4 * i + row)]));
     const auto beyond_exactly = [&](const glm::dvec4 model[3], const glm::dvec4 clip[3]) {
+        if (in.orthographic) {  // x - w > ex + ew: beyond whatever the representatives' rounding
+            const ClipError e = orthographic_clip_error(in.model_to_clip, model);
+            return detail::outside_side_plane(clip, e.x + e.w, e.y + e.w);
+        }
         return beyond_side_plane_exactly(model, clip, rows[0], rows[1], rows[3]);
     };
     // One triangle: true when it makes the occludee visible.
@@ -293,7 +320,7 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
         if (beyond_exactly(model, clip)) return false;
         // Ground truth sees surfaces from the near plane on: the part before it is clipped
         // away, at a plane moved towards the eye by the rounding bound of w.
-        const ClipError error = clip_error(in.model_to_clip, model);
+        const ClipError error = input_clip_error(in, model);
         const double near_clip = near_w * (1.0 - 0x1.0p-20) - error.w;
         if (clip[0].w < near_clip && clip[1].w < near_clip && clip[2].w < near_clip) return false;
         in_frustum = true;

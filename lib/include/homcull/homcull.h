@@ -184,8 +184,7 @@ enum {
  * near distance is in front of the near plane), or an orthographic one (its w row (0, 0, 0, c),
  * c > 0; its near and far planes are those of its depth range, and it has a far plane: no
  * HOMCULL_VIEW_INFINITE_FAR). An orthographic frame culls what lies beyond its far plane, and
- * leaves what lies beyond twice the far distance visible; its occludee-triangle test is
- * HOMCULL_ERROR_UNSUPPORTED (answered visible).
+ * leaves what lies beyond twice the far distance visible.
  * The winding is the one the engine's own rasterizer calls front, as it sees the screen. */
 typedef struct homcull_view {
     double world_to_clip[16];       /* projection * view, in `layout` */

@@ -61,8 +61,8 @@ struct BufferConfig {
     // then 0.5 (the near plane, z = -1) whatever it was set to. What lies beyond twice the far
     // distance (g < 2^-8) is not drawn and not answered: occluder triangles reaching it are
     // skipped (counted as invalid), occludees reaching it are visible. Inputs must say they are
-    // orthographic (TriangleInput, ClusteredInput::orthographic); test_triangles answers
-    // visible, and occlusion maps refuse such a buffer.
+    // orthographic (TriangleInput, ClusteredInput::orthographic). Occlusion maps refuse such a
+    // buffer.
     bool orthographic = false;
     // Inner margin of coverage, in samples: see "Conservative" above.
     double edge_margin = 1.0 / 1024.0;
