@@ -1,6 +1,7 @@
 // libFuzzer target: the conservativeness property against the exact oracle (exact_oracle.hpp).
 // The bytes give a small buffer and a few occluder triangles (float positions, any finite value,
-// under a matrix that may translate large model coordinates back near the eye), sometimes a
+// under a matrix that may translate large model coordinates back near the eye, perspective or
+// orthographic), sometimes a
 // closed mesh with its shared-edge flags and a backface rule, queries, and the instruction set. Every claimed sample must be backed by an occluder at or nearer than the claim,
 // and every rectangle and occludee triangle answered occluded must be hidden at every sample
 // centre, and one answered view_culled seen at none, exactly; any violation traps.
@@ -84,6 +85,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             }
         tri.backface = backfaces[in.below(3)];
     }
+    // Sometimes orthographic (BufferConfig::orthographic): the same positions to clip (x, y, z, 1),
+    // z = the position's third coordinate less the origin's (the cancelling form: w = 1, z = 0).
+    if (in.flag()) {
+        config.orthographic = tri.orthographic = true;
+        if (tri.model_to_clip[4] != 1.0f) {
+            const float o[3] = {-tri.model_to_clip[12], -tri.model_to_clip[13], -tri.model_to_clip[15]};
+            tri.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -o[0], -o[1], -o[2], 1};
+        }
+    }
     tri.positions = positions.data();
     tri.vertex_count = positions.size() / 3;
     tri.triangle_count = positions.size() / 9;
@@ -100,12 +110,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::vector<test::ExactTriangle> occluders = test::exact_triangles(tri);
     if (test::unbacked_claims(buffer, occluders) != 0) __builtin_trap();
     const int sw = buffer.sample_width(), sh = buffer.sample_height();
+    const float near_w = buffer.config().near_w;  // an orthographic buffer's is its near plane's
     for (int q = 0; q < 4 && in.left() >= 20; ++q) {
         const ScreenRect r{finite(in), finite(in), finite(in), finite(in), finite(in)};
         const Visibility v = buffer.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
         // occluded: hidden at every sample centre; view_culled: no sample centre at all
-        if (v == Visibility::occluded && !test::rect_truly_hidden(occluders, r, sw, sh, config.near_w)) __builtin_trap();
-        if (v == Visibility::view_culled && !test::rect_truly_hidden({}, r, sw, sh, config.near_w)) __builtin_trap();
+        if (v == Visibility::occluded && !test::rect_truly_hidden(occluders, r, sw, sh, near_w)) __builtin_trap();
+        if (v == Visibility::view_culled && !test::rect_truly_hidden({}, r, sw, sh, near_w)) __builtin_trap();
     }
     if (in.left() >= 36) {
         TriangleInput occludee = tri;
@@ -117,8 +128,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         occludee.triangle_count = 1;
         const Visibility v = buffer.test_triangles(occludee).visibility;
         const std::vector<test::ExactTriangle> exact = test::exact_triangles(occludee);
-        if (v == Visibility::occluded && !test::triangles_truly_hidden(occluders, exact, sw, sh, config.near_w)) __builtin_trap();
-        if (v == Visibility::view_culled && !test::triangles_truly_hidden({}, exact, sw, sh, config.near_w)) __builtin_trap();
+        if (v == Visibility::occluded && !test::triangles_truly_hidden(occluders, exact, sw, sh, near_w)) __builtin_trap();
+        if (v == Visibility::view_culled && !test::triangles_truly_hidden({}, exact, sw, sh, near_w)) __builtin_trap();
     }
     return 0;
 }
