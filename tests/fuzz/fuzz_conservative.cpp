@@ -1,8 +1,8 @@
 // libFuzzer target: the conservativeness property against the exact oracle (exact_oracle.hpp).
 // The bytes give a small buffer and a few occluder triangles (float positions, any finite value,
 // under a matrix that may translate large model coordinates back near the eye, perspective or
-// orthographic), sometimes a
-// closed mesh with its shared-edge flags and a backface rule, queries, and the instruction set. Every claimed sample must be backed by an occluder at or nearer than the claim,
+// orthographic), sometimes a closed mesh with its shared-edge flags and a backface rule, queries,
+// and the instruction set. Every claimed sample must be backed by an occluder at or nearer than the claim,
 // and every rectangle and occludee triangle answered occluded must be hidden at every sample
 // centre, and one answered view_culled seen at none, exactly; any violation traps.
 #include "../exact_oracle.hpp"
