@@ -211,7 +211,8 @@ typedef struct homcull_buffer_desc {
 } homcull_buffer_desc;
 
 /* The largest work the engine will give a buffer: after homcull_buffer_reserve, frames within
- * these sizes never allocate. Zeros keep what the buffer already holds. */
+ * these sizes never allocate, but for homcull_buffer_draw_triangles through a job system (its
+ * per-band bins may still grow). Zeros keep what the buffer already holds. */
 typedef struct homcull_reserve_desc {
     int32_t max_width, max_height;  /* largest resolution set_resolution will be asked for */
     size_t max_draw_triangles;      /* the most triangles one draw call carries (an instanced draw: per instance) */
