@@ -276,27 +276,23 @@ void check_cases_against_exact_arithmetic(bool orthographic, long& claims_checke
     }
 }
 
-TEST(Conservative, ClaimsAndAnswersHoldAtEverySampleCentreAgainstExactArithmetic) {
+// The property over the cases in one projection, and that it is not vacuous: the cases claim
+// samples and hide occludees.
+void expect_cases_hold_against_exact_arithmetic(bool orthographic) {
     long claims_checked = 0, occluded_checked = 0;
-    check_cases_against_exact_arithmetic(false, claims_checked, occluded_checked);
-    // The property is not vacuous: the cases claim samples and hide occludees.
+    check_cases_against_exact_arithmetic(orthographic, claims_checked, occluded_checked);
     EXPECT_GT(claims_checked, 10000);
     EXPECT_GT(occluded_checked, 200);
-    RecordProperty("claims_checked", std::to_string(claims_checked));
-    RecordProperty("occluded_checked", std::to_string(occluded_checked));
+    ::testing::Test::RecordProperty("claims_checked", std::to_string(claims_checked));
+    ::testing::Test::RecordProperty("occluded_checked", std::to_string(occluded_checked));
 }
+
+TEST(Conservative, ClaimsAndAnswersHoldAtEverySampleCentreAgainstExactArithmetic) { expect_cases_hold_against_exact_arithmetic(false); }
 
 // The same cases drawn with an orthographic projection (each clip point at the same spot on the
 // screen, its depth from clip z): the same promises, against the same exact arithmetic on the
 // orthographic representatives (exact_oracle.cpp), for rectangles, boxes and occludee triangles.
-TEST(Conservative, OrthographicClaimsAndAnswersHoldAgainstExactArithmetic) {
-    long claims_checked = 0, occluded_checked = 0;
-    check_cases_against_exact_arithmetic(true, claims_checked, occluded_checked);
-    EXPECT_GT(claims_checked, 10000);
-    EXPECT_GT(occluded_checked, 200);
-    RecordProperty("claims_checked", std::to_string(claims_checked));
-    RecordProperty("occluded_checked", std::to_string(occluded_checked));
-}
+TEST(Conservative, OrthographicClaimsAndAnswersHoldAgainstExactArithmetic) { expect_cases_hold_against_exact_arithmetic(true); }
 
 // Model coordinates near 2^k that the matrix brings back next to the eye: positions (h, a, b)
 // with one large h, and x = (h + a) - h, y = (h + b) - h, w = 1 (column-major below).

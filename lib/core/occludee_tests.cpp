@@ -127,22 +127,18 @@ double box_corners(const float box_min[3], const float box_max[3], const std::ar
 
 double orthographic_corners(glm::dvec4 corners[8], double error) {
     // Each corner's h = (3w - z) / 2 is off by at most (3 + 1) / 2 of the corners' error, plus
-    // its own rounding; x / h by (error h + |x| dh) / (h (h - dh)) for x and h off by error and
-    // dh, largest at the smallest h (it falls as h grows past 2 dh); and each division rounds
-    // by 2^-53 of its result.
-    double h_min = HUGE_VAL, magnitude = 0.0, largest = 0.0;
+    // its own rounding; representative_error is largest at the smallest h and the largest
+    // coordinate.
+    double h_min = HUGE_VAL, magnitude = 0.0;
     for (int k = 0; k < 8; ++k) {
         const glm::dvec4& c = corners[k];
         h_min = std::min(h_min, (3.0 * c.w - c.z) * 0.5);
         magnitude = std::max({magnitude, std::abs(c.x), std::abs(c.y), std::abs(c.z), std::abs(c.w)});
-    }
-    for (int k = 0; k < 8; ++k) {
-        corners[k] = orthographic_representative(corners[k]);
-        largest = std::max({largest, std::abs(corners[k].x), std::abs(corners[k].y), std::abs(corners[k].w)});
+        corners[k] = orthographic_representative(c);
     }
     const double dh = 2.0 * error + 0x1.0p-50 * magnitude;
     if (!(h_min > 2.0 * dh)) return HUGE_VAL;  // no bound to reason with: the box is visible
-    return (error * h_min + (magnitude + error) * dh) / (h_min * (h_min - dh)) + 0x1.0p-52 * largest;
+    return representative_error(magnitude + error, error, h_min, dh);
 }
 
 double ndc_error_bound(double error, double max_abs_ndc, double min_w) {

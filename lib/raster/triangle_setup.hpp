@@ -71,8 +71,16 @@ inline glm::dvec4 transform_to_clip_plain(const std::array<float, 16>& m, double
 // operations, as the SIMD kernels have it: the same bits on every instruction set.
 inline glm::dvec4 orthographic_representative(const glm::dvec4& c) {
     const double h = (3.0 * c.w - c.z) * 0.5;
-    if (!(c.w > 0.0) || !(h >= 0x1.0p-8 * c.w)) return glm::dvec4(std::numeric_limits<double>::quiet_NaN());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (!(c.w > 0.0) || !(h >= 0x1.0p-8 * c.w)) return {nan, nan, c.z, nan};  // z untouched, as the SIMD kernels leave it
     return {c.x / h, c.y / h, c.z, c.w / h};
+}
+// How far a coordinate v / h of a representative may lie from the exact one when |v| is at most
+// `v` (a bound, or the value), v is off by at most ev and h by at most dh (h > 2 dh):
+// (ev h + |v| dh) / (h (h - dh)), which falls as h grows past 2 dh, plus the division's own
+// rounding (2^-52 of the result covers it). The box tests and the occludee triangles use it.
+inline double representative_error(double v, double ev, double h, double dh) {
+    return (ev * h + std::abs(v) * dh) / (h * (h - dh)) + 0x1.0p-52 * std::abs(v / h);
 }
 // The near plane of an orthographic buffer: w' = 1 / g >= 0.5 is z >= -1.
 constexpr float kOrthographicNearW = 0.5f;
