@@ -111,7 +111,7 @@ homcull_result triangle_input(const homcull_buffer& b, const homcull_triangles* 
     in.triangle_count = t->triangle_count;
     in.model_to_clip = capi::float_clip_from_model(b.clip_from_world, read_model(b, model));
     in.backface = b.backface;
-    in.orthographic = b.orthographic;
+    in.orthographic = b.buffer.config().orthographic;  // the frame's projection: begin_frame configures it
     return HOMCULL_OK;
 }
 
@@ -320,7 +320,6 @@ homcull_result homcull_buffer_begin_frame(homcull_buffer* b, const homcull_view*
         }
     }
     b->buffer.clear();  // allocates nothing
-    b->orthographic = conventions.orthographic;
     b->ortho_z_scale = conventions.ortho_z_scale, b->ortho_z_offset = conventions.ortho_z_offset;
     b->view = *view;
     b->clip_from_world = conventions.clip_from_world;
@@ -349,7 +348,7 @@ homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* m
         ClusteredInput in;
         in.clusters = &mesh->clusters;
         in.backface = b->backface;
-        in.orthographic = b->orthographic;
+        in.orthographic = b->buffer.config().orthographic;
         for (std::size_t i = 0; i < instance_count; ++i) {
             in.model_to_clip = capi::float_clip_from_model(b->clip_from_world, read_model(*b, model_matrices ? model_matrices + 16 * i : nullptr));
             if (mesh->bounded && outside_view(mesh->bounds_min, mesh->bounds_max, in.model_to_clip, b->buffer.config().near_w, in.orthographic)) continue;
@@ -425,7 +424,7 @@ homcull_result homcull_buffer_test_rects(const homcull_buffer* b, const homcull_
             const std::size_t n = std::min(kBlock, count - base);
             for (std::size_t k = 0; k < n; ++k) {
                 const homcull_rect& r = rects[base + k];
-                const float nearest = b->orthographic ? orthographic_nearest_w(*b, r.nearest_w) : r.nearest_w;
+                const float nearest = b->buffer.config().orthographic ? orthographic_nearest_w(*b, r.nearest_w) : r.nearest_w;
                 block[k] = y_down ? ScreenRect{r.min_x, -r.max_y, r.max_x, -r.min_y, nearest}
                                   : ScreenRect{r.min_x, r.min_y, r.max_x, r.max_y, nearest};
             }

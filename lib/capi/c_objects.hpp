@@ -65,10 +65,9 @@ struct homcull_buffer {
     homcull::Backface backface = homcull::Backface::cw;
     bool far_plane = false;
     glm::dvec4 far_row{0.0};  // in front of (or on) the far plane: dot(far_row, world clip) >= 0
-    // The frame's projection is orthographic (the buffer is then configured so), with the
-    // engine's clip z = (z_gl - ortho_z_offset) / ortho_z_scale; perspective frames clip at
-    // near_distance (an orthographic buffer's own near_w is its near plane's).
-    bool orthographic = false;
+    // An orthographic frame (begin_frame configures the buffer so: BufferConfig::orthographic)
+    // has the engine's clip z = (z_gl - ortho_z_offset) / ortho_z_scale; perspective frames clip
+    // at near_distance (an orthographic buffer's own near_w is its near plane's).
     double ortho_z_scale = 1.0, ortho_z_offset = 0.0;
     float near_distance = 0.1f;
     std::uint64_t draw_calls = 0, allocations_at_frame = 0;
