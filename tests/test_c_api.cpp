@@ -286,7 +286,7 @@ TEST(CApi, OrthographicFramesBetweenPerspectiveOnes) {
     EngineMemory memory;
     {
         Culler culler(scene, make_context(&memory));
-        const homcull_reserve_desc reserve{320, 180, 8, 0, 0, 0};
+        const homcull_reserve_desc reserve{320, 180, 8, 0, 0, 0, 0, 0};
         ASSERT_EQ(homcull_buffer_reserve(culler.buffer, &reserve), HOMCULL_OK);
         const std::size_t before = memory.calls;
         for (Engine e : {Engine::opengl_ortho, Engine::opengl, Engine::vulkan_ortho_y_down, Engine::d3d_reversed_lh, Engine::d3d_reversed_ortho_lh}) {
@@ -364,7 +364,7 @@ TEST(CApi, NoAllocationAfterReserve) {
     EngineMemory memory;
     {
         Culler culler(scene, make_context(&memory), 320, 180);
-        const homcull_reserve_desc reserve{1280, 720, 64, 64, 4, 256};
+        const homcull_reserve_desc reserve{1280, 720, 64, 64, 4, 256, 0, 0};
         ASSERT_EQ(homcull_buffer_reserve(culler.buffer, &reserve), HOMCULL_OK) << homcull_last_error();
         const std::size_t before = memory.calls;
         for (int k = 0; k < 6; ++k) {
@@ -395,7 +395,7 @@ TEST(CApi, TaskListsAnswerAsDrawsDoAndRefuseCallsOutOfOrder) {
     {
         Culler culler(scene, make_context(&memory));
         homcull_buffer* b = culler.buffer;
-        const homcull_reserve_desc reserve{320, 180, 8, 0, 3, 24};
+        const homcull_reserve_desc reserve{320, 180, 8, 0, 3, 24, 0, 0};
         ASSERT_EQ(homcull_buffer_reserve(b, &reserve), HOMCULL_OK) << homcull_last_error();
         const homcull_view view = engine_view(Engine::opengl);
         std::size_t tasks = 99;
@@ -570,7 +570,8 @@ TEST(CApi, CppLayerOwnsItsHandles) {
 }  // namespace
 
 // The engine's job system: the same answers and statistics as the calling thread, for
-// registered meshes and for triangles, frame after frame.
+// registered meshes and for triangles, frame after frame, and after a reserve nothing allocated
+// from the first frame on.
 #include "support.hpp"
 
 #include <homcull/world_triangles.hpp>
@@ -605,6 +606,8 @@ TEST(CApi, JobSystemGivesTheAnswersOfTheCallingThread) {
             const homcull_job_system jobs{threads.run, threads.user, 2, 0};
             ASSERT_EQ(homcull_buffer_set_job_system(buffer, &jobs), HOMCULL_OK);
         }
+        const homcull_reserve_desc reserve{480, 270, md.triangle_count, md.vertex_count, 1, md.triangle_count, 2, 0};
+        ASSERT_EQ(homcull_buffer_reserve(buffer, &reserve), HOMCULL_OK) << homcull_last_error();
         for (int frame = 0; frame < 3; ++frame) {
             homcull::Camera camera = street.camera;
             camera.eye.z += 4.0 * frame;
@@ -622,6 +625,7 @@ TEST(CApi, JobSystemGivesTheAnswersOfTheCallingThread) {
             ASSERT_EQ(homcull_buffer_test_boxes(buffer, boxes.data(), boxes.size(), nullptr, a.data()), HOMCULL_OK);
             answers[threaded].insert(answers[threaded].end(), a.begin(), a.end());
             ASSERT_EQ(homcull_buffer_frame_stats(buffer, &stats[threaded][frame]), HOMCULL_OK);
+            EXPECT_EQ(stats[threaded][frame].allocations, 0u) << "threaded " << threaded << ", frame " << frame;
         }
         homcull_buffer_destroy(buffer);
         homcull_mesh_destroy(mesh);

@@ -127,6 +127,67 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
         }
 }
 
+// After OcclusionBuffer::reserve, not even the first frame allocates: every resolution within
+// the reserve, every kind of input, on one thread and through job systems of two and three
+// threads. The inputs include a clip-space soup (drawn in parts of rows), an indexed one of many
+// waves of chunks and one whose chunks clip into more triangles than their room.
+TEST(FrameAllocations, NoneFromTheFirstFrameAfterAReserve) {
+    const std::vector<float> soup_xyzw = test::random_clip_triangles(5, 4000, 0.3f);
+    const TriangleInput soup = test::clip_space_input(soup_xyzw);
+    const std::vector<float> many_xyzw = test::random_clip_triangles(6, 70000, 0.05f);
+    std::vector<std::uint32_t> many_indices(many_xyzw.size() / 4);
+    for (std::size_t k = 0; k < many_indices.size(); ++k) many_indices[k] = std::uint32_t(k);
+    TriangleInput many = test::clip_space_input(many_xyzw);
+    many.indices = many_indices.data();
+    std::vector<float> crossing_xyzw = test::random_clip_triangles(7, 5000, 0.2f, 0.8f);
+    for (std::size_t v = 0; v < crossing_xyzw.size(); v += 12) {  // each triangle's first vertex behind the near plane
+        for (int c = 0; c < 4; ++c) crossing_xyzw[v + std::size_t(c)] *= 0.02f / crossing_xyzw[v + 3];  // w 0.02, the near plane 0.1
+    }
+    TriangleInput crossing = test::clip_space_input(crossing_xyzw);
+    crossing.indices = many_indices.data();
+    const test::CityStreet street;
+    const WorldTriangles& occluders = street.occluders;
+    const OccluderClusters clusters =
+        build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3, occluders.indices.data(),
+                                occluders.triangle_count(), occluders.shared_edges.data(), occluders.edge_apexes.data(), ClusterLimits{});
+    const std::array<float, 16> clip = street.clip(320.0 / 180.0);
+    const TriangleInput city_input = occluders.input(clip);
+    const ClusteredInput clustered{&clusters, clip, Backface::none};
+
+    BufferReserve reserve;
+    reserve.max_width = 640, reserve.max_height = 360;
+    reserve.max_triangles = many.triangle_count;
+    reserve.max_vertices = many.vertex_count;
+    reserve.max_clusters = reserve.max_task_list_clusters = clusters.clusters.size();
+    reserve.max_task_list_triangles = occluders.triangle_count();
+    reserve.max_task_list_draws = 1;
+    for (const OccluderCluster& c : clusters.clusters)
+        reserve.max_cluster_vertices = std::max<std::size_t>(reserve.max_cluster_vertices, c.vertex_count);
+    reserve.max_threads = 3;
+    const ParallelFor serial{}, two{&test::run_backwards, nullptr, 2}, three{&test::run_backwards, nullptr, 3};
+    for (const bool sample_depth : {false, true}) {
+        OcclusionBuffer buffer(test::buffer_config(320, 180, 1, float(street.camera.near_plane), sample_depth));
+        buffer.reserve(reserve);
+        for (const ParallelFor* parallel : {&three, &serial, &two})
+            for (const std::array<int, 2> size : {std::array<int, 2>{640, 360}, {333, 97}, {320, 180}}) {
+                const std::string what = std::string(sample_depth ? "per-sample depth, " : "") + std::to_string(parallel->threads) +
+                                         " threads, " + std::to_string(size[0]) + "x" + std::to_string(size[1]);
+                const std::size_t allocated = allocations_of([&] {
+                    BufferConfig config = buffer.config();
+                    config.width = size[0], config.height = size[1];
+                    buffer.configure(config);
+                    buffer.render_frame(many, *parallel);
+                    buffer.render_frame(crossing, *parallel);
+                    buffer.render_frame(soup, *parallel);
+                    buffer.render_frame(city_input, *parallel);
+                    buffer.render(clustered, *parallel);
+                });
+                EXPECT_EQ(allocated, 0u) << what;
+                EXPECT_GT(buffer.stats().rasterized, 0u) << what;
+            }
+    }
+}
+
 // The C interface takes every byte from the engine's allocator: with a context holding one,
 // making meshes and buffers, frames, draws (registered meshes and triangles), queries, a
 // resolution change and destroying it all never call the global operator new; and what the

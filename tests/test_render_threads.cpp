@@ -68,6 +68,43 @@ TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
     EXPECT_TRUE(test::same_subtiles(serial, threaded));
 }
 
+// With a job system an indexed input is set up in chunks, each into a room of fixed size so
+// that the tasks never allocate. Here every triangle crosses the near plane and is clipped into
+// two, more than a chunk's room holds: every band then sets such a chunk up itself, and the bits
+// are still those of one thread.
+TEST(RenderThreads, ChunksClippedBeyondTheirRoomGiveTheSameBits) {
+    std::mt19937_64 rng(21);
+    std::uniform_real_distribution<float> ndc(-0.9f, 0.9f), far_w(2.0f, 40.0f), size(0.02f, 0.2f);
+    std::vector<float> xyzw;
+    std::vector<std::uint32_t> indices;
+    for (std::uint32_t t = 0; t < 7000; ++t) {
+        const float cx = ndc(rng), cy = ndc(rng), r = size(rng);
+        const float w[3] = {0.5f, far_w(rng), far_w(rng)};  // the first vertex behind the near plane (w = 1)
+        for (int k = 0; k < 3; ++k)
+            xyzw.insert(xyzw.end(), {(cx + r * float(k == 1) - r * float(k == 2)) * w[k], (cy + r * float(k == 2)) * w[k], 0.0f, w[k]});
+        indices.insert(indices.end(), {3 * t + 2, 3 * t, 3 * t + 1});
+    }
+    TriangleInput in = test::clip_space_input(xyzw);
+    in.indices = indices.data();
+    in.triangle_count = indices.size() / 3;
+    BufferConfig config;
+    config.width = 301;
+    config.height = 517;  // five bands
+    config.near_w = 1.0f;
+    OcclusionBuffer serial(config), threaded(config), shuffled(config);
+    serial.render_frame(in);
+    threaded.render_frame(in, test::parallel_jobs());
+    std::mt19937_64 order_rng(4);
+    shuffled.render_frame(in, ParallelFor{test::run_shuffled, &order_rng});
+    EXPECT_EQ(serial.stats().near_clipped, in.triangle_count);
+    EXPECT_EQ(serial.stats().rasterized, in.triangle_count);  // each into a quad: a fan of two triangles
+    for (const OcclusionBuffer* other : {&threaded, &shuffled}) {
+        EXPECT_TRUE(serial.stats() == other->stats());
+        EXPECT_TRUE(test::same_subtiles(serial, *other));
+        EXPECT_TRUE(test::same_pyramid(serial, *other));
+    }
+}
+
 // render_frame is clear() then render(): the same bits with and without a job system, over a
 // buffer that still holds another frame, and the same statistics. With more than 8,192
 // triangles a render with a job system goes in several waves, the later ones dropping what

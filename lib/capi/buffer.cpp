@@ -217,6 +217,7 @@ homcull_result homcull_buffer_reserve(homcull_buffer* b, const homcull_reserve_d
         // A draw through the job system is a task list of one draw.
         r.max_task_list_draws = std::max<std::size_t>(desc->max_task_list_draws, 1);
         r.max_task_list_clusters = r.max_task_list_triangles = std::max(desc->max_draw_triangles, desc->max_task_list_triangles);
+        r.max_threads = desc->max_job_threads;
         b->buffer.reserve(r);
         return HOMCULL_OK;
     });

@@ -18,6 +18,7 @@ static_assert(offsetof(homcull_rect, nearest_w) == 16, "homcull_rect's layout");
 static_assert(offsetof(homcull_buffer_desc, near_distance) == 12 && offsetof(homcull_buffer_desc, flags) == 16, "homcull_buffer_desc's layout");
 static_assert(offsetof(homcull_frame_stats, allocations) == 40, "homcull_frame_stats' layout");
 static_assert(offsetof(homcull_reserve_desc, max_task_list_triangles) == 8 + 3 * sizeof(size_t), "homcull_reserve_desc's layout");
+static_assert(offsetof(homcull_reserve_desc, max_job_threads) == 8 + 4 * sizeof(size_t), "homcull_reserve_desc's layout");
 static_assert(offsetof(homcull_context_desc, isa) == 5 * sizeof(void*), "homcull_context_desc's layout");
 static_assert(sizeof(homcull_visibility) == 1 && sizeof(homcull_result) == 4 && sizeof(homcull_isa) == 4, "enums' sizes");
 

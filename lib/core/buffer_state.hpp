@@ -186,8 +186,13 @@ public:
     void refresh_reference_cells(const ReferenceCells& cells, int row_begin, int row_end);
 
     // Render scratch, reused across frames (grown, never shrunk).
+    // The waves of render_binned: per chunk slot of a wave its record, its set-up triangles and,
+    // per band, their numbers (render_binned's Chunk).
     struct Chunk;
     Vector<Chunk> chunks_;
+    Vector<RasterTriangle> wave_triangles_;
+    Vector<std::uint16_t> wave_entry_counts_, wave_entries_;
+    void reserve_waves(std::size_t slots, std::size_t bands);
     Vector<std::uint64_t> band_updated_;
     Vector<double> vertex_clip_;           // four planes of vertex_count + padding
     Vector<std::uint8_t> vertex_outcode_;

@@ -23,10 +23,16 @@ constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtil
 using detail::kBandPyramidLevels;
 using detail::kBandSubtileRows;
 constexpr std::size_t kChunkTriangles = 2048;  // triangles set up per task
+// A chunk's room for its set-up triangles: clipping at the near plane or the guard band may give
+// a triangle more than one; a chunk that needs more sets up again in every band (render_binned).
+constexpr std::size_t kChunkRoom = kChunkTriangles + kChunkTriangles / 8;
+static_assert(kChunkRoom <= 65536, "a band's entries number a chunk's triangles in 16 bits");
 // The chunks of the first wave of a render with a job system (render_binned); each later wave
-// has twice as many chunks as the one before. S1 at 1080p, two threads: one wave 6.88 ms; a
-// first wave of 2, 4 or 8 chunks 5.06, 5.07, 5.18 ms.
+// has twice as many chunks as the one before, up to kMaxWaveChunks, so that the room for a wave
+// is bounded whatever the input: reserve sizes it once. S1 at 1080p, two threads: one wave
+// 6.88 ms; a first wave of 2, 4 or 8 chunks 5.06, 5.07, 5.18 ms.
 constexpr std::size_t kFirstWaveChunks = 4;
+constexpr std::size_t kMaxWaveChunks = 32;
 // One thread: the triangles set up between two refreshes of the reference cells of the rows
 // drawn into (render_serial).
 constexpr std::size_t kCellRefreshTriangles = 4096;
@@ -43,13 +49,15 @@ void prefetch_triangle(const detail::RasterTriangle& tri) {
 
 }  // namespace
 
-// The triangles of one chunk of the input, set up once and copied into the bin of every band
-// they reach, in order: each band then reads its triangles sequentially. (Binning indices
-// into the chunk instead saves memory, but nearly every read of a band is then a cache miss:
-// 10 % slower on S1 even with prefetching.)
+// A chunk of the input in a wave of render_binned: its triangles set up once into its slot of
+// wave_triangles_ (kChunkRoom each), and per band the numbers of those the band reaches, in
+// order, in its slot of wave_entries_ (kChunkRoom per band: a band reaches each triangle at most
+// once). Everything has a fixed size, so that the tasks never allocate. (Copying each triangle
+// into the bin of every band it reaches instead reads better, but needs room without bound.)
 struct detail::BufferState::Chunk {
-    detail::Vector<detail::Vector<detail::RasterTriangle>> bins;
     RasterStats stats;
+    std::uint32_t count = 0;  // triangles set up into the room
+    bool overflow = false;    // clipping gave more than kChunkRoom: every band sets the chunk up itself
 };
 
 // A part of a noted render's rows (draw_noted_part) and its scratch: room for a slice's
@@ -224,6 +232,15 @@ void detail::BufferState::reserve(const BufferReserve& r) {
         at_least(draw_order_->vertex_code, r.max_vertices);
         at_least(vertex_clip_, 4 * (r.max_vertices + detail::kVertexClipPadding));
         at_least(vertex_outcode_, r.max_vertices);
+    }
+    // Triangle input with a job system: the waves (render_binned) and, for a clip-space soup,
+    // one part of the rows per thread (render_parts).
+    if (n > 0 && r.max_threads > 0) {
+        reserve_waves(std::min((n + kChunkTriangles - 1) / kChunkTriangles, kMaxWaveChunks), z.bands);
+        const std::size_t parts = std::min(r.max_threads, z.cells_height);
+        at_least(reference_cells_, parts * z.cells);
+        if (noted_parts_.size() < parts) noted_parts_.resize(parts);
+        for (NotedPart& part : noted_parts_) at_least(part.undecided, kCellRefreshTriangles);
     }
     // Clustered input: one draw on one thread, or a task list (render_clusters, close_tasks).
     at_least(cluster_places_, r.max_clusters);
@@ -583,6 +600,14 @@ void detail::BufferState::render_parts(const TriangleInput& in, const ParallelFo
     for (std::size_t p = 1; p < parts; ++p) stats_.subtiles_updated += noted_parts_[p].stats.subtiles_updated;
 }
 
+// Room for waves of `slots` chunks over `bands` bands (render_binned), kept when it is enough.
+void detail::BufferState::reserve_waves(std::size_t slots, std::size_t bands) {
+    if (chunks_.size() < slots) chunks_.resize(slots);
+    if (wave_triangles_.size() < slots * kChunkRoom) wave_triangles_.resize(slots * kChunkRoom);
+    if (wave_entry_counts_.size() < slots * bands) wave_entry_counts_.resize(slots * bands);
+    if (wave_entries_.size() < slots * bands * kChunkRoom) wave_entries_.resize(slots * bands * kChunkRoom);
+}
+
 // With a job system, the triangles go in waves of chunks: in each, phase 1 sets up and bins
 // the wave's chunks in parallel, then phase 2 rasterizes bands of subtile rows in parallel,
 // each band its triangles in input order. The first wave is small and the waves double: drawn
@@ -590,12 +615,13 @@ void detail::BufferState::render_parts(const TriangleInput& in, const ParallelFo
 // the triangles already hidden in it before their edges are set up and they are binned
 // (hidden_in_target, as on one thread). Dropping them changes no bit, so the waves' sizes are
 // free; only the speed depends on them. (A clip-space soup with cell records goes to
-// render_parts instead.)
+// render_parts instead.) The waves' room is allocated here, on the calling thread, when a
+// reserve did not: the tasks allocate nothing.
 void detail::BufferState::render_binned(const TriangleInput& in, const ParallelFor& parallel, const detail::VertexClip* cache, bool clear_first) {
     reference_cells_current_ = false;
     const std::size_t chunk_count = (in.triangle_count + kChunkTriangles - 1) / kChunkTriangles;
     const std::size_t bands = band_updated_.size();
-    if (chunks_.size() < chunk_count) chunks_.resize(chunk_count);
+    reserve_waves(std::min(chunk_count, kMaxWaveChunks), bands);
     std::fill(band_updated_.begin(), band_updated_.end(), std::uint64_t(0));
 
     struct Job {
@@ -610,24 +636,33 @@ void detail::BufferState::render_binned(const TriangleInput& in, const ParallelF
     std::size_t drawn_chunks = 0;  // the chunks of the waves drawn so far
     try {
         // At least one wave, so that render_frame clears and builds the pyramid whatever the count.
-        for (std::size_t first = 0, wave_chunks = kFirstWaveChunks; first == 0 || first < chunk_count; first += wave_chunks, wave_chunks *= 2) {
+        for (std::size_t first = 0, wave_chunks = kFirstWaveChunks; first == 0 || first < chunk_count;
+             first += wave_chunks, wave_chunks = std::min(2 * wave_chunks, kMaxWaveChunks)) {
             const std::size_t end = std::min(chunk_count, first + wave_chunks);
             const bool nothing_drawn = first == 0 && clear_first;  // the buffer still holds the last frame
             Job job{this, &in, cache, first, end, bands, nothing_drawn ? nullptr : &whole, first == 0 && clear_first, end == chunk_count};
 
-            detail::run_tasks(parallel, end - first, [](void* data, std::size_t k) {
+            detail::run_tasks(parallel, end - first, [](void* data, std::size_t slot) {
                 const Job& j = *static_cast<Job*>(data);
-                const std::size_t c = j.first_chunk + k;
-                Chunk& chunk = j.self->chunks_[c];
-                chunk.stats = RasterStats{};
-                if (chunk.bins.size() < j.bands) chunk.bins.resize(j.bands);
-                for (auto& bin : chunk.bins) bin.clear();
-                const std::size_t end_triangle = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
-                const detail::BufferState& b = *j.self;
+                detail::BufferState& b = *j.self;
+                const std::size_t c = j.first_chunk + slot;
+                Chunk& chunk = b.chunks_[slot];
+                chunk = Chunk{};
+                detail::RasterTriangle* room = b.wave_triangles_.data() + slot * kChunkRoom;
+                std::uint16_t* counts = b.wave_entry_counts_.data() + slot * j.bands;
+                std::uint16_t* entries = b.wave_entries_.data() + slot * j.bands * kChunkRoom;
+                std::fill(counts, counts + j.bands, std::uint16_t(0));
                 const auto bin = [&](const detail::RasterTriangle& tri) {
+                    if (chunk.count == kChunkRoom) {
+                        chunk.overflow = true;  // the setup goes on, for the statistics
+                        return;
+                    }
+                    room[chunk.count] = tri;
                     for (int band = tri.j0 / (kH * kBandSubtileRows); band <= tri.j1 / (kH * kBandSubtileRows); ++band)
-                        chunk.bins[std::size_t(band)].push_back(tri);
+                        entries[std::size_t(band) * kChunkRoom + counts[band]++] = std::uint16_t(chunk.count);
+                    ++chunk.count;
                 };
+                const std::size_t end_triangle = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
                 detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
                                              b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin);
             }, &job);
@@ -639,37 +674,46 @@ void detail::BufferState::render_binned(const TriangleInput& in, const ParallelF
                 if (j.clear_first) b.clear_rows(row_begin, row_end);
                 const detail::RasterTarget target = b.raster_target(row_begin, row_end);
                 std::uint64_t updated = 0;
-                for (std::size_t c = j.first_chunk; c < j.end_chunk; ++c) {
-                    const auto& bin = b.chunks_[c].bins[band];
-                    for (std::size_t k = 0; k < bin.size(); ++k) {
-                        if (k + kPrefetchTriangles < bin.size()) prefetch_triangle(bin[k + kPrefetchTriangles]);
-                        updated += target.kernel(target, bin[k]);
+                for (std::size_t slot = 0; slot < j.end_chunk - j.first_chunk; ++slot) {
+                    const Chunk& chunk = b.chunks_[slot];
+                    if (chunk.overflow) {
+                        // The same triangles in the same order as the room would have held.
+                        const std::size_t c = j.first_chunk + slot;
+                        RasterStats ignored;
+                        detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, std::min(j.in->triangle_count, (c + 1) * kChunkTriangles),
+                                                     b.config_.near_w, b.config_.edge_margin, b.sample_width_, b.sample_height_, nullptr,
+                                                     ignored, [&](const detail::RasterTriangle& tri) {
+                                                         if (tri.j0 < row_end * kH && tri.j1 >= row_begin * kH) updated += target.kernel(target, tri);
+                                                     });
+                        continue;
+                    }
+                    const detail::RasterTriangle* room = b.wave_triangles_.data() + slot * kChunkRoom;
+                    const std::size_t count = b.wave_entry_counts_[slot * j.bands + band];
+                    const std::uint16_t* entries = b.wave_entries_.data() + (slot * j.bands + band) * kChunkRoom;
+                    for (std::size_t k = 0; k < count; ++k) {
+                        if (k + kPrefetchTriangles < count) prefetch_triangle(room[entries[k + kPrefetchTriangles]]);
+                        updated += target.kernel(target, room[entries[k]]);
                     }
                 }
                 b.band_updated_[band] += updated;
                 if (j.last_wave) b.build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(b.levels_.size()) - 1));
             }, &job);
+            for (std::size_t slot = 0; slot < end - first; ++slot) stats_ += chunks_[slot].stats;
             drawn_chunks = end;
         }
     } catch (...) {
-        // Out of memory growing a bin, or the job system failed (input errors throw before any
-        // wave). After the first wave, the buffer keeps the waves drawn, a partial but
+        // The job system failed (input errors throw before any wave, and the tasks allocate
+        // nothing). After the first wave, the buffer keeps the waves drawn, a partial but
         // conservative render, with their statistics. Before that some bands may still hold
         // the frame before, which must not hide anything of this one: a render_frame then
         // leaves the buffer clear. Either way the pyramid is rebuilt to match, so that no test
         // reads a pyramid of the frame before.
-        if (clear_first && drawn_chunks == 0) {
-            clear_rows(0, subtiles_y_);
-        } else {
-            for (std::size_t c = 0; c < drawn_chunks; ++c) stats_ += chunks_[c].stats;
-            for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
-        }
+        if (clear_first && drawn_chunks == 0) clear_rows(0, subtiles_y_);
+        else for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
         build_pyramid_rows(0, subtiles_y_, int(levels_.size()) - 1);
         throw;
     }
     reduce_pyramid_above_bands();
-
-    for (std::size_t c = 0; c < chunk_count; ++c) stats_ += chunks_[c].stats;
     for (std::uint64_t updated : band_updated_) stats_.subtiles_updated += updated;
 }
 

@@ -406,6 +406,7 @@ static unsigned long run_walk(const Walk* w, uint32_t frames, unsigned long fail
             for (i = 0; i < w->occluder_count; ++i) all_triangles += w->meshes[w->occluders[i].mesh].triangles;
             reserve.max_width = width, reserve.max_height = height, reserve.max_draw_triangles = largest;
             reserve.max_task_list_draws = w->occluder_count, reserve.max_task_list_triangles = all_triangles;
+            reserve.max_job_threads = 2;
             acceptable(homcull_buffer_reserve(buffer, &reserve), sweeping, "homcull_buffer_reserve");
             if (drawing == DRAW_THROUGH_JOBS) {
                 homcull_job_system jobs;

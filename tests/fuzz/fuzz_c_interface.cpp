@@ -92,7 +92,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             case 0: check(homcull_buffer_set_resolution(buffer, int(in.below(400)) - 2, int(in.below(300)) - 2)); break;
             case 1: check(homcull_buffer_set_near(buffer, in.take<float>())); break;
             case 2: {
-                const homcull_reserve_desc r{int(in.below(600)), int(in.below(400)), in.below(5000), in.below(5000), in.below(9), in.below(5000)};
+                const homcull_reserve_desc r{int(in.below(600)), int(in.below(400)), in.below(5000), in.below(5000), in.below(9), in.below(5000), std::uint32_t(in.below(5)), 0};
                 check(homcull_buffer_reserve(buffer, &r));
                 break;
             }

@@ -82,7 +82,8 @@ class homcull_buffer_desc(Structure):
 
 class homcull_reserve_desc(Structure):
     _fields_ = [("max_width", c_int32), ("max_height", c_int32), ("max_draw_triangles", c_size_t),
-                ("max_draw_vertices", c_size_t), ("max_task_list_draws", c_size_t), ("max_task_list_triangles", c_size_t)]
+                ("max_draw_vertices", c_size_t), ("max_task_list_draws", c_size_t), ("max_task_list_triangles", c_size_t),
+                ("max_job_threads", c_uint32), ("reserved", c_uint32)]
 
 
 job_task_fn = CFUNCTYPE(None, c_void_p, c_size_t)

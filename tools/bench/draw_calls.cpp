@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
 
     api::Buffer buffer;
     check(api::Buffer::create(context, homcull_buffer_desc{width, height, 1, 1.0f, 0, 0}, buffer), "homcull_buffer_create");
-    check(buffer.reserve(homcull_reserve_desc{width, height, triangles, 0, draws.size(), triangles}), "homcull_buffer_reserve");
+    check(buffer.reserve(homcull_reserve_desc{width, height, triangles, 0, draws.size(), triangles, 0, 0}), "homcull_buffer_reserve");
 
     std::printf("%zu occluder objects (%zu triangles), %dx%d, %d rounds, instruction set %s\n", draws.size(), triangles, width, height, rounds,
                 homcull_isa_name(context.isa()));

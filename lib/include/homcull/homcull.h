@@ -211,8 +211,7 @@ typedef struct homcull_buffer_desc {
 } homcull_buffer_desc;
 
 /* The largest work the engine will give a buffer: after homcull_buffer_reserve, frames within
- * these sizes never allocate, but for homcull_buffer_draw_triangles through a job system (its
- * per-band bins may still grow). Zeros keep what the buffer already holds. */
+ * these sizes never allocate. Zeros keep what the buffer already holds. */
 typedef struct homcull_reserve_desc {
     int32_t max_width, max_height;  /* largest resolution set_resolution will be asked for */
     size_t max_draw_triangles;      /* the most triangles one draw call carries (an instanced draw: per instance) */
@@ -220,6 +219,10 @@ typedef struct homcull_reserve_desc {
     /* Task lists (homcull_buffer_begin_tasks): the most mesh draws (instances counted each) one
      * list records, and the most triangles of all their meshes. */
     size_t max_task_list_draws, max_task_list_triangles;
+    /* homcull_buffer_draw_triangles through a job system: the most threads it reports
+     * (homcull_job_system::threads; one that reports 0 counts as 2). 0: not reserved for. */
+    uint32_t max_job_threads;
+    uint32_t reserved; /* 0 */
 } homcull_reserve_desc;
 
 typedef struct homcull_buffer homcull_buffer;
@@ -355,7 +358,7 @@ HOMCULL_CHECK_SIZE_(allocator, homcull_allocator, 3 * sizeof(void*));
 HOMCULL_CHECK_SIZE_(context_desc, homcull_context_desc, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(mesh_desc, homcull_mesh_desc, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(triangles, homcull_triangles, 5 * sizeof(void*) + 8);
-HOMCULL_CHECK_SIZE_(reserve_desc, homcull_reserve_desc, 8 + 4 * sizeof(size_t));
+HOMCULL_CHECK_SIZE_(reserve_desc, homcull_reserve_desc, 16 + 4 * sizeof(size_t));
 HOMCULL_CHECK_SIZE_(job_system, homcull_job_system, 2 * sizeof(void*) + 8);
 
 #ifdef __cplusplus

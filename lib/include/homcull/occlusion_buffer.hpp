@@ -84,6 +84,9 @@ struct BufferReserve {
     // Clustered draws with a job system, and record()ed task lists: the most clusters and the
     // most triangles in them of one task list (a render with a job system is a list of one draw).
     std::size_t max_task_list_draws = 0, max_task_list_clusters = 0, max_task_list_triangles = 0;
+    // Triangle renders (render(TriangleInput)) with a job system: the most ParallelFor::threads
+    // they are given (a job system that says 0 counts as 2). 0: such renders are not reserved for.
+    std::size_t max_threads = 0;
 };
 
 struct RasterStats {
@@ -255,8 +258,10 @@ public:
     // A new near plane (BufferConfig::near_w), emptying the buffer; allocates nothing.
     void set_near_w(float near_w);
     // Sizes every array for the largest buffer and input the caller will give, so that renders
-    // on one thread within these sizes, and configure() up to that resolution, never allocate.
-    // Throws like configure; whatever it reserved stays reserved.
+    // within these sizes (with a job system: of at most max_threads threads), and configure()
+    // up to that resolution, never allocate, not even the first frame (tested:
+    // FrameAllocations.NoneFromTheFirstFrameAfterAReserve). Throws like configure; whatever it
+    // reserved stays reserved.
     void reserve(const BufferReserve& reserve);
 
     void clear();
@@ -264,16 +269,16 @@ public:
     // Without a job system each triangle is set up and drawn in turn; with one, a clip-space
     // soup drawn nearest first (the identity matrix, 4 packed floats per vertex, no shared-edge
     // flags, as S1 and MOC's API give triangles) is drawn in ParallelFor::threads parts of rows,
-    // one task each; other input in waves of chunks of triangles (4, 8, 16, ... chunks), each
-    // set up and binned into bands of subtile rows in parallel, then each band rasterized in
-    // draw order. Every subtile sees the same sequence of triangles whatever the threads.
-    // Triangles already hidden in the buffer are dropped before their edges are set up (most
-    // of a noted soup's before they are read), which changes no bit. Scratch memory (the
-    // per-chunk band bins) is reused and only grows, so a frame allocates only when a bin
-    // outgrows every earlier frame's: after a few frames of a walkthrough, rarely. Should that
-    // allocation, or the job system, fail (std::bad_alloc) after drawing began, the buffer keeps
-    // what was drawn, with a pyramid to match; a render_frame leaves no row of the frame
-    // before. Indexed input with at most two vertices per
+    // one task each; other input in waves of chunks of triangles (4, 8, 16, then 32 chunks at
+    // a time), each set up and binned into bands of subtile rows in parallel, then each band
+    // rasterized in draw order. Every subtile sees the same sequence of triangles whatever the
+    // threads. Triangles already hidden in the buffer are dropped before their edges are set
+    // up (most of a noted soup's before they are read), which changes no bit. The room for the
+    // waves has a fixed size (about 14 MB at 1080p for inputs of 65,536 triangles or more),
+    // allocated on the calling thread before any task runs, or by reserve(): the tasks never
+    // allocate. Should the job system fail after drawing began, the buffer keeps what was
+    // drawn, with a pyramid to match; a render_frame leaves no row of the frame before.
+    // Indexed input with at most two vertices per
     // triangle has every one of its vertex_count positions read and transformed once (so
     // vertex_count must not overstate the positions), into scratch of 33 bytes a vertex (up to
     // 4M vertices) that also only grows and stays allocated with the buffer. Statistics
