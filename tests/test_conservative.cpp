@@ -86,6 +86,14 @@ void orthographic_point(float near_w, float& x, float& y, float& w) {
     w = -1.0f + (w - near_w) * (2.0f / 20.0f);
 }
 
+// A perspective case's clip (x, y, w) points, 3 floats each, as positions for
+// translated_projection(origin 0, orthographic): unchanged, or through orthographic_point.
+std::vector<float> positions_for(std::vector<float> xyw, bool orthographic, float near_w) {
+    if (orthographic)
+        for (std::size_t v = 0; v + 2 < xyw.size(); v += 3) orthographic_point(near_w, xyw[v], xyw[v + 1], xyw[v + 2]);
+    return xyw;
+}
+
 Case make_case(std::uint32_t seed, bool orthographic = false) {
     std::mt19937_64 rng(seed);
     Case c;
@@ -316,28 +324,34 @@ TEST(Conservative, TransformToClipIsAccurateWhereTheMatrixCancelsLargeCoordinate
 
 // The same through the buffer: triangles of such vertices at 2^30 to 2^60, drawn on a 64 x 64
 // buffer at w = 1, claim no sample that the exact geometry does not cover (the plain double sum
-// claimed samples where no occluder is from 2^42 on).
+// claimed samples where no occluder is from 2^42 on). Orthographic too (w = 1 everywhere, z = 0).
 TEST(Conservative, LargeCancellingCoordinatesClaimNoSampleOutsideTheOccluders) {
     std::mt19937_64 rng(11);
     std::uniform_real_distribution<float> small(-1.2f, 1.2f), mantissa(1.0f, 2.0f);
-    for (const std::string& isa : available_isas()) {
-        select_isa(isa);
-        for (int k = 30; k <= 60; k += 2) {
-            const float h = std::ldexp(mantissa(rng), k);
-            OcclusionBuffer buffer(test::buffer_config(64, 64, 1, 0.1f));
-            std::vector<float> positions;
-            for (int v = 0; v < 3 * 12; ++v) positions.insert(positions.end(), {h, small(rng), small(rng)});
-            TriangleInput in;
-            in.positions = positions.data();
-            in.vertex_count = positions.size() / 3;
-            in.triangle_count = in.vertex_count / 3;
-            in.model_to_clip = cancelling_matrix(h);
-            in.backface = Backface::none;
-            buffer.render_frame(in);
-            int first = -1;
-            EXPECT_EQ(test::unbacked_claims(buffer, test::exact_triangles(in), &first), 0) << isa << ", 2^" << k << ", sample " << first;
+    for (const bool orthographic : {false, true})
+        for (const std::string& isa : available_isas()) {
+            select_isa(isa);
+            for (int k = 30; k <= 60; k += 2) {
+                const float h = std::ldexp(mantissa(rng), k);
+                BufferConfig config = test::buffer_config(64, 64, 1, 0.1f);
+                config.orthographic = orthographic;
+                OcclusionBuffer buffer(config);
+                std::vector<float> positions;
+                for (int v = 0; v < 3 * 12; ++v) positions.insert(positions.end(), {h, small(rng), small(rng)});
+                TriangleInput in;
+                in.positions = positions.data();
+                in.vertex_count = positions.size() / 3;
+                in.triangle_count = in.vertex_count / 3;
+                in.model_to_clip = cancelling_matrix(h);
+                in.backface = Backface::none;
+                in.orthographic = orthographic;
+                buffer.render_frame(in);
+                EXPECT_GT(buffer.stats().rasterized, 0u);
+                int first = -1;
+                EXPECT_EQ(test::unbacked_claims(buffer, test::exact_triangles(in), &first), 0)
+                    << (orthographic ? "orthographic, " : "") << isa << ", 2^" << k << ", sample " << first;
+            }
         }
-    }
     select_isa("best");
 }
 
@@ -463,10 +477,10 @@ TEST(Conservative, OccludeeTrianglesHiddenByTheirRoundingAreTested) {
 // edge covers the row: one below it (a closed mesh's far side, facing as T does) keeps the flag;
 // one folded back above it (the view silhouette of a closed mesh: it faces away), a degenerate
 // one (its apex on the edge's line) or a missing apex drops it. Drawn as a soup, indexed (with a
-// vertex cache), as clusters, with back faces drawn or culled, on every instruction set.
+// vertex cache), as clusters, with back faces drawn or culled, on every instruction set, with
+// perspective and orthographic projections (the same spots on the screen).
 TEST(Conservative, SharedEdgesAtViewSilhouettesKeepTheirMargin) {
     const float e = 0x1.0p-100f;
-    const BufferConfig config = test::buffer_config(16, 15, 1, 0.1f);
     struct Neighbour {
         const char* name;
         float apex[3];  // clip (x, y, w)
@@ -475,63 +489,73 @@ TEST(Conservative, SharedEdgesAtViewSilhouettesKeepTheirMargin) {
     const Neighbour neighbours[] = {{"below (across the edge)", {0.0f, -0.5f, 1.0f}, true},
                                     {"folded above (a view silhouette)", {0.1f, 0.5f, 2.0f}, false},
                                     {"degenerate (apex on the edge's line)", {0.3f, e, 1.0f}, false}};
-    const std::array<float, 16> matrix = translated_projection(std::array<float, 3>{0, 0, 0}.data());
-    long row_claims_kept = 0;
-    for (const Neighbour& n : neighbours)
-        for (const Backface backface : {Backface::none, Backface::cw})
-            for (const std::string& isa : available_isas()) {
-                select_isa(isa);
-                const std::string where = std::string(n.name) + ", backface " + std::to_string(int(backface)) + ", " + isa;
-                // T = (a, b, c), N = (b, a, apex); as a soup of 6 vertices and as 4 indexed ones.
-                const std::vector<float> soup = {-0.8f, e, 1, 0.8f, e, 1, 0, 0.8f, 1, 0.8f, e, 1, -0.8f, e, 1, n.apex[0], n.apex[1], n.apex[2]};
-                const std::vector<float> vertices = {-0.8f, e, 1, 0.8f, e, 1, 0, 0.8f, 1, n.apex[0], n.apex[1], n.apex[2]};
-                const std::vector<std::uint32_t> indices = {0, 1, 2, 1, 0, 3};
-                std::uint8_t soup_flags[2], flags[2];
-                std::uint32_t soup_apexes[6], apexes[6];
-                compute_shared_edges(soup.data(), 12, 6, nullptr, 2, soup_flags, soup_apexes);
-                compute_shared_edges(vertices.data(), 12, 4, indices.data(), 2, flags, apexes);
-                ASSERT_EQ(soup_flags[0], 1u) << where;  // the flag is the mesh's: only the view can drop it
-                TriangleInput as_soup;
-                as_soup.positions = soup.data();
-                as_soup.vertex_count = 6;
-                as_soup.triangle_count = 2;
-                as_soup.model_to_clip = matrix;
-                as_soup.backface = backface;
-                as_soup.shared_edges = soup_flags;
-                as_soup.edge_apexes = soup_apexes;
-                TriangleInput indexed = as_soup;
-                indexed.positions = vertices.data();
-                indexed.vertex_count = 4;
-                indexed.indices = indices.data();
-                indexed.shared_edges = flags;
-                indexed.edge_apexes = apexes;
-                const OccluderClusters clusters = build_occluder_clusters(vertices.data(), 12, 4, indices.data(), 2, flags, apexes);
-                const std::vector<test::ExactTriangle> occluders = test::exact_triangles(as_soup);
-                OcclusionBuffer from_soup(config), from_indices(config), from_clusters(config);
-                from_soup.render_frame(as_soup);
-                from_indices.render_frame(indexed);
-                from_clusters.render_frame(ClusteredInput{&clusters, matrix, backface});
-                ASSERT_TRUE(test::same_subtiles(from_soup, from_indices)) << where;
-                ASSERT_TRUE(test::same_subtiles(from_soup, from_clusters)) << where;
-                EXPECT_EQ(test::unbacked_claims(from_soup, occluders), 0) << where;
-                // The row at y = 0 (sample row 7) is claimed exactly when the neighbour covers it.
-                const std::vector<float> claims = test::claimed_inverse_w(from_soup);
-                int row_claims = 0;
-                for (int i = 0; i < from_soup.sample_width(); ++i) row_claims += claims[std::size_t(7 * from_soup.sample_width() + i)] > 0.0f;
-                if (n.covers_row) EXPECT_GT(row_claims, 10) << where;
-                else EXPECT_EQ(row_claims, 0) << where;
-                row_claims_kept += row_claims;
-                // Without its apex, the flag is dropped.
-                std::uint32_t no_apexes[6] = {kNoApex, kNoApex, kNoApex, kNoApex, kNoApex, kNoApex};
-                TriangleInput without = as_soup;
-                without.edge_apexes = no_apexes;
-                OcclusionBuffer margin(config);
-                margin.render_frame(without);
-                const std::vector<float> margin_claims = test::claimed_inverse_w(margin);
-                for (int i = 0; i < margin.sample_width(); ++i) EXPECT_EQ(margin_claims[std::size_t(7 * margin.sample_width() + i)], 0.0f) << where;
-            }
+    long row_claims_kept[2] = {0, 0};
+    for (const bool orthographic : {false, true})
+        for (const Neighbour& n : neighbours)
+            for (const Backface backface : {Backface::none, Backface::cw})
+                for (const std::string& isa : available_isas()) {
+                    select_isa(isa);
+                    const std::string where = std::string(orthographic ? "orthographic, " : "") + n.name + ", backface " +
+                                              std::to_string(int(backface)) + ", " + isa;
+                    BufferConfig config = test::buffer_config(16, 15, 1, 0.1f);
+                    config.orthographic = orthographic;
+                    const std::array<float, 16> matrix = translated_projection(std::array<float, 3>{0, 0, 0}.data(), orthographic);
+                    // T = (a, b, c), N = (b, a, apex); as a soup of 6 vertices and as 4 indexed ones.
+                    const std::vector<float> soup = positions_for(
+                        {-0.8f, e, 1, 0.8f, e, 1, 0, 0.8f, 1, 0.8f, e, 1, -0.8f, e, 1, n.apex[0], n.apex[1], n.apex[2]}, orthographic, 0.1f);
+                    const std::vector<float> vertices =
+                        positions_for({-0.8f, e, 1, 0.8f, e, 1, 0, 0.8f, 1, n.apex[0], n.apex[1], n.apex[2]}, orthographic, 0.1f);
+                    const std::vector<std::uint32_t> indices = {0, 1, 2, 1, 0, 3};
+                    std::uint8_t soup_flags[2], flags[2];
+                    std::uint32_t soup_apexes[6], apexes[6];
+                    compute_shared_edges(soup.data(), 12, 6, nullptr, 2, soup_flags, soup_apexes);
+                    compute_shared_edges(vertices.data(), 12, 4, indices.data(), 2, flags, apexes);
+                    ASSERT_EQ(soup_flags[0], 1u) << where;  // the flag is the mesh's: only the view can drop it
+                    TriangleInput as_soup;
+                    as_soup.positions = soup.data();
+                    as_soup.vertex_count = 6;
+                    as_soup.triangle_count = 2;
+                    as_soup.model_to_clip = matrix;
+                    as_soup.backface = backface;
+                    as_soup.shared_edges = soup_flags;
+                    as_soup.edge_apexes = soup_apexes;
+                    as_soup.orthographic = orthographic;
+                    TriangleInput indexed = as_soup;
+                    indexed.positions = vertices.data();
+                    indexed.vertex_count = 4;
+                    indexed.indices = indices.data();
+                    indexed.shared_edges = flags;
+                    indexed.edge_apexes = apexes;
+                    const OccluderClusters clusters = build_occluder_clusters(vertices.data(), 12, 4, indices.data(), 2, flags, apexes);
+                    const std::vector<test::ExactTriangle> occluders = test::exact_triangles(as_soup);
+                    OcclusionBuffer from_soup(config), from_indices(config), from_clusters(config);
+                    from_soup.render_frame(as_soup);
+                    from_indices.render_frame(indexed);
+                    ClusteredInput clustered{&clusters, matrix, backface};
+                    clustered.orthographic = orthographic;
+                    from_clusters.render_frame(clustered);
+                    ASSERT_TRUE(test::same_subtiles(from_soup, from_indices)) << where;
+                    ASSERT_TRUE(test::same_subtiles(from_soup, from_clusters)) << where;
+                    EXPECT_EQ(test::unbacked_claims(from_soup, occluders), 0) << where;
+                    // The row at y = 0 (sample row 7) is claimed exactly when the neighbour covers it.
+                    const std::vector<float> claims = test::claimed_inverse_w(from_soup);
+                    int row_claims = 0;
+                    for (int i = 0; i < from_soup.sample_width(); ++i) row_claims += claims[std::size_t(7 * from_soup.sample_width() + i)] > 0.0f;
+                    if (n.covers_row) EXPECT_GT(row_claims, 10) << where;
+                    else EXPECT_EQ(row_claims, 0) << where;
+                    row_claims_kept[orthographic] += row_claims;
+                    // Without its apex, the flag is dropped.
+                    std::uint32_t no_apexes[6] = {kNoApex, kNoApex, kNoApex, kNoApex, kNoApex, kNoApex};
+                    TriangleInput without = as_soup;
+                    without.edge_apexes = no_apexes;
+                    OcclusionBuffer margin(config);
+                    margin.render_frame(without);
+                    const std::vector<float> margin_claims = test::claimed_inverse_w(margin);
+                    for (int i = 0; i < margin.sample_width(); ++i) EXPECT_EQ(margin_claims[std::size_t(7 * margin.sample_width() + i)], 0.0f) << where;
+                }
     select_isa("best");
-    EXPECT_GT(row_claims_kept, 0);
+    EXPECT_GT(row_claims_kept[0], 0);
+    EXPECT_GT(row_claims_kept[1], 0);
 }
 
 // The ends of margin-free edges (margin_free_edges). Both cases put the sample centre at NDC (0, 0)
@@ -542,7 +566,8 @@ TEST(Conservative, SharedEdgesAtViewSilhouettesKeepTheirMargin) {
 // - a corner on the outline: T's vertex at (1e-30, 1e-30), both of its edges there shared with
 //   neighbours across them, the sample in the vertical angle of T's corner, which no triangle
 //   covers.
-// Each must claim no sample the exact geometry leaves open, on every instruction set.
+// Each must claim no sample the exact geometry leaves open, on every instruction set, with
+// perspective and orthographic projections.
 TEST(Conservative, MarginFreeEdgesClaimNothingPastThinNeighboursOrOutlineCorners) {
     const float e = 0x1.0p-100f, tiny = 1e-30f;
     struct Mesh {
@@ -554,31 +579,37 @@ TEST(Conservative, MarginFreeEdgesClaimNothingPastThinNeighboursOrOutlineCorners
         {"corner on the outline",
          {tiny, tiny, 1, 0.5f, 0.15f, 1, 0.15f, 0.5f, 1, 0.5f, 0.15f, 1, tiny, tiny, 1, 0.5f, -0.4f, 1, tiny, tiny, 1, 0.15f, 0.5f, 1, -0.4f, 0.5f, 1}},
     };
-    const std::array<float, 16> matrix = translated_projection(std::array<float, 3>{0, 0, 0}.data());
-    for (const Mesh& m : meshes) {
-        const std::size_t triangles = m.soup.size() / 9;
-        std::vector<std::uint8_t> flags(triangles);
-        std::vector<std::uint32_t> apexes(3 * triangles);
-        compute_shared_edges(m.soup.data(), 12, 3 * triangles, nullptr, triangles, flags.data(), apexes.data());
-        ASSERT_NE(flags[0], 0u) << m.name;
-        TriangleInput in;
-        in.positions = m.soup.data();
-        in.vertex_count = 3 * triangles;
-        in.triangle_count = triangles;
-        in.model_to_clip = matrix;
-        in.backface = Backface::none;
-        in.shared_edges = flags.data();
-        in.edge_apexes = apexes.data();
-        const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
-        for (const std::string& isa : available_isas()) {
-            select_isa(isa);
-            OcclusionBuffer buffer(test::buffer_config(15, 15, 1, 0.1f));
-            buffer.render_frame(in);
-            std::vector<float> claims = test::claimed_inverse_w(buffer);
-            EXPECT_GT(std::count_if(claims.begin(), claims.end(), [](float d) { return d > 0.0f; }), 5) << m.name << ", " << isa;
-            EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << m.name << ", " << isa;
+    for (const bool orthographic : {false, true})
+        for (const Mesh& m : meshes) {
+            const std::string what = std::string(orthographic ? "orthographic, " : "") + m.name;
+            const std::array<float, 16> matrix = translated_projection(std::array<float, 3>{0, 0, 0}.data(), orthographic);
+            const std::vector<float> soup = positions_for(m.soup, orthographic, 0.1f);
+            const std::size_t triangles = soup.size() / 9;
+            std::vector<std::uint8_t> flags(triangles);
+            std::vector<std::uint32_t> apexes(3 * triangles);
+            compute_shared_edges(soup.data(), 12, 3 * triangles, nullptr, triangles, flags.data(), apexes.data());
+            ASSERT_NE(flags[0], 0u) << what;
+            TriangleInput in;
+            in.positions = soup.data();
+            in.vertex_count = 3 * triangles;
+            in.triangle_count = triangles;
+            in.model_to_clip = matrix;
+            in.backface = Backface::none;
+            in.shared_edges = flags.data();
+            in.edge_apexes = apexes.data();
+            in.orthographic = orthographic;
+            const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
+            for (const std::string& isa : available_isas()) {
+                select_isa(isa);
+                BufferConfig config = test::buffer_config(15, 15, 1, 0.1f);
+                config.orthographic = orthographic;
+                OcclusionBuffer buffer(config);
+                buffer.render_frame(in);
+                std::vector<float> claims = test::claimed_inverse_w(buffer);
+                EXPECT_GT(std::count_if(claims.begin(), claims.end(), [](float d) { return d > 0.0f; }), 5) << what << ", " << isa;
+                EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << what << ", " << isa;
+            }
         }
-    }
     select_isa("best");
 }
 
@@ -603,6 +634,48 @@ TEST(Conservative, ClippedSliversClaimNoSampleAlongTheirFanDiagonals) {
         buffer.render_frame(in);
         EXPECT_EQ(buffer.stats().near_clipped, 1u) << isa;
         EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << isa;
+    }
+    select_isa("best");
+}
+
+// Orthographic extremes, clip (x, y, z) with w = 1: a sliver one float step (6e-8) wide along the
+// diagonal of sample centres crossing the near plane (z = -1), drawn as a clipped fan; a
+// triangle reaching 10^33 behind the near plane; one reaching past twice the far distance
+// (z > 1 - 2^-7, which an orthographic buffer drops). None claims a sample its exact geometry
+// leaves open, on every instruction set and sample count.
+TEST(Conservative, OrthographicExtremesClaimNoSampleOutsideTheOccluders) {
+    struct Triangle {
+        const char* name;
+        std::vector<float> xyz;
+    };
+    const Triangle triangles[] = {
+        {"sliver across the near plane", {-0.9f, 0.9f, -3.0f, 0.9f, -0.9f, 0.5f, std::nextafter(0.9f, 1.0f), -0.9f, 0.5f}},
+        {"10^33 behind the near plane", {-0.5f, -0.5f, -1e33f, 0.5f, -0.5f, 0.0f, 0.0f, 0.5f, 0.0f}},
+        {"past twice the far distance", {-0.7f, -0.6f, 0.99f, 0.6f, -0.5f, 1.5f, 0.0f, 0.7f, 0.98f}},
+    };
+    for (const Triangle& t : triangles) {
+        TriangleInput in;
+        in.positions = t.xyz.data();
+        in.vertex_count = 3;
+        in.triangle_count = 1;
+        in.model_to_clip = translated_projection(std::array<float, 3>{0, 0, 0}.data(), true);
+        in.backface = Backface::none;
+        in.orthographic = true;
+        const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
+        for (const std::string& isa : available_isas()) {
+            select_isa(isa);
+            for (const int samples : {1, 4}) {
+                BufferConfig config = test::buffer_config(16, 16, samples, 0.5f);
+                config.orthographic = true;
+                OcclusionBuffer buffer(config);
+                buffer.render_frame(in);
+                EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << t.name << ", " << isa << ", S = " << samples;
+                if (t.name == triangles[0].name) {
+                    EXPECT_EQ(buffer.stats().near_clipped, 1u) << isa;
+                    EXPECT_EQ(buffer.stats().rasterized, 1u) << isa;
+                }
+            }
+        }
     }
     select_isa("best");
 }

@@ -307,8 +307,8 @@ TEST(EngineHost, RandomOrthographicViewsOnSharedScenesFromAC99Host) { check_rand
 // For every k, the host's walk (a few frames of a part of the castle) with an allocator that
 // fails on its k-th call: every call returns OK or out of memory, every block comes back (the
 // host checks both; under AddressSanitizer, leaks and bad accesses fail it too), and no answer
-// hides what Embree sees.
-TEST(EngineHost, AllocationFailureSweep) {
+// hides what Embree sees. Perspective and orthographic.
+void check_allocation_failure_sweep(bool orthographic) {
     const std::string file = test::shared_scene("intel_castle.glb");
     if (file.empty()) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
     const Scene castle = load_scene(file);
@@ -319,9 +319,11 @@ TEST(EngineHost, AllocationFailureSweep) {
     std::vector<std::uint32_t> occluders = occluder_candidates(castle, OccluderFilter::role);
     occluders.resize(std::min<std::size_t>(occluders.size(), 12));  // a few hundred allocations a run
     HostWalk walk = castle_walk(castle, occluders, walk_path(rays, castle, options));
-    const std::string dir = test::temp_dir("EngineHost.AllocationFailureSweep");
+    const std::string dir = test::temp_dir(orthographic ? "EngineHost.OrthographicAllocationFailureSweep" : "EngineHost.AllocationFailureSweep");
     write_walk(dir + "/castle.walk", castle, walk);
-    const std::string command = std::string(HOMCULL_ENGINE_HOST) + " --fail-sweep " + dir + "/castle.walk " + dir + "/answers";
+    const std::string command = std::string(HOMCULL_ENGINE_HOST) +
+                                (orthographic ? " --orthographic " + std::to_string(kOrthographicDistance) : std::string()) + " --fail-sweep " +
+                                dir + "/castle.walk " + dir + "/answers";
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
     std::uint32_t runs, frames, boxes;
     const std::vector<std::uint8_t> answers = read_answers(dir + "/answers", runs, frames, boxes);
@@ -329,9 +331,12 @@ TEST(EngineHost, AllocationFailureSweep) {
     ASSERT_EQ(frames, walk.cameras.size());
     ASSERT_EQ(boxes, castle.objects.size());
     std::size_t culled = 0;
-    EXPECT_EQ(false_culls(rays, castle, walk, answers, runs, culled), 0u);
+    EXPECT_EQ(false_culls(rays, castle, walk, answers, runs, culled, orthographic), 0u);
     EXPECT_GT(culled, 0u);  // the runs whose allocations all succeeded cull something
 }
+
+TEST(EngineHost, AllocationFailureSweep) { check_allocation_failure_sweep(false); }
+TEST(EngineHost, OrthographicAllocationFailureSweep) { check_allocation_failure_sweep(true); }
 
 }  // namespace
 }  // namespace homcull

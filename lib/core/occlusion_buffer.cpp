@@ -53,7 +53,8 @@ void prefetch_triangle(const detail::RasterTriangle& tri) {
 // wave_triangles_ (kChunkRoom each), and per band the numbers of those the band reaches, in
 // order, in its slot of wave_entries_ (kChunkRoom per band: a band reaches each triangle at most
 // once). Everything has a fixed size, so that the tasks never allocate. (Copying each triangle
-// into the bin of every band it reaches instead reads better, but needs room without bound.)
+// into a bin of every band it reaches reads better, castle C0 at 1080p on two threads 5 % faster,
+// but needs room without bound, and the bins grew inside the tasks.)
 struct detail::BufferState::Chunk {
     RasterStats stats;
     std::uint32_t count = 0;  // triangles set up into the room
