@@ -351,6 +351,29 @@ TEST(SceneCulling, TemporalDrawsAnOccluderThatComesIntoViewAtOnce) {
     EXPECT_EQ(temporal.work().renders, 2u);  // the second pass
 }
 
+// An orthographic camera is refused with an error that names it, not answered as a perspective
+// one (its w = 1 everywhere would cull nothing, silently); the culler stays usable.
+TEST(SceneCulling, OrthographicCamerasAreRefused) {
+    Scene scene;
+    const std::uint32_t wall = test::add_quad(scene, "wall", {-1, -1, -5}, {1, -1, -5}, {1, 1, -5}, {-1, 1, -5});
+    const std::uint32_t box = test::add_box(scene, "box", {-0.5f, -0.5f, -15.5f}, {0.5f, 0.5f, -14.5f});
+    scene.finalize();
+    SceneCullerConfig config;
+    config.display = {64, 64};
+    SceneCuller culler(scene, {wall}, config);
+    Camera ortho = test::camera_down_minus_z(60.0);
+    ortho.ortho_height = 4.0;
+    std::vector<OccludeeAnswer> answers;
+    try {
+        culler.cull(ortho, answers);
+        ADD_FAILURE() << "an orthographic camera was culled with";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("orthographic"), std::string::npos) << e.what();
+    }
+    culler.cull(test::camera_down_minus_z(60.0), answers);
+    EXPECT_EQ(answers[box].visibility, Visibility::occluded);
+}
+
 TEST(SceneCulling, TemporalFirstFrameIsOnePassAndResetForgets) {
     const Scene scene = generate_scene("city:seed=3,blocks=5");
     const std::vector<std::uint32_t> candidates = occluder_candidates(scene, OccluderFilter::role);

@@ -130,6 +130,9 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
 void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     validate_camera(camera);
+    if (camera.ortho_height > 0.0)
+        throw Error("scene culler: orthographic cameras are not supported (its occlusion maps compare perspective depths); the "
+                    "occlusion buffer and the C interface take orthographic projections");
     // The near plane is the camera's: rebuild the buffer only when it changes.
     if (buffer_.config().near_w != float(camera.near_plane)) {
         buffer_ = OcclusionBuffer(scene_buffer_config(config_, float(camera.near_plane)));

@@ -122,7 +122,9 @@ public:
 
     // answers[id] for every object of the scene (objects without geometry are view-culled).
     // overlap_exit is the deciding box test's (the object's own, or the hidden node's above
-    // it); an object its triangles found hidden reports level of visibility 0.
+    // it); an object its triangles found hidden reports level of visibility 0. Throws
+    // homcull::Error on an invalid or orthographic camera (validate_camera; the occlusion maps
+    // compare perspective depths).
     void cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
     // temporal: forget the last frame (after a camera cut), so that the next frame works as
     // one_pass.
