@@ -284,7 +284,8 @@ void check_random_views_from_c99_host(bool orthographic) {
         const Scene scene = translated_scene(load_scene(file), c.offset);
         const RayScene rays(scene);
         const HostWalk walk = castle_walk(scene, occluder_candidates(scene, OccluderFilter::size), random_views(rays, scene, 8, 11), {643, 359});
-        const std::string dir = test::temp_dir("EngineHost.RandomViews");
+        // A folder of its own: the perspective and orthographic tests may run at once (ctest -j).
+        const std::string dir = test::temp_dir(orthographic ? "EngineHost.RandomOrthographicViews" : "EngineHost.RandomViews");
         write_walk(dir + "/views.walk", scene, walk);
         const std::string command = std::string(HOMCULL_ENGINE_HOST) +
                                     (orthographic ? " --orthographic " + std::to_string(kOrthographicDistance) + " " : " ") + dir +
