@@ -84,11 +84,11 @@ ln -s /usr/include/hwy "$tmp/include/hwy"
 ln -s /usr/include/glm "$tmp/include/glm"
 
 # --- Sources of homcull_core, from lib/CMakeLists.txt ----------------------------------------
-# The words between "add_library(homcull_core" and the first ")" after it.
-mapfile -t sources < <(sed -n '/add_library(homcull_core\b/,/)/p' lib/CMakeLists.txt |
-  sed -e 's/.*add_library(homcull_core//' -e 's/).*//' -e 's/#.*//' | tr -s ' \t' '\n' | grep -v '^$' || true)
+# The .cpp files of the layers: every homcull_layer(...) call, up to "set(homcull_layers".
+mapfile -t sources < <(sed -n '/^homcull_layer(common/,/^set(homcull_layers/p' lib/CMakeLists.txt |
+  sed -e 's/#.*//' | tr -s ' \t()' '\n' | grep '\.cpp$' || true)
 if [ "${#sources[@]}" -eq 0 ]; then
-  echo "check-neon: found no sources in add_library(homcull_core ...) in lib/CMakeLists.txt" >&2
+  echo "check-neon: found no layer sources (homcull_layer(...)) in lib/CMakeLists.txt" >&2
   exit 1
 fi
 simd_source=raster/rasterize_simd.cpp

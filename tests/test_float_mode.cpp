@@ -1,8 +1,8 @@
-// The library computes in IEEE round-to-nearest with subnormals kept (core/float_mode.hpp),
+// The library computes in IEEE round-to-nearest with subnormals kept (common/float_mode.hpp),
 // whatever floating-point mode the calling thread or the job system's threads run in: the same
 // bits with flush-to-zero, denormals-are-zero or rounding toward zero set, and each thread's
 // mode given back.
-#include "core/float_mode.hpp"
+#include "common/float_mode.hpp"
 #include "support.hpp"
 
 #include <homcull/occlusion_buffer.hpp>

@@ -1,7 +1,7 @@
 // Occludee tests on every instruction set: single rectangle tests, batches of rectangles and
 // batches of boxes all give the answers of the exhaustive scalar definition, including for
 // invalid, huge, inverted and off-screen input.
-#include "core/min_pyramid.hpp"
+#include "buffer/min_pyramid.hpp"
 #include "support.hpp"
 
 #include <homcull/occlusion_buffer.hpp>

@@ -1,7 +1,7 @@
 // OcclusionBuffer::test_triangles: occludee triangles tested sample by sample. Hand-built
 // cases for each answer, a hole counted sample by sample, bad input, and a brute-force check on
 // random triangles that the test never hides a triangle seen at a sample of the buffer.
-#include "core/occludee_depth.hpp"
+#include "buffer/occludee_depth.hpp"
 #include "support.hpp"
 
 #include <homcull/error.hpp>

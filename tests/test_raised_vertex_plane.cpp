@@ -1,11 +1,11 @@
-// The raised-vertex depth bound (lib/core/raised_vertex_plane.hpp) on its own: random screen
+// The raised-vertex depth bound (lib/buffer/raised_vertex_plane.hpp) on its own: random screen
 // triangles, many of them thin or nearly edge-on, whose vertices are moved to the corners of
 // their allowed boxes (on screen and in depth). The moved triangle's depth, exact in long
 // double, must stay under the bound at every sample centre it covers, some of them outside our
 // triangle. Fails when the bound drops the vertices' depth error or the gradient times their
 // screen error; not when it drops the term for negative barycentrics, which the gradient term
 // covered in every case tried.
-#include "core/raised_vertex_plane.hpp"
+#include "buffer/raised_vertex_plane.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 
 #include <homcull/aabb.hpp>
 
-#include "core/rect_tests.hpp"  // box_rectangle
+#include "buffer/rect_tests.hpp"  // box_rectangle
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 // Every object is placed in memory from the engine's allocator, and everything it holds is made
 // inside a MemoryScope of its own account (homcull/detail/memory.hpp): its containers keep that
 // account's hooks for life. Entry points run under the context's instruction set
-// (raster/isa_choice.hpp). Errors found here are reported without throwing (report()); those
+// (common/isa_choice.hpp). Errors found here are reported without throwing (report()); those
 // thrown by the C++ library are caught at the entry point (guarded()), so none reaches the caller.
 #include <homcull/homcull.h>
 
@@ -12,7 +12,7 @@
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
-#include "raster/isa_choice.hpp"
+#include "common/isa_choice.hpp"
 
 #include <glm/mat4x4.hpp>
 

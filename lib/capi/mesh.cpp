@@ -2,7 +2,7 @@
 // the mesh's account, so that all of it comes from the engine's allocator.
 #include "capi/c_objects.hpp"
 
-#include "core/float_mode.hpp"
+#include "common/float_mode.hpp"
 
 #include <algorithm>
 #include <cmath>

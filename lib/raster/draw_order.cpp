@@ -1,6 +1,6 @@
 #include "raster/draw_order.hpp"
 
-#include "core/run_tasks.hpp"
+#include "common/run_tasks.hpp"
 
 #include "raster/triangle_setup.hpp"
 

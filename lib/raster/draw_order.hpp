@@ -15,7 +15,8 @@
 #include "raster/triangle_batch.hpp"
 
 #include <homcull/detail/memory.hpp>
-#include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
+#include <homcull/triangle_input.hpp>
 
 #include <cstdint>
 #include <vector>
@@ -110,7 +111,7 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // first pass also notes each of its triangles for the reference cells (bucket_packed_soup);
 // the second copies each note, with its triangle's number, into its place: list->notes, 12
 // bytes a triangle (list->order null), so that the render reads the notes in order and drops
-// most hidden triangles without reading them (OcclusionBuffer::draw_noted_part). Read through
+// most hidden triangles without reading them (BufferState::draw_noted_part). Read through
 // a list of numbers, the notes took about 1.0 ms of S1's 5.9 on one thread; in order, in
 // vectors (DropHiddenKernel), about 0.3, and every part of the rows reads all of them
 // (render_parts). Otherwise list->notes is null. may_list false (a render with a job system):

@@ -12,7 +12,7 @@
 
 #include "raster/clip_fates-inl.h"
 #include "raster/draw_order.hpp"
-#include "raster/lane_bits-inl.h"
+#include "common/lane_bits-inl.h"
 #include "raster/reference_cells.hpp"
 
 #include <algorithm>
@@ -251,7 +251,7 @@ void BucketIndexed(const float* positions, std::size_t stride, int components, c
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "raster/resolved_kernel.hpp"
+#include "common/resolved_kernel.hpp"
 
 namespace homcull::detail {
 

@@ -22,7 +22,7 @@
 namespace homcull::detail {
 namespace {
 
-constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+constexpr int kW = kSubtileWidth, kH = kSubtileHeight;
 
 // floor and ceil of doubles well inside the int range (sample coordinates stay within the guard
 // band), exact, without a libm call.

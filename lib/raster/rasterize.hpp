@@ -3,7 +3,12 @@
 // preparation and the per-row coverage intervals are shared; the per-subtile work of a subtile
 // row (masks, depth bound, layer update) has a plain scalar reference and SIMD kernels
 // (rasterize_simd.cpp) that must give the same bits.
-#include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
+#include <homcull/triangle_input.hpp>
+
+#include <glm/glm.hpp>
+
+#include "common/float_round.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +17,10 @@
 #include <limits>
 
 namespace homcull::detail {
+
+// A subtile: 8 x 4 samples, one 32-bit coverage mask (OcclusionBuffer::kSubtileWidth and
+// kSubtileHeight, the buffer's layout).
+constexpr int kSubtileWidth = 8, kSubtileHeight = 4;
 
 // A triangle in sample space (x right, y down, in samples) with depth d = 1/w per vertex.
 struct ScreenTriangle {
@@ -33,7 +42,7 @@ struct RasterTriangle;
 using TriangleRowsKernel = std::uint64_t (*)(const RasterTarget& target, const RasterTriangle& triangle);
 
 // The widest SIMD vector the kernels use, in 32-bit lanes: subtile rows are padded so that a
-// vector of this many subtiles loads and stores within the row (see OcclusionBuffer::stride_).
+// vector of this many subtiles loads and stores within the row (see BufferState::stride_).
 constexpr int kMaxSimdLanes = 16;
 
 // The buffer's subtile planes (OcclusionBuffer's layout): element (tx, ty) at ty * stride + tx.
@@ -59,7 +68,7 @@ struct RasterTarget {
 // [row_begin, row_end) (a target's, or a band's); false when there are none. The one clamp of
 // the row loops, the setup's hidden test and the clustered render's band test.
 inline bool subtile_rows_within(int j0, int j1, int row_begin, int row_end, int& ty0, int& ty1) {
-    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kH = kSubtileHeight;
     ty0 = std::max(j0 / kH, row_begin);
     ty1 = std::min(j1 / kH, row_end - 1);
     return ty0 <= ty1;
@@ -145,7 +154,7 @@ bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1
 // nearest_conservative_depth of a triangle over its samples in subtile rows [ty0, ty1] (its
 // columns [i0, i1], its rows [j0, j1] within those): what the row loops test a chunk with.
 inline float chunk_nearest_depth(const PreparedTriangle& tri, int i0, int i1, int j0, int j1, int ty0, int ty1) {
-    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kH = kSubtileHeight;
     return nearest_conservative_depth(tri, i0, i1, std::max(j0, ty0 * kH), std::min(j1, ty1 * kH + kH - 1));
 }
 
@@ -239,7 +248,7 @@ void subtile_row_intervals(const TriangleEdges* edges, int ty, int i0, int i1, i
 // and the columns and rows (within the subtile) of their bounding rectangle; mask 0 when none.
 struct SubtileCoverage {
     std::uint32_t mask = 0;
-    int column_lo = OcclusionBuffer::kSubtileWidth, column_hi = -1, row_lo = OcclusionBuffer::kSubtileHeight, row_hi = -1;
+    int column_lo = kSubtileWidth, column_hi = -1, row_lo = kSubtileHeight, row_hi = -1;
 };
 SubtileCoverage subtile_coverage(const std::int32_t first[4], const std::int32_t last[4], int tx);
 
@@ -248,35 +257,6 @@ SubtileCoverage subtile_coverage(const std::int32_t first[4], const std::int32_t
 // of subtiles updated.
 std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, int tx_begin, int tx_end, const std::int32_t first[4],
                                            const std::int32_t last[4], const PreparedTriangle& tri, int sample_width, int sample_height);
-
-// The float next to a finite f towards +infinity (up) or -infinity, by one step of its bits
-// (what std::nextafter does, without the library call these hot paths would pay).
-inline float float_step(float f, bool up) {
-    if (f == 0.0f) return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
-    std::uint32_t bits;
-    std::memcpy(&bits, &f, sizeof bits);
-    bits = (up == (f > 0.0f)) ? bits + 1u : bits - 1u;  // away from zero: larger magnitude
-    std::memcpy(&f, &bits, sizeof bits);
-    return f;
-}
-
-// float(v) rounded towards -infinity / +infinity: bounds that must stay on one side of a double
-// (rectangles rounded outwards, depths towards the eye). Beyond the float range the result is
-// the largest float or infinity on the safe side; NaN stays NaN.
-inline float float_down(double v) {
-    constexpr double kMax = std::numeric_limits<float>::max();
-    if (!(v >= -kMax)) return v > 0.0 || v != v ? float(v) : -std::numeric_limits<float>::infinity();  // NaN, or below the range
-    if (v > kMax) return std::numeric_limits<float>::max();
-    const float f = float(v);
-    return double(f) > v ? float_step(f, false) : f;
-}
-inline float float_up(double v) {
-    constexpr double kMax = std::numeric_limits<float>::max();
-    if (!(v <= kMax)) return v != v ? float(v) : std::numeric_limits<float>::infinity();  // NaN, or above the range
-    if (v < -kMax) return -std::numeric_limits<float>::max();
-    const float f = float(v);
-    return double(f) < v ? float_step(f, true) : f;
-}
 
 // Bit count without a library call (the baseline x86-64 target has no popcnt instruction).
 inline std::uint32_t bit_count(std::uint32_t v) {
@@ -287,7 +267,7 @@ inline std::uint32_t bit_count(std::uint32_t v) {
 
 // The mask of subtile (tx, ty)'s samples that lie in the sample range [i0, i1] x [j0, j1].
 inline std::uint32_t subtile_rect_bits(int tx, int ty, int i0, int i1, int j0, int j1) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kW = kSubtileWidth, kH = kSubtileHeight;
     const int c0 = std::max(0, i0 - tx * kW), c1 = std::min(kW - 1, i1 - tx * kW);
     const int r0 = std::max(0, j0 - ty * kH), r1 = std::min(kH - 1, j1 - ty * kH);
     if (c0 > c1 || r0 > r1) return 0;
@@ -321,9 +301,9 @@ inline void sample_span(double lo, double hi, int count, int& first, int& last) 
 // [first[j], last[j]] reach, within the triangle's columns [i0, i1]; false when none.
 inline bool reached_subtile_columns(const std::int32_t first[4], const std::int32_t last[4], int i0, int i1, int& tx_begin,
                                     int& tx_end) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth;
+    constexpr int kW = kSubtileWidth;
     int reach_lo = i1 + 1, reach_hi = i0 - 1;
-    for (int j = 0; j < OcclusionBuffer::kSubtileHeight; ++j)
+    for (int j = 0; j < kSubtileHeight; ++j)
         if (first[j] <= last[j]) {
             reach_lo = std::min(reach_lo, int(first[j]));
             reach_hi = std::max(reach_hi, int(last[j]));
@@ -357,7 +337,7 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& target, const RasterT
 void set_hidden_skip(bool enabled);
 bool hidden_skip_enabled();
 
-// The kernel for the selected instruction set (see select_isa in occlusion_buffer.hpp).
+// The kernel for the selected instruction set (see select_isa in homcull/isa.hpp).
 TriangleRowsKernel selected_rows_kernel();
 // hidden_behind_reference_layer for the selected instruction set: the SIMD row loop's test
 // (a vector of subtiles per step, the same comparisons, so the same answer), or the scalar one.
@@ -370,7 +350,5 @@ HiddenTestKernel selected_hidden_test();
 using RowIntervalsKernel = void (*)(const TriangleEdges& edges, int i0, int i1, int j0, int j1, int row0, int rows,
                                     std::int32_t* first, std::int32_t* last);
 RowIntervalsKernel selected_row_intervals_kernel();
-// Whether select_isa chose the plain scalar reference paths.
-bool scalar_reference_selected();
 
 }  // namespace homcull::detail

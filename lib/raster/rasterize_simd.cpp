@@ -108,7 +108,7 @@ template <int kRows>
 HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, const std::int32_t* first, const std::int32_t* last,
                                            int i0, int i1, const PreparedTriangle& tri, int sample_width, int sample_height) {
     static_assert(kRows == 1 || kRows == 2 || kRows == 4, "one, two or four subtile rows");
-    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kW = kSubtileWidth, kH = kSubtileHeight;
     // The byte transpose below takes subtiles of 4 rows of 8 samples (a byte per sample row),
     // 4 of them (32 samples) per 128-bit block.
     static_assert(kW == 8 && kH == 4, "the transpose assumes 8 x 4 subtiles");
@@ -252,10 +252,10 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
 // evaluates conservative_depth with the same float operations (the row's part, a + dzdy y,
 // once per row: the same rounding for every sample) and keeps the larger. Whole vectors are
 // loaded and stored; lanes past the interval write back what they read, within the row and
-// its padding (OcclusionBuffer::sample_depth_stride_), which no other band touches.
+// its padding (BufferState::sample_depth_stride_), which no other band touches.
 HWY_INLINE void UpdateSampleDepth(const SubtilePlanes& planes, int ty, const std::int32_t* first, const std::int32_t* last,
                                   const PreparedTriangle& tri, hn::Vec<hn::CappedTag<std::int32_t, kMaxSimdLanes>> lane) {
-    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kH = kSubtileHeight;
     const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many (sample_depth_stride_)
     const hn::RebindToSigned<decltype(df)> di;
     const int lanes = int(hn::Lanes(df));
@@ -412,12 +412,12 @@ bool HiddenBehindReferenceLayerKernel(const SubtilePlanes& planes, int tx0, int 
 std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangle) {
     const PreparedTriangle& tri = triangle.plane;
     const int i0 = triangle.i0, i1 = triangle.i1, j1 = triangle.j1;
-    constexpr int kH = OcclusionBuffer::kSubtileHeight;
+    constexpr int kH = kSubtileHeight;
     int ty_first, ty_last;
     if (!subtile_rows_within(triangle.j0, j1, t.row_begin, t.row_end, ty_first, ty_last)) return 0;
     const auto sample_lane = hn::Iota(hn::CappedTag<std::int32_t, kMaxSimdLanes>(), 0);
 
-    constexpr int kChunkRows = kChunkSubtileRows * kH, kW = OcclusionBuffer::kSubtileWidth;
+    constexpr int kChunkRows = kChunkSubtileRows * kH, kW = kSubtileWidth;
 #if HOMCULL_SUBTILE_LANES
     // How many subtile rows one update vector takes: rows of 8 subtiles, or of 4 for a triangle
     // that spans at most 4 subtile columns (the castle's small triangles filled 4 of 16 lanes
@@ -469,8 +469,8 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 #include <homcull/error.hpp>
 
-#include "raster/isa_choice.hpp"
-#include "raster/resolved_kernel.hpp"
+#include "common/isa_choice.hpp"
+#include "common/resolved_kernel.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -486,21 +486,7 @@ HWY_EXPORT(HiddenBehindReferenceLayerKernel);
 HWY_EXPORT(RowIntervals);
 
 namespace {
-
-// The selected kernel: the reference, or Highway's choice among the allowed targets.
-std::atomic<bool> use_reference{false};
 std::atomic<bool> skip_hidden{true};
-
-struct NamedTarget {
-    const char* name;
-    std::int64_t bits;
-};
-// Best first, as Highway prefers them. sve2_128 and sve_256 are Highway's builds for SVE
-// vectors of exactly 128 (with SVE2) and 256 bits: the CPU supports them only at that length.
-const NamedTarget kTargets[] = {{"avx512", HWY_AVX3},      {"avx2", HWY_AVX2},       {"sse4", HWY_SSE4}, {"sve2_128", HWY_SVE2_128},
-                                {"sve_256", HWY_SVE_256},  {"sve2", HWY_SVE2},       {"sve", HWY_SVE},   {"neon", HWY_NEON},
-                                {"emu128", HWY_EMU128}};
-
 }  // namespace
 
 TriangleRowsKernel selected_rows_kernel() {
@@ -510,108 +496,9 @@ HiddenTestKernel selected_hidden_test() {
     return scalar_reference_selected() ? &hidden_behind_reference_layer : HOMCULL_RESOLVED_KERNEL(HiddenBehindReferenceLayerKernel);
 }
 RowIntervalsKernel selected_row_intervals_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(RowIntervals); }
-bool scalar_reference_selected() {
-    const IsaChoice* choice = current_isa_choice();
-    return choice ? choice->scalar : use_reference.load();
-}
-
-namespace {
-thread_local const IsaChoice* current_choice = nullptr;
-}  // namespace
-
-const IsaChoice* current_isa_choice() noexcept { return current_choice; }
-IsaScope::IsaScope(const IsaChoice* choice) noexcept : previous_(current_choice) { current_choice = choice; }
-IsaScope::~IsaScope() { current_choice = previous_; }
 void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
 bool hidden_skip_enabled() { return skip_hidden; }
 
 }  // namespace detail
-
-namespace {
-
-// The CPU's own targets, read once, before select_isa forces one: while a target is forced,
-// Highway's SupportedTargets() returns only that one. (Lifting the force to read them again
-// would change what renders and queries on other threads dispatch to.)
-std::int64_t cpu_targets() {
-    static const std::int64_t cpu = hwy::SupportedTargets();
-    return cpu;
-}
-
-}  // namespace
-
-std::vector<std::string> available_isas() {
-    std::vector<std::string> names = {"scalar"};
-    const std::int64_t supported = cpu_targets();
-    for (const auto& t : detail::kTargets)
-        if ((HWY_TARGETS & t.bits) && (supported & t.bits)) names.push_back(t.name);
-    return names;
-}
-
-namespace {
-
-// The Highway target bits of a name ("best": 0), or throws. `scalar` tells the reference paths.
-std::int64_t target_bits(const std::string& name, bool& scalar) {
-    scalar = name == "scalar";
-    if (scalar || name == "best") return 0;
-    const auto t = std::find_if(std::begin(detail::kTargets), std::end(detail::kTargets), [&](const auto& k) { return name == k.name; });
-    if (t == std::end(detail::kTargets)) {
-        std::string known;
-        for (const std::string& n : available_isas()) known += (known.empty() ? "" : ", ") + n;
-        throw Error("unknown instruction set '" + name + "' (available: best, " + known + ")");
-    }
-    if (!(HWY_TARGETS & t->bits) || !(cpu_targets() & t->bits))
-        throw Error("instruction set '" + name + "' is not available on this machine or in this build");
-    return t->bits;
-}
-
-}  // namespace
-
-// Checks the name first: a name that cannot be selected throws and leaves the selection as it was.
-void select_isa(const std::string& name) {
-    bool scalar = false;
-    const std::int64_t bits = target_bits(name, scalar);
-    detail::use_reference = scalar;
-    if (scalar) return;  // the SIMD targets stay as they were: the scalar paths do not dispatch
-    hwy::SetSupportedTargetsForTest(bits);
-}
-
-namespace detail {
-
-bool isa_available(const char* name) noexcept {
-    if (std::strcmp(name, "best") == 0 || std::strcmp(name, "scalar") == 0) return true;
-    for (const auto& t : kTargets)
-        if (std::strcmp(name, t.name) == 0) return (HWY_TARGETS & t.bits) && (cpu_targets() & t.bits);
-    return false;
-}
-
-// The dispatch-table entry comes from a ChosenTarget of our own, updated to the one target (or
-// to every target the CPU has, for "best"): the process-wide one is left alone.
-IsaChoice make_isa_choice(const std::string& name) {
-    IsaChoice choice;
-    const std::int64_t bits = target_bits(name, choice.scalar);
-    const std::int64_t targets = bits ? bits : cpu_targets();
-    hwy::ChosenTarget chosen;
-    chosen.Update(targets);
-    choice.table_index = int(chosen.GetIndex());
-    choice.name = "scalar";
-    if (!choice.scalar)
-        for (const auto& t : kTargets)
-            if (HWY_TARGETS & targets & t.bits) {
-                choice.name = t.name;  // the best one the table will give
-                break;
-            }
-    return choice;
-}
-
-}  // namespace detail
-
-std::string selected_isa() {
-    if (detail::use_reference) return "scalar";
-    const std::int64_t target = hwy::SupportedTargets() & HWY_TARGETS;
-    for (const auto& t : detail::kTargets)
-        if (target & t.bits) return t.name;  // the best one Highway will dispatch to
-    return "unknown";
-}
-
 }  // namespace homcull
 #endif  // HWY_ONCE

@@ -3,7 +3,7 @@
 // cell of 8 x 8 subtiles (64 x 32 samples; 30 x 34 cells, 4 KB, at 1080p). With the notes the
 // draw order takes of a clip-space soup (CellRecord below), the render drops most hidden
 // triangles from their note and a few cells in L1, without reading the triangle, setting it up
-// or reading some ten rows of d0 (OcclusionBuffer::draw_noted_part, on one thread for the whole
+// or reading some ten rows of d0 (BufferState::draw_noted_part, on one thread for the whole
 // buffer, with a job system for each part of its rows): on S1 at 1080p about 80,000 of 100,000
 // triangles.
 //

@@ -99,7 +99,7 @@ std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "raster/resolved_kernel.hpp"
+#include "common/resolved_kernel.hpp"
 
 namespace homcull::detail {
 

@@ -2,7 +2,7 @@
 // from position A to position B and the other from B to A (consistent winding), bit for bit.
 #include <homcull/detail/memory.hpp>
 #include <homcull/error.hpp>
-#include <homcull/occlusion_buffer.hpp>
+#include <homcull/triangle_input.hpp>
 
 #include <array>
 #include <cstdint>

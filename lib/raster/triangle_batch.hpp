@@ -17,7 +17,8 @@
 #include "raster/shared_edge_rule.hpp"
 #include "raster/triangle_setup.hpp"
 
-#include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
+#include <homcull/triangle_input.hpp>
 
 #include <algorithm>
 #include <cstddef>
@@ -188,7 +189,7 @@ FrontEndKernels selected_front_end_kernels();
 // fewer subtiles): not drawing it changes no bit. A lane without area or with an empty box is
 // never called hidden: assembly rejects it, and its plane may be NaN.
 inline bool hidden_in_target(const BatchSetup& setup, int t, const RasterTarget& target, HiddenTestKernel hidden_test) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth;
+    constexpr int kW = kSubtileWidth;
     if (setup.area2[t] == 0.0 || setup.i0[t] > setup.i1[t] || setup.j0[t] > setup.j1[t]) return false;  // assembly rejects it
     int ty0, ty1;
     return !subtile_rows_within(setup.j0[t], setup.j1[t], target.row_begin, target.row_end, ty0, ty1) || hidden_test(target.planes, setup.i0[t] / kW, setup.i1[t] / kW, ty0, ty1, setup.nearest[t]);

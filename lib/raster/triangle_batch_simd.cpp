@@ -10,8 +10,8 @@
 #include <hwy/highway.h>
 
 #include "raster/clip_fates-inl.h"
-#include "raster/float_outward-inl.h"
-#include "raster/lane_bits-inl.h"
+#include "common/float_outward-inl.h"
+#include "common/lane_bits-inl.h"
 #include "raster/triangle_batch.hpp"
 
 #include <cstdint>
@@ -410,7 +410,7 @@ void SetupEdges(int count, double edge_margin, std::uint32_t silhouette_only, st
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "raster/resolved_kernel.hpp"
+#include "common/resolved_kernel.hpp"
 
 namespace homcull::detail {
 

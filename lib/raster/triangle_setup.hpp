@@ -3,7 +3,8 @@
 // rejection, near-plane and guard-band clipping, backface culling, projection to sample space.
 #include "raster/rasterize.hpp"
 
-#include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
+#include <homcull/triangle_input.hpp>
 
 #include <cmath>
 #include <limits>
@@ -51,7 +52,7 @@ inline glm::dvec4 transform_to_clip(const std::array<float, 16>& m, double x, do
 
 // The plain sum of the same products, ((m x + m y) + m z) + m w: off by up to 3 * 2^-53 of
 // the terms' magnitudes. For the occludee tests, which pad every vertex by 2^-22 of that
-// magnitude anyway (clip_error in core/occludee_triangles.cpp) and so need no more; their
+// magnitude anyway (clip_error in buffer/occludee_triangles.cpp) and so need no more; their
 // transform is most of what they cost (castle C0's occludee tests: about 15 % slower with Sum2).
 inline glm::dvec4 transform_to_clip_plain(const std::array<float, 16>& m, double x, double y, double z, double w) {
     glm::dvec4 r;

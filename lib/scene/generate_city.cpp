@@ -1,7 +1,7 @@
 // A city of box buildings on a street grid: the classic urban walkthrough of the occlusion
 // culling literature (large, well-fused occluders; most of the city hidden from street level).
 #include "scene/primitives.hpp"
-#include "scene/random.hpp"
+#include "common/random.hpp"
 
 #include <homcull/error.hpp>
 #include <homcull/generate.hpp>

@@ -2,7 +2,7 @@
 // hidden by the fusion of many (Zhang 1998, ch. 1: "occluder fusion"), which is what the
 // opacity pyramid is for and what per-occluder shadow-frusta methods miss.
 #include "scene/primitives.hpp"
-#include "scene/random.hpp"
+#include "common/random.hpp"
 
 #include <homcull/error.hpp>
 #include <homcull/generate.hpp>

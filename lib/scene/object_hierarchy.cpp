@@ -2,7 +2,7 @@
 
 #include <homcull/error.hpp>
 
-#include "core/float_mode.hpp"
+#include "common/float_mode.hpp"
 
 #include <algorithm>
 #include <array>

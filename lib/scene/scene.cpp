@@ -1,7 +1,7 @@
 #include <homcull/error.hpp>
 #include <homcull/scene.hpp>
 
-#include "raster/rasterize.hpp"  // float_down, float_up
+#include "common/float_round.hpp"  // float_down, float_up
 
 #include <cmath>
 #include <string>

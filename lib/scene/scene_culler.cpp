@@ -5,7 +5,7 @@
 
 #include "scene/scene_culler_state.hpp"
 
-#include "core/float_mode.hpp"
+#include "common/float_mode.hpp"
 #include "scene/scene_culler_frame.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>

@@ -4,8 +4,7 @@
 
 #include "scene/scene_culler_state.hpp"
 
-#include "core/rect_tests.hpp"
-#include "raster/rasterize.hpp"
+#include "common/float_round.hpp"
 #include "scene/scene_culler_frame.hpp"
 
 #include <algorithm>

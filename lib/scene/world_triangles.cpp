@@ -1,6 +1,6 @@
 #include <homcull/world_triangles.hpp>
 
-#include "core/float_mode.hpp"
+#include "common/float_mode.hpp"
 
 namespace homcull {
 

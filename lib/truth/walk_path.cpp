@@ -1,5 +1,5 @@
 // Walkthrough paths: a walker at eye height that feels its way through the scene with rays.
-#include "scene/random.hpp"
+#include "common/random.hpp"
 
 #include <homcull/error.hpp>
 #include <homcull/truth/walk_path.hpp>

@@ -22,7 +22,7 @@
 
 namespace homcull {
 namespace detail {
-class MapsState;  // lib/core/maps_state.hpp
+class MapsState;  // lib/hom/maps_state.hpp
 }
 
 enum class DepthTest : std::uint8_t {
@@ -142,7 +142,7 @@ public:
     // covered, and when the maps make no hzb pyramid.
     float plane_depth() const;
 
-    // The implementation (lib/core/maps_state.hpp): not part of the interface.
+    // The implementation (lib/hom/maps_state.hpp): not part of the interface.
     const detail::MapsState& state() const { return *state_; }
 
     // Moves leave the source with no state: it may then only be assigned to or destroyed.

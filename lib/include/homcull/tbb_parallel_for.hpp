@@ -2,7 +2,7 @@
 // A ParallelFor backed by oneTBB, for the tools and for engines without a job system of
 // their own (target homcull::tbb). Thread count: TBB's when it is called, within any
 // tbb::global_control limit then in force (ParallelFor::threads).
-#include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
 
 namespace homcull {
 

@@ -3,7 +3,7 @@
 // code; the C interface (homcull.h) makes its objects inside a MemoryScope holding the engine's
 // allocator, and every container made there keeps that allocator for its whole life (a stateful
 // allocator, as std::pmr's), whichever thread later grows or frees it. Tasks run through the
-// caller's job system carry the caller's scope (core/run_tasks.hpp). So every byte an object of
+// caller's job system carry the caller's scope (common/run_tasks.hpp). So every byte an object of
 // the C interface uses comes from the engine, by construction: the containers have no other way
 // to allocate.
 #include <cstddef>

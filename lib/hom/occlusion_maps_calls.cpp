@@ -1,6 +1,6 @@
-// OcclusionMaps' calls, each forwarded to its state (core/maps_state.hpp), where the
+// OcclusionMaps' calls, each forwarded to its state (hom/maps_state.hpp), where the
 // implementation lives (occlusion_maps.cpp, occlusion_maps_depth.cpp).
-#include "core/maps_state.hpp"
+#include "hom/maps_state.hpp"
 
 namespace homcull {
 

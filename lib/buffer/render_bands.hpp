@@ -3,7 +3,7 @@
 // clustered_render.cpp), and the clustered render's per-frame record of a cluster.
 #include <homcull/occlusion_buffer.hpp>
 
-#include "core/buffer_state.hpp"
+#include "buffer/buffer_state.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>

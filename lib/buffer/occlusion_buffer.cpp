@@ -1,10 +1,10 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
-#include "core/buffer_state.hpp"
-#include "core/float_mode.hpp"
-#include "core/render_bands.hpp"
-#include "core/run_tasks.hpp"
+#include "buffer/buffer_state.hpp"
+#include "common/float_mode.hpp"
+#include "buffer/render_bands.hpp"
+#include "common/run_tasks.hpp"
 #include "raster/draw_order.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/reference_cells.hpp"

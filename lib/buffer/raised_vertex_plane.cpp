@@ -1,5 +1,5 @@
 // The raised-vertex depth bound of an occludee triangle: see raised_vertex_plane.hpp.
-#include "core/raised_vertex_plane.hpp"
+#include "buffer/raised_vertex_plane.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
-#include "core/float_mode.hpp"
+#include "common/float_mode.hpp"
 
 #include <meshoptimizer.h>
 

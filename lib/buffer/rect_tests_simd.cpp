@@ -8,14 +8,14 @@
 // - The others are packed with the query computed here and go on to the exact scan (ScanRect),
 //   which test_rect also uses (RectScan).
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "core/rect_tests_simd.cpp"
+#define HWY_TARGET_INCLUDE "buffer/rect_tests_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
 #include <hwy/highway.h>
 
-#include "core/buffer_state.hpp"
-#include "core/rect_tests.hpp"
-#include "raster/lane_bits-inl.h"
+#include "buffer/buffer_state.hpp"
+#include "buffer/rect_tests.hpp"
+#include "common/lane_bits-inl.h"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -246,7 +246,7 @@ void TestRectBlock(const CoarseRectView& view, const SubtileView& subtiles, cons
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "raster/resolved_kernel.hpp"
+#include "common/resolved_kernel.hpp"
 
 namespace homcull::detail {
 

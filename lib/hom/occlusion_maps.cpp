@@ -10,11 +10,11 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_maps.hpp>
 
-#include "core/buffer_state.hpp"
-#include "core/maps_state.hpp"
-#include "core/float_mode.hpp"
-#include "core/opacity_pyramid.hpp"
-#include "core/rect_tests.hpp"
+#include "buffer/buffer_state.hpp"
+#include "hom/maps_state.hpp"
+#include "common/float_mode.hpp"
+#include "hom/opacity_pyramid.hpp"
+#include "buffer/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>

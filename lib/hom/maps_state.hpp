@@ -4,7 +4,7 @@
 // Private to the library.
 #include <homcull/occlusion_maps.hpp>
 
-#include "core/min_pyramid.hpp"
+#include "buffer/min_pyramid.hpp"
 
 #include <cstdint>
 #include <vector>

@@ -4,13 +4,13 @@
 // with occludee_depth.hpp's operations in its order, no fused multiply-add) and the layers'
 // test. Every lane computes what occludee_row_reference computes for its subtile.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "core/occludee_rows_simd.cpp"
+#define HWY_TARGET_INCLUDE "buffer/occludee_rows_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
 #include <hwy/highway.h>
 
-#include "core/occludee_depth.hpp"
-#include "raster/float_outward-inl.h"
+#include "buffer/occludee_depth.hpp"
+#include "common/float_outward-inl.h"
 
 #include <cmath>
 
@@ -107,7 +107,7 @@ void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], c
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "raster/resolved_kernel.hpp"
+#include "common/resolved_kernel.hpp"
 
 namespace homcull::detail {
 

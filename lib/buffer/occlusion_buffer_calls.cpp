@@ -1,7 +1,7 @@
-// OcclusionBuffer's calls, each forwarded to its state (core/buffer_state.hpp), where the
+// OcclusionBuffer's calls, each forwarded to its state (buffer/buffer_state.hpp), where the
 // implementation lives (occlusion_buffer.cpp, clustered_render.cpp, occludee_tests.cpp,
 // occludee_triangles.cpp).
-#include "core/buffer_state.hpp"
+#include "buffer/buffer_state.hpp"
 
 namespace homcull {
 

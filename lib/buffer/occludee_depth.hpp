@@ -3,8 +3,8 @@
 // subtile row of an occludee triangle against the buffer's layers (OcclusionBuffer::
 // test_triangles, occludee_triangles.cpp): a scalar reference and a SIMD kernel, a subtile per
 // lane (occludee_rows_simd.cpp), which give the same masks and the same answers.
-#include "core/raised_vertex_plane.hpp"
-#include "core/rect_tests.hpp"
+#include "buffer/raised_vertex_plane.hpp"
+#include "buffer/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>

@@ -4,7 +4,7 @@
 // target at every call (a call through the PLT and an atomic load), which the rasterizer paid
 // once per triangle and the rectangle tests once per rectangle. Use it in the translation unit
 // of the HWY_EXPORT (after HWY_ONCE): GetIndex must see that unit's compiled targets.
-#include "raster/isa_choice.hpp"
+#include "common/isa_choice.hpp"
 
 #include <hwy/highway.h>
 

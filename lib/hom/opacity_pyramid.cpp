@@ -1,6 +1,6 @@
 // Reference paths of the occlusion maps' level 0 and pyramid reduction (opacity_pyramid.hpp);
 // the SIMD kernels are in opacity_pyramid_simd.cpp.
-#include "core/opacity_pyramid.hpp"
+#include "hom/opacity_pyramid.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
 

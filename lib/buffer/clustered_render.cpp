@@ -4,10 +4,10 @@
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
-#include "core/buffer_state.hpp"
-#include "core/rect_tests.hpp"
-#include "core/render_bands.hpp"
-#include "core/run_tasks.hpp"
+#include "buffer/buffer_state.hpp"
+#include "buffer/rect_tests.hpp"
+#include "buffer/render_bands.hpp"
+#include "common/run_tasks.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 

@@ -16,11 +16,11 @@
 // In approximate mode holes are tolerated, and the depth maps ignore uncovered samples.
 #include <homcull/occlusion_maps.hpp>
 
-#include "core/buffer_state.hpp"
-#include "core/maps_state.hpp"
-#include "core/float_mode.hpp"
-#include "core/min_pyramid.hpp"
-#include "core/rect_tests.hpp"
+#include "buffer/buffer_state.hpp"
+#include "hom/maps_state.hpp"
+#include "common/float_mode.hpp"
+#include "buffer/min_pyramid.hpp"
+#include "buffer/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>

@@ -6,7 +6,7 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include <cstddef>
-#include "core/min_pyramid.hpp"
+#include "buffer/min_pyramid.hpp"
 
 #include <cstdint>
 #include <new>

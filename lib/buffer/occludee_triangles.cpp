@@ -14,11 +14,11 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
-#include "core/buffer_state.hpp"
-#include "core/float_mode.hpp"
-#include "core/occludee_depth.hpp"
-#include "core/raised_vertex_plane.hpp"
-#include "core/rect_tests.hpp"
+#include "buffer/buffer_state.hpp"
+#include "common/float_mode.hpp"
+#include "buffer/occludee_depth.hpp"
+#include "buffer/raised_vertex_plane.hpp"
+#include "buffer/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 #include "raster/triangle_setup.hpp"

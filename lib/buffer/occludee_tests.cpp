@@ -2,10 +2,10 @@
 // whose first, coarse stage runs in SIMD lanes: rect_tests_simd.cpp) and world boxes.
 #include <homcull/occlusion_buffer.hpp>
 
-#include "core/buffer_state.hpp"
-#include "core/float_mode.hpp"
-#include "core/min_pyramid.hpp"
-#include "core/rect_tests.hpp"
+#include "buffer/buffer_state.hpp"
+#include "common/float_mode.hpp"
+#include "buffer/min_pyramid.hpp"
+#include "buffer/rect_tests.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_setup.hpp"
 
@@ -144,26 +144,6 @@ double orthographic_corners(glm::dvec4 corners[8], double error) {
 double ndc_error_bound(double error, double max_abs_ndc, double min_w) {
     if (!(min_w > error)) return HUGE_VAL;
     return error * (1.0 + max_abs_ndc) / (min_w - error) + 0x1.0p-52 * max_abs_ndc;
-}
-
-ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w) {
-    ClipBounds b;
-    for (int k = 0; k < count; ++k) {
-        const glm::dvec4& c = points[k];
-        if (!finite_clip(c)) {
-            b.finite = false;
-            return b;
-        }
-        b.max_w = std::max(b.max_w, c.w);
-        if (c.w < near_w) {
-            ++b.behind;
-            continue;
-        }
-        b.min_x = std::min(b.min_x, c.x / c.w), b.max_x = std::max(b.max_x, c.x / c.w);
-        b.min_y = std::min(b.min_y, c.y / c.w), b.max_y = std::max(b.max_y, c.y / c.w);
-        b.min_w = std::min(b.min_w, c.w);
-    }
-    return b;
 }
 
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, bool orthographic, ScreenRect& rect,

@@ -5,7 +5,8 @@
 // at that stage, with the same answers.
 #include <homcull/occlusion_buffer.hpp>
 
-#include "core/buffer_state.hpp"
+#include "buffer/buffer_state.hpp"
+#include "common/float_round.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -98,15 +99,6 @@ double box_corners(const float box_min[3], const float box_max[3], const std::ar
 // rounding. Infinite when the error reaches the nearest w.
 double ndc_error_bound(double error, double max_abs_ndc, double min_w);
 
-// What an occludee test needs of clip-space points: their NDC bounds and nearest w over the
-// points at or beyond near_w, their farthest w over all, how many lie before near_w, and
-// whether every coordinate is finite (the rest is meaningless when not).
-struct ClipBounds {
-    bool finite = true;
-    int behind = 0;
-    double min_x = HUGE_VAL, max_x = -HUGE_VAL, min_y = HUGE_VAL, max_y = -HUGE_VAL, min_w = HUGE_VAL, max_w = -HUGE_VAL;
-};
-ClipBounds clip_bounds(const glm::dvec4* points, int count, double near_w);
 
 // The screen rectangle of a box under a model-to-clip matrix (incremental corner transform:
 // base corner plus three edge vectors), widened by the corners' error bound and rounded

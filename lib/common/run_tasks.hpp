@@ -2,15 +2,15 @@
 // Runs tasks 0..count-1 through the caller's job system (ParallelFor) when it has one and there
 // is more than one task, else one after another on the calling thread. Each task runs as the
 // calling thread would: in the library's floating-point environment (float_mode.hpp), with the
-// caller's memory hooks (homcull/detail/memory.hpp) and instruction set (raster/isa_choice.hpp),
+// caller's memory hooks (homcull/detail/memory.hpp) and instruction set (common/isa_choice.hpp),
 // whichever thread runs it. No exception leaves a task into the job system (a C job system
 // cannot pass one on, and an exception reaching it would end the process): the first one a
 // task throws is kept and thrown again on the calling thread once every task has returned.
-#include "core/float_mode.hpp"
-#include "raster/isa_choice.hpp"
+#include "common/float_mode.hpp"
+#include "common/isa_choice.hpp"
 
 #include <homcull/detail/memory.hpp>
-#include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
 
 #include <atomic>
 #include <cstddef>

@@ -2,7 +2,7 @@
 // An instruction set chosen for one caller instead of the whole process: the C interface's
 // contexts each have their own (homcull.h). While an IsaScope is alive on a thread, every kernel
 // looked up there (resolved_kernel.hpp, scalar_reference_selected) follows its choice, and tasks
-// run through the caller's job system carry it (core/run_tasks.hpp). Without one, the
+// run through the caller's job system carry it (common/run_tasks.hpp). Without one, the
 // process-wide select_isa applies.
 #include <cstdint>
 #include <string>
@@ -21,6 +21,10 @@ IsaChoice make_isa_choice(const std::string& name);
 
 // Whether make_isa_choice accepts the name ("best" and "scalar" always). Allocates nothing.
 bool isa_available(const char* name) noexcept;
+
+// Whether the plain scalar reference paths are in force on this thread: its IsaChoice's, or
+// select_isa's.
+bool scalar_reference_selected();
 
 // The choice in force on this thread (null: the process-wide one).
 const IsaChoice* current_isa_choice() noexcept;

@@ -2,12 +2,14 @@
 // (opacity_pyramid.hpp). Reduction: a vector of output cells at a time, their children's even and odd columns separated with
 // ConcatEven/ConcatOdd. Integer sums and float minima are exact: the reference's bits.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "core/opacity_pyramid_simd.cpp"
+#define HWY_TARGET_INCLUDE "hom/opacity_pyramid_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
 #include <hwy/highway.h>
 
-#include "core/opacity_pyramid.hpp"
+#include <homcull/occlusion_buffer.hpp>
+
+#include "hom/opacity_pyramid.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -89,7 +91,7 @@ int Level0SingleSample(const Level0Maps& m) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "raster/resolved_kernel.hpp"
+#include "common/resolved_kernel.hpp"
 
 namespace homcull::detail {
 
