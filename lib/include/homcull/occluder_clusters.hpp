@@ -8,9 +8,8 @@
 // cubes front to back (Greene, Kass and Miller, "Hierarchical Z-Buffer Visibility",
 // SIGGRAPH 1993), with a flat list of clusters in place of the octree.
 //
-// Building is not an offline bake: it takes milliseconds (the castle's 48,700 occluder
-// triangles: about 60 ms, half of it in meshoptimizer) and keeps every triangle and vertex bit
-// for bit.
+// Building is not an offline bake: it runs at load time, in time linear in the mesh (half of
+// it in meshoptimizer), and keeps every triangle and vertex bit for bit.
 #include <homcull/aabb.hpp>
 #include <homcull/detail/memory.hpp>
 

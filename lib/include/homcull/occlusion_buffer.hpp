@@ -101,7 +101,8 @@ struct ClusteredInput {
     std::size_t cluster_count = 0;
     // Optional: shared-edge flags and their apexes to use instead of clusters->shared_edges and
     // clusters->edge_apexes, one (three) per clustered triangle in the same order (for example
-    // flags computed within each object only); the apexes number OccluderClusters::positions.
+    // flags computed within each object only); the apexes number vertices within each
+    // triangle's cluster, as OccluderClusters::edge_apexes do.
     const std::uint8_t* shared_edges = nullptr;
     const std::uint32_t* edge_apexes = nullptr;
     bool orthographic = false;  // as TriangleInput::orthographic
@@ -130,8 +131,7 @@ public:
 
     // Throws homcull::Error on an invalid configuration. The buffer's planes and pyramid are
     // allocated here; the first render sizes its scratch (draw order, clusters, bins) to its
-    // input, and from then on renders of inputs no larger, and every query, allocate nothing
-    // (tested: FrameAllocations.NoneAfterTheFirstFrame).
+    // input, and from then on renders of inputs no larger, and every query, allocate nothing.
     explicit OcclusionBuffer(const BufferConfig& config);
 
     // A new configuration (resolution, samples, near plane, ...): the buffer is then empty. Its
@@ -143,9 +143,8 @@ public:
     void set_near_w(float near_w);
     // Sizes every array for the largest buffer and input the caller will give, so that renders
     // within these sizes (with a job system: of at most max_threads threads), and configure()
-    // up to that resolution, never allocate, not even the first frame (tested:
-    // FrameAllocations.NoneFromTheFirstFrameAfterAReserve). Throws like configure; whatever it
-    // reserved stays reserved.
+    // up to that resolution, never allocate, not even the first frame. Throws like configure;
+    // whatever it reserved stays reserved.
     void reserve(const BufferReserve& reserve);
 
     void clear();
@@ -222,8 +221,7 @@ public:
     std::size_t finish_tasks(std::nothrow_t) noexcept;
 
     // Occludee tests. Thread-safe with each other (no render in flight): they only read the
-    // buffer (RenderThreads.QueriesFromManyThreadsAnswerAsOneThread compares the answers of
-    // four threads asking at once with one thread's).
+    // buffer.
     // Screen rectangle in NDC (y up) with the nearest clip w of the occludee. Occluded when
     // every sample whose centre lies in it has an occluder nearer than w_min, by the subtile
     // bounds: d0, or max(d0, d1) where the rectangle's samples are all in the working layer.
