@@ -9,6 +9,10 @@
 #include <string>
 #include <vector>
 
+#include <homcull/isa.hpp>
+
+#include <string>
+
 namespace homcull {
 class RayScene;
 }
@@ -30,6 +34,18 @@ BufferConfig buffer_config(int width, int height, int samples, float near_w, boo
 // build (HOMCULL_TSAN) threads_jobs(), since TSan reports the internals of the uninstrumented
 // libtbb as races.
 ParallelFor parallel_jobs();
+
+// An instruction set selected (select_isa) while the object lives, and "best" again when it
+// goes, also when a failed ASSERT leaves the test early, so that no later test runs on the
+// wrong one. Tests that run on every instruction set make one per iteration:
+//     for (const std::string& isa : available_isas()) { const test::ScopedIsa selected(isa); ... }
+class ScopedIsa {
+public:
+    explicit ScopedIsa(const std::string& name) { select_isa(name); }
+    ~ScopedIsa() { select_isa("best"); }
+    ScopedIsa(const ScopedIsa&) = delete;
+    ScopedIsa& operator=(const ScopedIsa&) = delete;
+};
 // A plain job system: each run starts `threads` - 1 std::threads that take task numbers from
 // an atomic counter with the calling thread, and joins them.
 ParallelFor thread_jobs(std::size_t threads = 2);

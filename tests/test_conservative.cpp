@@ -209,17 +209,16 @@ void check_cases_against_exact_arithmetic(bool orthographic, long& claims_checke
     for (std::uint32_t seed = 1; seed <= 160; ++seed) {
         const Case c = make_case(seed, orthographic);
         const TriangleInput in = c.input();
-        select_isa("scalar");
+        const test::ScopedIsa reference_isa("scalar");
         OcclusionBuffer reference(c.config);
         reference.render_frame(in);
         for (const std::string& isa : isas) {
             if (isa == "scalar") continue;
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             OcclusionBuffer b(c.config);
             b.render_frame(in);
             ASSERT_TRUE(test::same_subtiles(reference, b)) << isa << ", " << c.kind;
         }
-        select_isa("best");
         const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
         int first = -1;
         const long unbacked = test::unbacked_claims(reference, occluders, &first);
@@ -330,7 +329,7 @@ TEST(Conservative, LargeCancellingCoordinatesClaimNoSampleOutsideTheOccluders) {
     std::uniform_real_distribution<float> small(-1.2f, 1.2f), mantissa(1.0f, 2.0f);
     for (const bool orthographic : {false, true})
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             for (int k = 30; k <= 60; k += 2) {
                 const float h = std::ldexp(mantissa(rng), k);
                 BufferConfig config = test::buffer_config(64, 64, 1, 0.1f);
@@ -352,7 +351,6 @@ TEST(Conservative, LargeCancellingCoordinatesClaimNoSampleOutsideTheOccluders) {
                     << (orthographic ? "orthographic, " : "") << isa << ", 2^" << k << ", sample " << first;
             }
         }
-    select_isa("best");
 }
 
 // A triangle whose w spans 10^33 down to behind the eye: the near-plane clip's interpolation
@@ -361,7 +359,7 @@ TEST(Conservative, LargeCancellingCoordinatesClaimNoSampleOutsideTheOccluders) {
 // too large to clip precisely, and is skipped.
 TEST(Conservative, AWRangeTooLargeToClipClaimsNothing) {
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         // fuzz_conservative's case as it found it: clip = position - origin, origin (-0.0018, 1.7e-6, -6.7e16).
         const std::vector<float> positions = {-0.00182647293f, 1.6704563e-06f, 4.64922061e+33f, 29.6489086f, 3.56850887e-06f,
                                               -6.73231571e+16f, -3500.91016f, 1.6704563e-06f, -8.98869087e+20f};
@@ -376,7 +374,6 @@ TEST(Conservative, AWRangeTooLargeToClipClaimsNothing) {
         EXPECT_EQ(test::unbacked_claims(buffer, test::exact_triangles(in)), 0) << isa;
         EXPECT_EQ(buffer.stats().too_large, 1u) << isa;
     }
-    select_isa("best");
 }
 
 // A NaN bound (from extreme finite setup values) must bound nothing, never drop its bound: int(NaN)
@@ -422,7 +419,7 @@ TEST(Conservative, SubnormalDepthsClaimNoSampleNearerThanTheOccluder) {
     in.backface = Backface::none;
     const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         for (const int samples : {1, 4}) {
             OcclusionBuffer buffer(test::buffer_config(16, 16, samples, 1.99f));
             buffer.render_frame(in);
@@ -432,7 +429,6 @@ TEST(Conservative, SubnormalDepthsClaimNoSampleNearerThanTheOccluder) {
             EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << isa << ", S = " << samples;
         }
     }
-    select_isa("best");
 }
 
 // Occludee triangles whose rounding hides part of them (fuzz_conservative's finds):
@@ -459,7 +455,7 @@ TEST(Conservative, OccludeeTrianglesHiddenByTheirRoundingAreTested) {
     beside.triangle_count = 1;
     beside.model_to_clip = {1, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -big, 0, 0, 0.78f};
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         const OcclusionBuffer empty(test::buffer_config(1, 5, 4, 0.72f, true));
         ASSERT_FALSE(test::triangles_truly_hidden({}, test::exact_triangles(sliver), empty.sample_width(), empty.sample_height(), 0.72f));
         EXPECT_EQ(empty.test_triangles(sliver).visibility, Visibility::visible) << isa;
@@ -467,7 +463,6 @@ TEST(Conservative, OccludeeTrianglesHiddenByTheirRoundingAreTested) {
         ASSERT_FALSE(test::triangles_truly_hidden({}, test::exact_triangles(beside), wide.sample_width(), wide.sample_height(), 0.1f));
         EXPECT_EQ(wide.test_triangles(beside).visibility, Visibility::visible) << isa;
     }
-    select_isa("best");
 }
 
 // Shared edges decided per view (neighbour_across_edge). A triangle T = (a, b, c) whose edge a -> b
@@ -494,7 +489,7 @@ TEST(Conservative, SharedEdgesAtViewSilhouettesKeepTheirMargin) {
         for (const Neighbour& n : neighbours)
             for (const Backface backface : {Backface::none, Backface::cw})
                 for (const std::string& isa : available_isas()) {
-                    select_isa(isa);
+                    const test::ScopedIsa selected(isa);
                     const std::string where = std::string(orthographic ? "orthographic, " : "") + n.name + ", backface " +
                                               std::to_string(int(backface)) + ", " + isa;
                     BufferConfig config = test::buffer_config(16, 15, 1, 0.1f);
@@ -553,7 +548,6 @@ TEST(Conservative, SharedEdgesAtViewSilhouettesKeepTheirMargin) {
                     const std::vector<float> margin_claims = test::claimed_inverse_w(margin);
                     for (int i = 0; i < margin.sample_width(); ++i) EXPECT_EQ(margin_claims[std::size_t(7 * margin.sample_width() + i)], 0.0f) << where;
                 }
-    select_isa("best");
     EXPECT_GT(row_claims_kept[0], 0);
     EXPECT_GT(row_claims_kept[1], 0);
 }
@@ -600,7 +594,7 @@ TEST(Conservative, MarginFreeEdgesClaimNothingPastThinNeighboursOrOutlineCorners
             in.orthographic = orthographic;
             const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
             for (const std::string& isa : available_isas()) {
-                select_isa(isa);
+                const test::ScopedIsa selected(isa);
                 BufferConfig config = test::buffer_config(15, 15, 1, 0.1f);
                 config.orthographic = orthographic;
                 OcclusionBuffer buffer(config);
@@ -610,7 +604,6 @@ TEST(Conservative, MarginFreeEdgesClaimNothingPastThinNeighboursOrOutlineCorners
                 EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << what << ", " << isa;
             }
         }
-    select_isa("best");
 }
 
 // A clipped sliver (fuzz_conservative's find): a triangle from w = 2.2e8 back past the near plane,
@@ -629,13 +622,12 @@ TEST(Conservative, ClippedSliversClaimNoSampleAlongTheirFanDiagonals) {
     in.backface = Backface::none;
     const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         OcclusionBuffer buffer(test::buffer_config(16, 16, 4, 1.99f));
         buffer.render_frame(in);
         EXPECT_EQ(buffer.stats().near_clipped, 1u) << isa;
         EXPECT_EQ(test::unbacked_claims(buffer, occluders), 0) << isa;
     }
-    select_isa("best");
 }
 
 // Orthographic extremes, clip (x, y, z) with w = 1: a sliver one float step (6e-8) wide along the
@@ -663,7 +655,7 @@ TEST(Conservative, OrthographicExtremesClaimNoSampleOutsideTheOccluders) {
         in.orthographic = true;
         const std::vector<test::ExactTriangle> occluders = test::exact_triangles(in);
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             for (const int samples : {1, 4}) {
                 BufferConfig config = test::buffer_config(16, 16, samples, 0.5f);
                 config.orthographic = true;
@@ -677,7 +669,6 @@ TEST(Conservative, OrthographicExtremesClaimNoSampleOutsideTheOccluders) {
             }
         }
     }
-    select_isa("best");
 }
 
 // Flags without apexes cannot be decided per view: render refuses them.

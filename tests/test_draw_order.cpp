@@ -352,7 +352,7 @@ TEST(DrawOrder, EveryInstructionSetSortsAlike) {
         const Input input = make_input(kind, 20005, rng, /*bad=*/true);
         std::vector<std::uint32_t> first;
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             DrawOrderScratch scratch;
             TriangleInput sorted;
             ASSERT_TRUE(sort_nearest_first(input.in, nullptr, 1.0, {}, scratch, sorted));
@@ -364,7 +364,6 @@ TEST(DrawOrder, EveryInstructionSetSortsAlike) {
             if (first.empty()) first = data;
             EXPECT_TRUE(data == first) << name(kind) << ", " << isa;
         }
-        select_isa("best");
     }
 }
 

@@ -159,21 +159,20 @@ TEST(Golden, BuffersAndPyramidsMatchTheReferencesOnEveryIsa) {
             continue;
         }
         if (update) {
-            select_isa("scalar");
+            const test::ScopedIsa reference_isa("scalar");
             write_maps_exr(render_case(c, scene), golden_path(c));
             std::printf("[ golden   ] wrote %s\n", golden_path(c).c_str());
             continue;
         }
         ASSERT_TRUE(std::filesystem::exists(golden_path(c))) << golden_path(c) << " is missing; see this file's header";
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             const std::string current = dir + "/" + c.name + "." + isa + ".exr";
             write_maps_exr(render_case(c, scene), current);
             const Comparison r = compare_exr(golden_path(c), current, dir + "/" + c.name + "." + isa + ".diff");
             EXPECT_TRUE(r.same) << c.name << " on " << isa << " differs from " << golden_path(c) << ":\n" << r.report;
         }
     }
-    select_isa("best");
     std::string isas;
     for (const std::string& isa : available_isas()) isas += " " + isa;
     std::printf("[ golden   ] %zu cases, each on:%s\n", golden_cases().size() - skipped.size(), isas.c_str());

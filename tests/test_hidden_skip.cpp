@@ -85,7 +85,7 @@ TEST(HiddenTriangleSkip, SetupLanesComputeTheBoxNearestDepth) {
     long compared = 0, clamped = 0;
     for (const std::string& isa : available_isas()) {
         if (isa == "scalar") continue;  // the reference sets every triangle up one by one
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         const FrontEndKernels kernels = selected_front_end_kernels();
         ASSERT_TRUE(kernels.setup_planes && kernels.setup_edges) << isa;
         for (int round = 0; round < 400; ++round) {
@@ -119,7 +119,6 @@ TEST(HiddenTriangleSkip, SetupLanesComputeTheBoxNearestDepth) {
             }
         }
     }
-    select_isa("best");
     if (available_isas().size() > 1) {
         EXPECT_GT(compared, 5000);
         EXPECT_GT(clamped, 500);  // boxes at the grid's edge
@@ -132,7 +131,7 @@ TEST(HiddenTriangleSkip, SetupLanesComputeTheBoxNearestDepth) {
 void expect_same_with_and_without_skip(const TriangleInput& in, int width, int height, int samples, float near_w) {
     ASSERT_GT(in.triangle_count, 0u);
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         for (bool sample_depth : {false, true})
             for (bool threads : {false, true}) {
                 const std::string where = isa + (threads ? ", two threads" : ", one thread") + (sample_depth ? ", per-sample depth" : "");
@@ -168,7 +167,6 @@ void expect_same_with_and_without_skip(const TriangleInput& in, int width, int h
                 EXPECT_TRUE(skipping.stats() == oracle.stats()) << where;
             }
     }
-    select_isa("best");
 }
 
 // Workload S1: 100,000 triangles drawn in an order that leaves about 70 % of them hidden

@@ -63,7 +63,7 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
         config.height = 97;
         config.samples = samples;
         config.near_w = 1.0f;
-        select_isa("scalar");
+        const test::ScopedIsa reference_isa("scalar");
         OcclusionBuffer buffer(config);
         buffer.render(test::clip_space_input(xyzw));
         std::vector<Visibility> expected, expected_boxes;
@@ -75,7 +75,7 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
         EXPECT_GT(std::count(expected.begin(), expected.end(), Visibility::visible), 2000);
 
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             std::vector<Visibility> single, batch(rects.size()), box_batch(boxes.size());
             for (const ScreenRect& r : rects) single.push_back(buffer.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min));
             buffer.test_rects(rects.data(), rects.size(), batch.data());
@@ -90,7 +90,6 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
             EXPECT_EQ(batch_wrong, 0u) << isa << ", samples " << samples;
             EXPECT_EQ(box_wrong, 0u) << isa << ", samples " << samples;
         }
-        select_isa("best");
     }
 }
 

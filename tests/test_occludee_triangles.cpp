@@ -333,17 +333,16 @@ TEST(OccludeeTriangles, EveryIsaGivesTheReferenceAnswersAndCounts) {
         in.model_to_clip = {1, 0, 0, -1, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0};
         in.backface = Backface::none;
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             const OcclusionBuffer empty = make_buffer(64, 36);
             EXPECT_EQ(empty.test_triangles(in).visibility, bad < 0 ? Visibility::view_culled : Visibility::visible)
                 << isa << ", bad coordinate " << bad;
         }
-        select_isa("best");
     }
     for (const auto& [samples, sample_depth] : {std::pair{1, false}, {4, false}, {1, true}}) {
         std::vector<OcclusionBuffer::TriangleTest> reference;
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             OcclusionBuffer buffer = make_buffer(149, 301, samples, sample_depth);  // more rows than a chunk of the row loop
             buffer.render(occluders.input());
             std::vector<OcclusionBuffer::TriangleTest> answers;
@@ -367,7 +366,6 @@ TEST(OccludeeTriangles, EveryIsaGivesTheReferenceAnswersAndCounts) {
                 ASSERT_EQ(answers[k].deciding_triangle, reference[k].deciding_triangle);
             }
         }
-        select_isa("best");
     }
 }
 
@@ -384,7 +382,7 @@ TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
     int checked = 0, unhidden_seen = 0;
     for (const std::string& isa : available_isas()) {
         if (isa == "scalar") continue;
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         const detail::OccludeeRowKernel kernel = detail::selected_occludee_row_kernel();
         ASSERT_NE(kernel, nullptr);
         for (int trial = 0; trial < 400; ++trial) {
@@ -429,7 +427,6 @@ TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
             }
         }
     }
-    select_isa("best");
     EXPECT_GT(checked, 1000);
     EXPECT_GT(unhidden_seen, checked / 10);  // both answers compared
 }
@@ -501,12 +498,11 @@ TEST(OccludeeTriangles, ThinTriangleJustBehindAGrazingFloorIsHidden) {
         return answer(buffer, s);
     };
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         EXPECT_EQ(wide_sliver(1e-4), Visibility::occluded) << isa;
         EXPECT_EQ(wide_sliver(0.0), Visibility::visible) << isa;
         EXPECT_EQ(wide_sliver(-1e-5), Visibility::visible) << isa;
     }
-    select_isa("best");
 }
 
 // A wide sliver behind a wall, without per-sample depth (the layers alone decide): two of its
@@ -523,7 +519,7 @@ TEST(OccludeeTriangles, RaisedBoundRetestsTheRestOfItsRow) {
         return buffer.test_triangles(s.input());
     };
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         const OcclusionBuffer::TriangleTest hidden = sliver(1e-5);
         EXPECT_EQ(hidden.visibility, Visibility::occluded) << isa;
         EXPECT_GT(hidden.samples, 8u) << isa;  // rows across several subtiles
@@ -532,7 +528,6 @@ TEST(OccludeeTriangles, RaisedBoundRetestsTheRestOfItsRow) {
         EXPECT_EQ(sliver(0.0).visibility, Visibility::occluded) << isa;
         EXPECT_EQ(sliver(-0.5).visibility, Visibility::visible) << isa;
     }
-    select_isa("best");
 }
 
 // The occludee's input rounding, as test_triangles models it (ClipError in

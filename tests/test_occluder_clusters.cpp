@@ -312,14 +312,14 @@ TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
         for (const bool sample_depth : {false, true}) {
             const BufferConfig config = test::buffer_config(sample_depth ? 320 : 1280, sample_depth ? 180 : 720, sample_depth ? 4 : 1,
                                                             float(camera.near_plane), sample_depth);
-            select_isa("scalar");
+            const test::ScopedIsa reference_isa("scalar");
             OcclusionBuffer reference(config);
             reference.render_frame(in);
             EXPECT_GT(reference.stats().cluster_bands_hidden, 10u);
             EXPECT_GT(reference.stats().clusters_outside, 50u);
             for (const std::string& isa : available_isas())
                 for (const ParallelFor& parallel : {ParallelFor{}, tbb, shuffled}) {
-                    select_isa(isa);
+                    const test::ScopedIsa selected(isa);
                     OcclusionBuffer buffer(config);
                     buffer.render(in, parallel);  // into an empty buffer: what render_frame gives
                     const std::string what = isa + (parallel.run ? (parallel.user ? ", shuffled" : ", TBB") : ", serial") +
@@ -328,7 +328,6 @@ TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
                     EXPECT_TRUE(test::same_subtiles(reference, buffer)) << what;
                     EXPECT_TRUE(test::same_pyramid(reference, buffer)) << what;
                 }
-            select_isa("best");
         }
     }
     // Frame after frame on the same buffers (render_frame clears each band in its task; the
@@ -392,7 +391,7 @@ TEST(ClusteredRender, TaskListsGiveTheBitsOfOneRenderPerDraw) {
         }
         for (const bool keep_before : {false, true}) {
             const BufferConfig config = test::buffer_config(640, 360, 2, float(camera.near_plane), view == 3);
-            select_isa("scalar");
+            const test::ScopedIsa reference_isa("scalar");
             OcclusionBuffer reference(config);
             if (keep_before) reference.render(draws[2]);  // the list then draws onto what is there
             for (const ClusteredInput& d : draws) reference.render(d);
@@ -400,7 +399,7 @@ TEST(ClusteredRender, TaskListsGiveTheBitsOfOneRenderPerDraw) {
             EXPECT_GT(reference.stats().near_clipped, 0u);
             for (const std::string& isa : available_isas())
                 for (const ParallelFor* jobs : {&shuffled, &tbb, &threads}) {
-                    select_isa(isa);
+                    const test::ScopedIsa selected(isa);
                     OcclusionBuffer buffer(config);
                     if (keep_before) buffer.render(draws[2]);
                     else buffer.render(draws[5]);  // cleared by the list
@@ -413,7 +412,6 @@ TEST(ClusteredRender, TaskListsGiveTheBitsOfOneRenderPerDraw) {
                     EXPECT_TRUE(test::same_subtiles(reference, buffer)) << what;
                     EXPECT_TRUE(test::same_pyramid(reference, buffer)) << what;
                 }
-            select_isa("best");
         }
     }
 }
@@ -496,7 +494,7 @@ TEST(ClusteredRender, OrthographicViewsGiveTheSameBitsEverywhereAndHideWhatIsBeh
     config.orthographic = true;
     ClusteredInput in{&clusters, ortho, Backface::cw};
     in.orthographic = true;
-    select_isa("scalar");
+    const test::ScopedIsa reference_isa("scalar");
     OcclusionBuffer reference(config);
     reference.render_frame(in);
     EXPECT_EQ(reference.config().near_w, 0.5f);  // the near plane's, whatever was asked
@@ -505,14 +503,13 @@ TEST(ClusteredRender, OrthographicViewsGiveTheSameBitsEverywhereAndHideWhatIsBeh
     const ParallelFor tbb = test::parallel_jobs(), shuffled{test::run_shuffled, &order_rng};
     for (const std::string& isa : available_isas())
         for (const ParallelFor& parallel : {ParallelFor{}, tbb, shuffled}) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             OcclusionBuffer buffer(config);
             buffer.render_frame(in, parallel);
             EXPECT_TRUE(reference.stats() == buffer.stats()) << isa;
             EXPECT_TRUE(test::same_subtiles(reference, buffer)) << isa;
             EXPECT_TRUE(test::same_pyramid(reference, buffer)) << isa;
         }
-    select_isa("best");
     const auto box = [&](float z0, float z1) {
         const float lo[3] = {-2.0f, -2.0f, z0}, hi[3] = {2.0f, 2.0f, z1};
         return reference.test_aabb(lo, hi, ortho);

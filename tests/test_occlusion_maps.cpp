@@ -105,7 +105,7 @@ TEST(OcclusionMaps, EveryIsaBuildsTheSamePyramids) {
         std::vector<std::uint32_t> reference_covered;
         std::vector<float> reference_far, reference_near;
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             BufferConfig c;
             c.width = 203;  // odd widths at several levels, and rows longer than a vector
             c.height = 77;
@@ -133,7 +133,6 @@ TEST(OcclusionMaps, EveryIsaBuildsTheSamePyramids) {
             EXPECT_EQ(far, reference_far) << isa << " S " << s;
             EXPECT_EQ(near, reference_near) << isa << " S " << s;
         }
-        select_isa("best");
     }
 }
 
@@ -150,7 +149,7 @@ TEST(OcclusionMaps, MakeOnlyTheDepthPyramidTheirTestReads) {
         rects.push_back({x, y, x + size(rng), y + size(rng), w(rng)});
     }
     for (const std::string isa : {"scalar", "best"}) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         for (int s : {1, 4}) {
             OcclusionBuffer buffer(test::buffer_config(101, 67, s, 0.5f));
             buffer.render(test::clip_space_input(tris));
@@ -192,7 +191,6 @@ TEST(OcclusionMaps, MakeOnlyTheDepthPyramidTheirTestReads) {
                 }
         }
     }
-    select_isa("best");
 }
 
 TEST(OcclusionMaps, ThresholdsFollowZhang) {

@@ -47,7 +47,7 @@ TEST(ReferenceCells, RefreshGivesTheSmallestD0OfEachCellOfTheRows) {
             }
         const SubtilePlanes planes{d0.data(), nullptr, nullptr, nullptr, stride, nullptr, 0};
         for (const std::string& isa : available_isas()) {
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             const RefreshCellsKernel refresh = selected_refresh_cells();
             if (isa == "scalar") {  // the reference sets triangles up one by one, without cells
                 EXPECT_EQ(refresh, nullptr);
@@ -62,7 +62,6 @@ TEST(ReferenceCells, RefreshGivesTheSmallestD0OfEachCellOfTheRows) {
                         << isa << ", trial " << trial << ", cell " << cx << ", " << cy;
         }
     }
-    select_isa("best");
 }
 
 // Random clip-space triangles (x, y, z, w floats): small and large, on screen, beyond its sides
@@ -110,7 +109,7 @@ TEST(ReferenceCells, NotesBoundWhatDrawingTheTriangleCanDo) {
         std::vector<CellRecord> records, first_records;
         for (const std::string& isa : available_isas()) {
             if (isa == "scalar") continue;
-            select_isa(isa);
+            const test::ScopedIsa selected(isa);
             std::vector<std::uint16_t> bucket(n);
             std::vector<std::uint32_t> count(kDrawOrderBuckets, 0u);
             records.assign(n, CellRecord{});
@@ -118,7 +117,6 @@ TEST(ReferenceCells, NotesBoundWhatDrawingTheTriangleCanDo) {
             if (first_records.empty()) first_records = records;
             else EXPECT_EQ(std::memcmp(records.data(), first_records.data(), n * sizeof(CellRecord)), 0) << isa;
         }
-        select_isa("best");
         if (records.empty()) GTEST_SKIP() << "no SIMD instruction set";
         for (std::size_t t = 0; t < n; ++t) {
             const CellRecord& r = records[t];
@@ -245,7 +243,7 @@ TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
     ASSERT_GT(kept_of_all, n / 5);
     ASSERT_LT(kept_of_all, 4 * n / 5);
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         for (const std::size_t count : {n, std::size_t(5), std::size_t(0)}) {
             std::vector<std::uint32_t> got(n, 0), want(n, 0);
             const std::size_t got_kept = selected_drop_hidden()(view, notes.data(), count, got.data());
@@ -264,7 +262,6 @@ TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
     const ReferenceCells rebuilt_view{rebuilt.data(), width, height};
     update_cell_blocks(rebuilt_view, 0, height);
     EXPECT_TRUE(rebuilt == cells);
-    select_isa("best");
 }
 
 // A clip-space soup drawn with a job system goes in parts of rows (render_parts), as many as

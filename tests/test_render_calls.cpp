@@ -33,7 +33,7 @@ void expect_pyramid_and_answers_exact(const OcclusionBuffer& b, const std::strin
 TEST(RenderCalls, SoupDrawnInManySmallCallsKeepsCellsAndPyramidExact) {
     const std::vector<float> xyzw = test::random_clip_triangles(3, 3000, 0.3f);
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         OcclusionBuffer skipping(test::buffer_config(203, 117, 2, 1.0f)), oracle(test::buffer_config(203, 117, 2, 1.0f));
         std::mt19937_64 rng(11);
         std::size_t calls = 0;
@@ -64,7 +64,6 @@ TEST(RenderCalls, SoupDrawnInManySmallCallsKeepsCellsAndPyramidExact) {
         EXPECT_TRUE(test::same_subtiles(skipping, oracle)) << isa;
         expect_pyramid_and_answers_exact(skipping, isa + " after a clear");
     }
-    select_isa("best");
 }
 
 // Meshes drawn as clusters, instance by instance, between soups: the pyramid follows every call.

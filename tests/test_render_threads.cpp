@@ -26,7 +26,7 @@ namespace {
 template <typename RenderAll>
 void expect_every_isa_gives(const std::vector<OcclusionBuffer>& reference, RenderAll&& render_all) {
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         std::vector<OcclusionBuffer> buffers;
         render_all(buffers);
         ASSERT_EQ(buffers.size(), reference.size());
@@ -35,7 +35,6 @@ void expect_every_isa_gives(const std::vector<OcclusionBuffer>& reference, Rende
             EXPECT_TRUE(test::same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
         }
     }
-    select_isa("best");
 }
 
 TEST(RenderThreads, SameBitsWhateverTheThreadsAndTaskOrder) {
@@ -445,7 +444,7 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
         out.emplace_back(config);
         out.back().render(test::clip_space_input(tiny_w));
     };
-    select_isa("scalar");
+    const test::ScopedIsa reference_isa("scalar");
     std::vector<OcclusionBuffer> reference;
     render_all(reference);
     EXPECT_GT(reference.back().stats().rasterized, 10000u);
@@ -453,14 +452,13 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
     const std::vector<std::string> isas = available_isas();
     EXPECT_GE(isas.size(), 2u) << "no SIMD instruction set available";
     for (const std::string& isa : isas) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         EXPECT_EQ(selected_isa(), isa);
         std::vector<OcclusionBuffer> buffers;
         render_all(buffers);
         for (std::size_t k = 0; k < buffers.size(); ++k)
             EXPECT_TRUE(test::same_subtiles(reference[k], buffers[k])) << isa << ", buffer " << k;
     }
-    select_isa("best");
     EXPECT_THROW(select_isa("mmx"), Error);
 }
 
@@ -534,7 +532,7 @@ TEST(Isa, SetupFrontEndCountsAndDrawsAsTheReference) {
                         out.back().render(input);
                     }
     };
-    select_isa("scalar");
+    const test::ScopedIsa reference_isa("scalar");
     std::vector<OcclusionBuffer> reference;
     render_all(reference);
     RasterStats all;
@@ -603,7 +601,7 @@ TEST(Isa, TriangleSoupsGiveTheReferenceBits) {
                     out.back().render(in);
                 }
     };
-    select_isa("scalar");
+    const test::ScopedIsa reference_isa("scalar");
     std::vector<OcclusionBuffer> reference;
     render_all(reference);
     const RasterStats& stats = reference.front().stats();
@@ -659,7 +657,7 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
         buffer.render(input, parallel);
         return buffer;
     };
-    select_isa("scalar");
+    const test::ScopedIsa reference_isa("scalar");
     const OcclusionBuffer reference = render(kVertices, {});
     EXPECT_GT(reference.stats().rasterized, 10000u);
     EXPECT_GT(reference.stats().outside + reference.stats().backface_culled, 10000u);
@@ -671,14 +669,13 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
     EXPECT_TRUE(cached.stats() == without_cache.stats());
     EXPECT_TRUE(test::same_subtiles(cached, without_cache));
     for (const std::string& isa : available_isas()) {
-        select_isa(isa);
+        const test::ScopedIsa selected(isa);
         for (const bool threads : {false, true}) {
             const OcclusionBuffer b = render(kVertices, threads ? tbb : ParallelFor{});
             EXPECT_TRUE(reference.stats() == b.stats()) << isa << (threads ? ", TBB" : ", serial");
             EXPECT_TRUE(test::same_subtiles(reference, b)) << isa << (threads ? ", TBB" : ", serial");
         }
     }
-    select_isa("best");
 }
 
 }  // namespace
