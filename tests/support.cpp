@@ -107,6 +107,11 @@ ParallelFor thread_jobs(std::size_t threads) {
     return ParallelFor{run_on_threads, reinterpret_cast<void*>(std::uintptr_t(threads)), threads};
 }
 
+OccluderClusters cluster_world(const WorldTriangles& w, const ClusterLimits& limits) {
+    return build_occluder_clusters(w.positions.data(), 3 * sizeof(float), w.positions.size() / 3, w.indices.data(), w.triangle_count(),
+                                   w.shared_edges.data(), w.edge_apexes.data(), limits);
+}
+
 ParallelFor parallel_jobs() {
 #ifdef HOMCULL_TSAN
     return thread_jobs(2);

@@ -1,7 +1,9 @@
 #pragma once
 // Small scenes built in code, with answers known by construction, and paths for test files.
 #include <homcull/camera.hpp>
+#include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/world_triangles.hpp>
 #include <homcull/scene.hpp>
 
 #include "inputs.hpp"  // random_clip_triangles, clip_space_input, random_screen_rects, run_backwards, CityStreet
@@ -33,6 +35,10 @@ BufferConfig buffer_config(int width, int height, int samples, float near_w, boo
 // The tests' job system with real threads: oneTBB's (homcull::tbb), or in a ThreadSanitizer
 // build (HOMCULL_TSAN) threads_jobs(), since TSan reports the internals of the uninstrumented
 // libtbb as races.
+// A mesh's occluder clusters (build_occluder_clusters) from gathered world triangles, with their
+// shared edges.
+OccluderClusters cluster_world(const WorldTriangles& w, const ClusterLimits& limits = {});
+
 ParallelFor parallel_jobs();
 
 // An instruction set selected (select_isa) while the object lives, and "best" again when it

@@ -86,9 +86,7 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
     const test::CityStreet street;
     const Scene& city = street.city;
     const WorldTriangles& occluders = street.occluders;
-    const OccluderClusters clusters =
-        build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3, occluders.indices.data(),
-                                occluders.triangle_count(), occluders.shared_edges.data(), occluders.edge_apexes.data(), ClusterLimits{});
+    const OccluderClusters clusters = test::cluster_world(occluders);
     const std::array<float, 16> clip = street.clip(320.0 / 180.0);
     const TriangleInput city_input = occluders.input(clip);
     const ClusteredInput clustered{&clusters, clip, Backface::none};
@@ -147,9 +145,7 @@ TEST(FrameAllocations, NoneFromTheFirstFrameAfterAReserve) {
     crossing.indices = many_indices.data();
     const test::CityStreet street;
     const WorldTriangles& occluders = street.occluders;
-    const OccluderClusters clusters =
-        build_occluder_clusters(occluders.positions.data(), 3 * sizeof(float), occluders.positions.size() / 3, occluders.indices.data(),
-                                occluders.triangle_count(), occluders.shared_edges.data(), occluders.edge_apexes.data(), ClusterLimits{});
+    const OccluderClusters clusters = test::cluster_world(occluders);
     const std::array<float, 16> clip = street.clip(320.0 / 180.0);
     const TriangleInput city_input = occluders.input(clip);
     const ClusteredInput clustered{&clusters, clip, Backface::none};

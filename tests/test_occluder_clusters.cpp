@@ -26,11 +26,6 @@
 namespace homcull {
 namespace {
 
-OccluderClusters cluster_world(const WorldTriangles& w, const ClusterLimits& limits = {}) {
-    return build_occluder_clusters(w.positions.data(), 3 * sizeof(float), w.positions.size() / 3, w.indices.data(), w.triangle_count(),
-                                   w.shared_edges.data(), w.edge_apexes.data(), limits);
-}
-
 // Appends a cluster made by hand: the given vertices and triangles (local indices, with their
 // shared-edge flags and apexes, 3 per triangle; none: kNoApex).
 void append_cluster(OccluderClusters& clusters, const std::vector<glm::vec3>& vertices, const std::vector<std::uint16_t>& indices,
@@ -77,7 +72,7 @@ TEST(OccluderClusters, KeepEveryTriangleWithItsVerticesAndFlags) {
         ClusterLimits limits;
         limits.max_triangles = max_triangles;
         limits.max_vertices = std::min<std::size_t>(255, max_triangles);
-        const OccluderClusters clusters = cluster_world(world, limits);
+        const OccluderClusters clusters = test::cluster_world(world, limits);
         std::vector<TriangleRecord> before, after;
         for (std::size_t t = 0; t < world.triangle_count(); ++t) {
             const std::uint32_t* v = &world.indices[3 * t];
@@ -303,7 +298,7 @@ const CastleOccluders* castle() {
 TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
     const CastleOccluders* c = castle();
     if (!c) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
-    const OccluderClusters clusters = cluster_world(c->world);
+    const OccluderClusters clusters = test::cluster_world(c->world);
     std::mt19937_64 order_rng(5);
     const ParallelFor tbb = test::parallel_jobs(), shuffled{test::run_shuffled, &order_rng};
     for (const std::size_t view : {std::size_t(0), c->views.frames.size() - 1}) {
@@ -365,7 +360,7 @@ void run_task_list(OcclusionBuffer& buffer, const ParallelFor& jobs) {
 TEST(ClusteredRender, TaskListsGiveTheBitsOfOneRenderPerDraw) {
     const CastleOccluders* c = castle();
     if (!c) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
-    const OccluderClusters clusters = cluster_world(c->world);
+    const OccluderClusters clusters = test::cluster_world(c->world);
     OccluderClusters near_quads;
     for (int k = 0; k < 6; ++k) {  // from behind the eye to far ahead, wide enough to reach the guard band
         const float x = -3.0f + 1.3f * float(k), z = 2.0f - 4.0f * float(k);
@@ -585,7 +580,7 @@ TEST(ClusteredRender, ClaimedSamplesAreBehindEmbreeHits) {
         if (path.empty()) GTEST_SKIP() << k.scene << " is missing from " << test::shared_scenes_dir();
         const Scene scene = load_scene(path);
         const RayScene rays(scene);
-        const OccluderClusters clusters = cluster_world(gather_world_triangles(scene, objects_with_role(scene, k.role)));
+        const OccluderClusters clusters = test::cluster_world(gather_world_triangles(scene, objects_with_role(scene, k.role)));
         for (const Camera& camera : k.cameras)
             for (const auto& [width, height, samples] : {std::tuple{640, 360, 1}, {160, 90, 4}}) {
                 OcclusionBuffer buffer(test::buffer_config(width, height, samples, float(camera.near_plane)));
