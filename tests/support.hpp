@@ -41,9 +41,10 @@ OccluderClusters cluster_world(const WorldTriangles& w, const ClusterLimits& lim
 
 ParallelFor parallel_jobs();
 
-// An instruction set selected (select_isa) while the object lives, and "best" again when it
-// goes, also when a failed ASSERT leaves the test early, so that no later test runs on the
-// wrong one. Tests that run on every instruction set make one per iteration:
+// An instruction set selected (select_isa: the default of buffers made without naming one)
+// while the object lives, and "best" again when it goes, also when a failed ASSERT leaves the
+// test early, so that no later test runs on the wrong one. Tests that run on every
+// instruction set make one per iteration, and their buffers inside it:
 //     for (const std::string& isa : available_isas()) { const test::ScopedIsa selected(isa); ... }
 class ScopedIsa {
 public:

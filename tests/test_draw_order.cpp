@@ -4,6 +4,7 @@
 // numbers a render on one thread reads instead follows the copy, and a render in that order
 // equals a render of the same triangles handed over in that order.
 #include "raster/draw_order.hpp"
+#include "raster/raster_kernels.hpp"
 #include "support.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -22,6 +23,9 @@
 
 namespace homcull::detail {
 namespace {
+
+// The kernels of the instruction set select_isa chose (test::ScopedIsa): those a buffer made now would run.
+const RasterKernels& default_kernels() { return raster_kernels(default_isa_choice()); }
 
 // One input of a given kind, with the storage it points into.
 struct Input {
@@ -208,7 +212,7 @@ TEST(DrawOrder, HoldsEveryTriangleOnceNearestClassFirstAndInInputOrderWithin) {
                 const Input input = make_input(kind, n, rng, /*bad=*/true, /*far=*/n == 5000);
                 DrawOrderScratch scratch;
                 TriangleInput sorted;
-                ASSERT_TRUE(sort_nearest_first(input.in, nullptr, near_w, threads ? test::parallel_jobs() : ParallelFor{}, scratch, sorted));
+                ASSERT_TRUE(sort_nearest_first(default_kernels(), input.in, nullptr, near_w, threads ? test::parallel_jobs() : ParallelFor{}, scratch, sorted));
                 check_order(input.in, sorted, near_w, where);
             }
 }
@@ -225,10 +229,10 @@ TEST(DrawOrder, SortsFromTheVertexCache) {
         std::vector<double> planes(4 * plane);
         std::vector<std::uint8_t> outcodes(input.in.vertex_count);
         const VertexClip cache{planes.data(), planes.data() + plane, planes.data() + 2 * plane, planes.data() + 3 * plane, outcodes.data()};
-        selected_front_end_kernels().transform_vertices(input.in, 1.0, 0, input.in.vertex_count, cache);
+        default_kernels().front_end.transform_vertices(input.in, 1.0, 0, input.in.vertex_count, cache);
         DrawOrderScratch scratch;
         TriangleInput sorted;
-        ASSERT_TRUE(sort_nearest_first(input.in, &cache, 1.0, {}, scratch, sorted));
+        ASSERT_TRUE(sort_nearest_first(default_kernels(), input.in, &cache, 1.0, {}, scratch, sorted));
         check_order(input.in, sorted, 1.0, name(kind) + ", from the cache");
     }
 }
@@ -247,7 +251,7 @@ TEST(DrawOrder, FromTheVertexCacheLeavesOutWhatTheSetupWouldSkipWithoutReorderin
         std::vector<double> planes(4 * plane);
         std::vector<std::uint8_t> outcodes(in.vertex_count);
         const VertexClip cache{planes.data(), planes.data() + plane, planes.data() + 2 * plane, planes.data() + 3 * plane, outcodes.data()};
-        selected_front_end_kernels().transform_vertices(in, 1.0, 0, in.vertex_count, cache);
+        default_kernels().front_end.transform_vertices(in, 1.0, 0, in.vertex_count, cache);
         // What the setup keeps and counts.
         RasterStats expected;
         std::vector<bool> kept(in.triangle_count, false);
@@ -265,8 +269,8 @@ TEST(DrawOrder, FromTheVertexCacheLeavesOutWhatTheSetupWouldSkipWithoutReorderin
             DrawOrderScratch all_scratch, left_scratch;
             TriangleInput all, left;
             RasterStats skipped;
-            ASSERT_TRUE(sort_nearest_first(in, &cache, 1.0, parallel, all_scratch, all));
-            ASSERT_TRUE(sort_nearest_first(in, &cache, 1.0, parallel, left_scratch, left, nullptr, &skipped));
+            ASSERT_TRUE(sort_nearest_first(default_kernels(), in, &cache, 1.0, parallel, all_scratch, all));
+            ASSERT_TRUE(sort_nearest_first(default_kernels(), in, &cache, 1.0, parallel, left_scratch, left, nullptr, &skipped));
             EXPECT_EQ(skipped.invalid, expected.invalid) << where;
             EXPECT_EQ(skipped.outside, expected.outside) << where;
             EXPECT_EQ(skipped.triangles_in, in.triangle_count - kept_count) << where;
@@ -334,7 +338,7 @@ TEST(DrawOrder, TrianglesInFrontOfTheNearPlaneComeFirstAndTiesKeepInputOrder) {
     const TriangleInput in = test::clip_space_input(xyzw);
     DrawOrderScratch scratch;
     TriangleInput sorted;
-    ASSERT_TRUE(sort_nearest_first(in, nullptr, 1.0, {}, scratch, sorted));
+    ASSERT_TRUE(sort_nearest_first(default_kernels(), in, nullptr, 1.0, {}, scratch, sorted));
     const float* p = static_cast<const float*>(sorted.positions);
     std::vector<int> order;
     for (std::size_t t = 0; t < 5; ++t) order.push_back(int(p[12 * t]));  // each triangle's x is its input number
@@ -342,7 +346,7 @@ TEST(DrawOrder, TrianglesInFrontOfTheNearPlaneComeFirstAndTiesKeepInputOrder) {
 
     TriangleInput as_given = in;
     as_given.order = DrawOrder::as_given;
-    EXPECT_FALSE(sort_nearest_first(as_given, nullptr, 1.0, {}, scratch, sorted));
+    EXPECT_FALSE(sort_nearest_first(default_kernels(), as_given, nullptr, 1.0, {}, scratch, sorted));
 }
 
 // Every kind of input, with a partial last vector in the SIMD passes (20,005 triangles).
@@ -355,7 +359,7 @@ TEST(DrawOrder, EveryInstructionSetSortsAlike) {
             const test::ScopedIsa selected(isa);
             DrawOrderScratch scratch;
             TriangleInput sorted;
-            ASSERT_TRUE(sort_nearest_first(input.in, nullptr, 1.0, {}, scratch, sorted));
+            ASSERT_TRUE(sort_nearest_first(default_kernels(), input.in, nullptr, 1.0, {}, scratch, sorted));
             check_order(input.in, sorted, 1.0, name(kind) + ", " + isa);
             const std::size_t n = input.in.triangle_count;
             const std::size_t words = kind == Kind::indexed16 ? (3 * n + 1) / 2 : kind == Kind::indexed32 ? 3 * n
@@ -379,8 +383,8 @@ TEST(DrawOrder, OneThreadSortsSoupsOfFourFloatsAsAListInTheCopysOrder) {
             DrawOrderScratch copy_scratch, list_scratch;
             TriangleInput copy, listed;
             DrawList list;
-            ASSERT_TRUE(sort_nearest_first(input.in, nullptr, 1.0, {}, copy_scratch, copy)) << where;
-            ASSERT_TRUE(sort_nearest_first(input.in, nullptr, 1.0, {}, list_scratch, listed, &list)) << where;
+            ASSERT_TRUE(sort_nearest_first(default_kernels(), input.in, nullptr, 1.0, {}, copy_scratch, copy)) << where;
+            ASSERT_TRUE(sort_nearest_first(default_kernels(), input.in, nullptr, 1.0, {}, list_scratch, listed, &list)) << where;
             if (kind != Kind::soup4) {
                 EXPECT_EQ(list.order, nullptr) << where;
                 EXPECT_TRUE(std::equal(copy_scratch.data.begin(), copy_scratch.data.end(), list_scratch.data.begin())) << where;
@@ -400,11 +404,11 @@ TEST(DrawOrder, OneThreadSortsSoupsOfFourFloatsAsAListInTheCopysOrder) {
     std::vector<std::uint8_t> outcodes(input.in.vertex_count);
     const std::size_t plane = input.in.vertex_count + kVertexClipPadding;
     const VertexClip cache{planes.data(), planes.data() + plane, planes.data() + 2 * plane, planes.data() + 3 * plane, outcodes.data()};
-    selected_front_end_kernels().transform_vertices(input.in, 1.0, 0, input.in.vertex_count, cache);
+    default_kernels().front_end.transform_vertices(input.in, 1.0, 0, input.in.vertex_count, cache);
     DrawOrderScratch scratch;
     TriangleInput sorted;
     DrawList list;
-    ASSERT_TRUE(sort_nearest_first(input.in, &cache, 1.0, {}, scratch, sorted, &list));
+    ASSERT_TRUE(sort_nearest_first(default_kernels(), input.in, &cache, 1.0, {}, scratch, sorted, &list));
     EXPECT_EQ(list.order, nullptr);
 }
 
@@ -420,7 +424,7 @@ TEST(DrawOrder, ARenderNearestFirstIsTheRenderOfTheSortedTriangles) {
     in.model_to_clip = {0.5f, 0, 0, 0, 0, 0.5f, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0};  // within the view
     DrawOrderScratch scratch;
     TriangleInput sorted;
-    ASSERT_TRUE(sort_nearest_first(in, nullptr, 0.1, {}, scratch, sorted));
+    ASSERT_TRUE(sort_nearest_first(default_kernels(), in, nullptr, 0.1, {}, scratch, sorted));
     for (const bool threads : {false, true}) {
         const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
         OcclusionBuffer nearest_first(test::buffer_config(320, 180, 2, 0.1f)), of_sorted(test::buffer_config(320, 180, 2, 0.1f)),

@@ -1,6 +1,7 @@
 // The early skip of triangles hidden behind the reference layer (hidden_behind_reference_layer,
 // nearest_conservative_depth): it must change no bit of the buffer, of its per-sample depth,
 // and no statistic.
+#include "raster/raster_kernels.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 #include "support.hpp"
@@ -85,8 +86,7 @@ TEST(HiddenTriangleSkip, SetupLanesComputeTheBoxNearestDepth) {
     long compared = 0, clamped = 0;
     for (const std::string& isa : available_isas()) {
         if (isa == "scalar") continue;  // the reference sets every triangle up one by one
-        const test::ScopedIsa selected(isa);
-        const FrontEndKernels kernels = selected_front_end_kernels();
+        const FrontEndKernels& kernels = raster_kernels(isa_choice(isa)).front_end;
         ASSERT_TRUE(kernels.setup_planes && kernels.setup_edges) << isa;
         for (int round = 0; round < 400; ++round) {
             TriangleBatch batch{};

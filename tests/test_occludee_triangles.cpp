@@ -1,6 +1,7 @@
 // OcclusionBuffer::test_triangles: occludee triangles tested sample by sample. Hand-built
 // cases for each answer, a hole counted sample by sample, bad input, and a brute-force check on
 // random triangles that the test never hides a triangle seen at a sample of the buffer.
+#include "buffer/buffer_kernels.hpp"
 #include "buffer/occludee_depth.hpp"
 #include "support.hpp"
 
@@ -382,8 +383,7 @@ TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
     int checked = 0, unhidden_seen = 0;
     for (const std::string& isa : available_isas()) {
         if (isa == "scalar") continue;
-        const test::ScopedIsa selected(isa);
-        const detail::OccludeeRowKernel kernel = detail::selected_occludee_row_kernel();
+        const detail::OccludeeRowKernel kernel = detail::buffer_kernels(detail::isa_choice(isa)).occludee_row;
         ASSERT_NE(kernel, nullptr);
         for (int trial = 0; trial < 400; ++trial) {
             detail::OccludeeDepth depth;

@@ -3,6 +3,7 @@
 // input is HiddenTriangleSkip.ChangesNoBitOnS1's to show (every instruction set against a render
 // without any skip); here, each piece's own promise.
 #include "raster/draw_order.hpp"
+#include "raster/raster_kernels.hpp"
 #include "raster/reference_cells.hpp"
 #include "support.hpp"
 
@@ -47,8 +48,7 @@ TEST(ReferenceCells, RefreshGivesTheSmallestD0OfEachCellOfTheRows) {
             }
         const SubtilePlanes planes{d0.data(), nullptr, nullptr, nullptr, stride, nullptr, 0};
         for (const std::string& isa : available_isas()) {
-            const test::ScopedIsa selected(isa);
-            const RefreshCellsKernel refresh = selected_refresh_cells();
+            const RefreshCellsKernel refresh = raster_kernels(isa_choice(isa)).refresh_cells;
             if (isa == "scalar") {  // the reference sets triangles up one by one, without cells
                 EXPECT_EQ(refresh, nullptr);
                 continue;
@@ -109,11 +109,10 @@ TEST(ReferenceCells, NotesBoundWhatDrawingTheTriangleCanDo) {
         std::vector<CellRecord> records, first_records;
         for (const std::string& isa : available_isas()) {
             if (isa == "scalar") continue;
-            const test::ScopedIsa selected(isa);
             std::vector<std::uint16_t> bucket(n);
             std::vector<std::uint32_t> count(kDrawOrderBuckets, 0u);
             records.assign(n, CellRecord{});
-            bucket_packed_soup(xyzw.data(), 4, 0, n, row, near_w, bucket.data(), count.data(), &spec, records.data());
+            raster_kernels(isa_choice(isa)).bucket_packed_soup(xyzw.data(), 4, 0, n, row, near_w, bucket.data(), count.data(), &spec, records.data());
             if (first_records.empty()) first_records = records;
             else EXPECT_EQ(std::memcmp(records.data(), first_records.data(), n * sizeof(CellRecord)), 0) << isa;
         }
@@ -243,10 +242,10 @@ TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
     ASSERT_GT(kept_of_all, n / 5);
     ASSERT_LT(kept_of_all, 4 * n / 5);
     for (const std::string& isa : available_isas()) {
-        const test::ScopedIsa selected(isa);
+        const DropHiddenKernel drop_hidden = raster_kernels(isa_choice(isa)).drop_hidden;
         for (const std::size_t count : {n, std::size_t(5), std::size_t(0)}) {
             std::vector<std::uint32_t> got(n, 0), want(n, 0);
-            const std::size_t got_kept = selected_drop_hidden()(view, notes.data(), count, got.data());
+            const std::size_t got_kept = drop_hidden(view, notes.data(), count, got.data());
             const std::size_t want_kept = drop_hidden_noted(view, notes.data(), count, want.data());
             ASSERT_EQ(got_kept, want_kept) << isa << ", " << count << " notes";
             EXPECT_TRUE(std::equal(want.begin(), want.begin() + std::ptrdiff_t(want_kept), got.begin())) << isa << ", " << count << " notes";

@@ -28,6 +28,8 @@ struct ReferenceCells;
 struct CellRecord;
 struct ChangedSubtiles;
 struct BufferSizes;
+struct BufferKernels;
+struct IsaChoice;
 
 class BufferState {
 public:
@@ -74,6 +76,9 @@ public:
     void check_projection(bool orthographic, const char* caller) const;
 
     BufferConfig config_;
+    // The kernels of the instruction set config_.isa names, for every render, task and query.
+    const BufferKernels* kernels_ = nullptr;
+    const IsaChoice* isa_ = nullptr;  // the choice they were resolved for
     int sample_width_ = 0, sample_height_ = 0;
     int subtiles_x_ = 0, subtiles_y_ = 0;
     // The subtiles as four planes (structure of arrays, so that SIMD kernels load a run of

@@ -4,6 +4,7 @@
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
 #include "buffer/rect_tests.hpp"
 #include "buffer/render_bands.hpp"
@@ -152,8 +153,8 @@ void detail::BufferState::append_placed(const ClusteredInput& in, std::size_t co
 // a cluster's setup.
 struct detail::BufferState::ClusterPass {
     detail::BufferState& b;
-    detail::HiddenTestKernel hidden_test = detail::selected_hidden_test();
-    detail::FrontEndKernels kernels = detail::selected_front_end_kernels();
+    detail::HiddenTestKernel hidden_test = b.kernels_->raster.hidden_test;
+    const detail::FrontEndKernels& kernels = b.kernels_->raster.front_end;
 
     std::size_t plane() const { return b.task_list_vertices_ + detail::kVertexClipPadding; }
     // Scratch for one cluster's transformed vertices (triangle_batch.hpp's cache), one per band.
@@ -188,7 +189,7 @@ struct detail::BufferState::ClusterPass {
         const TriangleInput t = cluster_input(*in.clusters, in.clusters->clusters[p.cluster], in);
         kernels.transform_vertices(t, double(b.config_.near_w), 0, t.vertex_count, cache);
         detail::setup_triangle_range(t, &cache, 0, t.triangle_count, b.config_.near_w, b.config_.edge_margin, b.sample_width_,
-                                     b.sample_height_, nullptr, stats, emit);
+                                     b.sample_height_, nullptr, stats, kernels, emit);
     }
 };
 

@@ -69,7 +69,6 @@ inline void occludee_row_reference(const SubtileView& view, int ty, const std::i
 }
 using OccludeeRowKernel = void (*)(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,
                                    int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden);
-// The SIMD kernel for the selected instruction set; null when the scalar reference is selected.
-OccludeeRowKernel selected_occludee_row_kernel();
+// (A SIMD kernel: BufferKernels::occludee_row.)
 
 }  // namespace homcull::detail

@@ -107,14 +107,14 @@ void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], c
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "common/resolved_kernel.hpp"
+#include "buffer/buffer_kernels.hpp"
 
 namespace homcull::detail {
 
 HWY_EXPORT(OccludeeRow);
 
-OccludeeRowKernel selected_occludee_row_kernel() {
-    return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(OccludeeRow);
+void resolve_occludee_row_kernels(const IsaChoice& choice, BufferKernels& k) {
+    k.occludee_row = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, OccludeeRow);
 }
 
 }  // namespace homcull::detail

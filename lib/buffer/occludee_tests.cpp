@@ -2,6 +2,7 @@
 // whose first, coarse stage runs in SIMD lanes: rect_tests_simd.cpp) and world boxes.
 #include <homcull/occlusion_buffer.hpp>
 
+#include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
 #include "common/float_mode.hpp"
 #include "buffer/min_pyramid.hpp"
@@ -85,7 +86,7 @@ Visibility detail::BufferState::test_prepared_rect(const detail::RectQuery& q) c
     const int x0 = tx0 >> level, x1 = tx1 >> level, y0 = ty0 >> level, y1 = ty1 >> level;
     const float coarse = std::min(std::min(min_d0(level, x0, y0), min_d0(level, x1, y0)), std::min(min_d0(level, x0, y1), min_d0(level, x1, y1)));
     if (q.d_near < coarse) return Visibility::occluded;
-    if (const detail::RectScanKernel scan = detail::selected_rect_scan_kernel()) return scan(subtile_view(), q);
+    if (const detail::RectScanKernel scan = kernels_->rect_scan) return scan(subtile_view(), q);
     // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound
     // (>= d0) is above d_near and the rectangle is hidden. Most hidden rectangles end here.
     const int level_count = int(levels_.size());
@@ -181,7 +182,7 @@ Visibility detail::BufferState::test_aabb(const float box_min[3], const float bo
 
 void detail::BufferState::test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
-    const detail::RectBlockKernel block = detail::selected_rect_block_kernel();
+    const detail::RectBlockKernel block = kernels_->rect_block;
     if (!block) {  // the scalar reference
         for (std::size_t k = 0; k < count; ++k)
             results[k] = test_rect(rects[k].ndc_min_x, rects[k].ndc_min_y, rects[k].ndc_max_x, rects[k].ndc_max_y, rects[k].w_min);

@@ -14,6 +14,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
 #include "common/float_mode.hpp"
 #include "buffer/occludee_depth.hpp"
@@ -164,18 +165,12 @@ struct SampleCounts {
     std::uint64_t samples = 0, visible = 0;
 };
 
-// The SIMD kernels count_triangle uses (null for the scalar reference), looked up once per
-// occludee rather than once per triangle.
-struct OccludeeKernels {
-    detail::RowIntervalsKernel row_intervals = detail::selected_row_intervals_kernel();
-    detail::OccludeeRowKernel row = detail::selected_occludee_row_kernel();
-};
 
 // Counts one screen triangle's outer-covered samples and those not certainly hidden; stops
 // once more than `tolerated` are visible.
 void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error, const PlaneError& depth_error, double margin,
                     const detail::SubtileView& view, int sample_width, int sample_height, std::uint64_t tolerated,
-                    const OccludeeKernels& kernels, SampleCounts& counts) {
+                    const detail::BufferKernels& kernels, SampleCounts& counts) {
     OrientedTriangle tri;
     const bool has_area = detail::orient_triangle(screen, tri);  // its vertices and depths are set either way
     const VertexSlack slack = vertex_slack(error, tri, sample_width, sample_height);
@@ -209,7 +204,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
     }
 
     bool raised_ready = false;
-    const detail::OccludeeRowKernel row_kernel = kernels.row;
+    const detail::OccludeeRowKernel row_kernel = kernels.occludee_row;
     constexpr int kRunSubtiles = 64;
     // Rows reaching fewer subtiles go subtile by subtile (castle C0's occludee tests: 3.04 ms
     // with lanes from 2 subtiles on, 3.08 from 1 or 3; the castle walk the same as without
@@ -219,7 +214,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
     // The rows' intervals a chunk of subtile rows at a time: in SIMD lanes where the instruction
     // set has them (the row loop's kernel, the same intervals), else row by row. They were about
     // a fifth of the castle's occludee tests.
-    const detail::RowIntervalsKernel row_intervals = has_area ? kernels.row_intervals : nullptr;
+    const detail::RowIntervalsKernel row_intervals = has_area ? kernels.raster.row_intervals : nullptr;
     constexpr int kChunkRows = detail::kChunkSubtileRows * kH;
     std::int32_t chunk_first[kChunkRows + detail::kMaxSimdLanes], chunk_last[kChunkRows + detail::kMaxSimdLanes];
     for (int ty = j0 / kH, chunk_ty = ty; ty <= j1 / kH; ++ty) {
@@ -294,7 +289,6 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
     const detail::SubtileView view = subtile_view();
     const double near_w = config_.near_w;
     SampleCounts counts;
-    const OccludeeKernels occludee_kernels;
     bool in_frustum = false;
     auto visible = [&] {
         result.visibility = Visibility::visible;
@@ -341,7 +335,7 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
         const PlaneError depth_error = plane_error(clip, error);
         for (int k = 0; k < setup.count; ++k) {
             count_triangle(setup.triangles[k], error, depth_error, config_.edge_margin, view, sample_width_, sample_height_, tolerated_samples,
-                           occludee_kernels, counts);
+                           *kernels_, counts);
             if (counts.visible > tolerated_samples) return true;
         }
         return false;
@@ -351,7 +345,7 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
     // transform: the triangles of a partly seen object are mostly outside, and their
     // transform was most of what they cost. Same order, same answers and counts.
     constexpr std::size_t kBatch = detail::TriangleBatch::kSize;
-    const detail::FrontEndKernels kernels = detail::selected_front_end_kernels();
+    const detail::FrontEndKernels& kernels = kernels_->raster.front_end;
     detail::TriangleBatch batch;  // gather_triangle_batch fills every lane
     std::size_t t = first_triangle < in.triangle_count ? first_triangle : 0;
     for (std::size_t n = 0; n < in.triangle_count;) {

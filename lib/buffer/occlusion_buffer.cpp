@@ -1,6 +1,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
 #include "common/float_mode.hpp"
 #include "buffer/render_bands.hpp"
@@ -88,6 +89,8 @@ const char* buffer_config_problem(const BufferConfig& config) noexcept {
     if (sample_width * sample_height > double(1 << 28)) return "more than 2^28 samples; lower the resolution or the samples";
     if (sample_width > double(1 << 22) || sample_height > double(1 << 22))  // sample coordinates stay exact in float (conservative_depth)
         return "more than 2^22 samples in a row or column; lower the resolution or the samples";
+    if (config.isa && !detail::find_isa_choice(config.isa))
+        return "the instruction set is not one this machine and build can run (available_isas(), or \"best\")";
     return nullptr;
 }
 
@@ -96,7 +99,8 @@ namespace {
 void validate_config(const BufferConfig& config) {
     if (const char* problem = buffer_config_problem(config))
         throw Error(std::string("occlusion buffer: ") + problem + " (got " + std::to_string(config.width) + "x" + std::to_string(config.height) +
-                    " pixels, " + std::to_string(config.samples) + " samples per axis, near_w " + std::to_string(config.near_w) + ")");
+                    " pixels, " + std::to_string(config.samples) + " samples per axis, near_w " + std::to_string(config.near_w) +
+                    (config.isa ? std::string(", instruction set '") + config.isa + "'" : std::string()) + ")");
 }
 
 }  // namespace
@@ -154,7 +158,11 @@ void detail::BufferState::configure(const BufferConfig& config) {
     const detail::BufferSizes z = buffer_sizes(config);
     reserve_arrays(z);
 
+    const detail::IsaChoice& isa = config.isa ? *detail::find_isa_choice(config.isa) : detail::default_isa_choice();
     config_ = config;
+    config_.isa = isa.name;
+    kernels_ = &detail::buffer_kernels(isa);
+    isa_ = &isa;
     if (config.orthographic) config_.near_w = detail::kOrthographicNearW;  // the near plane, z = -1
     sample_width_ = z.sample_width, sample_height_ = z.sample_height;
     subtiles_x_ = z.subtiles_x, subtiles_y_ = z.subtiles_y;
@@ -347,7 +355,7 @@ detail::ReferenceCells detail::BufferState::start_reference_cells(bool clear_fir
         std::fill(first + own_begin, first + own_end, 0.0f);  // d0 >= 0 everywhere
     } else {
         const detail::SubtilePlanes planes{d0_.data(), d1_.data(), mask_.data(), covered_.data(), stride_, nullptr, 0};
-        detail::selected_refresh_cells()(planes, subtiles_x_, subtiles_y_, int(own_begin / width), int(own_end / width), cells);
+        kernels_->raster.refresh_cells(planes, subtiles_x_, subtiles_y_, int(own_begin / width), int(own_end / width), cells);
     }
     detail::update_cell_blocks(cells, 0, height);  // every row: the infinite ones too
     return cells;
@@ -357,7 +365,7 @@ void detail::BufferState::refresh_reference_cells(const detail::ReferenceCells& 
     if (!cells.min_d0 || row_begin >= row_end) return;
     const detail::SubtilePlanes planes{d0_.data(), d1_.data(), mask_.data(), covered_.data(), stride_, nullptr, 0};
     const int cell_row_begin = row_begin >> detail::kReferenceCellShift, cell_row_end = ((row_end - 1) >> detail::kReferenceCellShift) + 1;
-    detail::selected_refresh_cells()(planes, subtiles_x_, subtiles_y_, cell_row_begin, cell_row_end, cells);
+    kernels_->raster.refresh_cells(planes, subtiles_x_, subtiles_y_, cell_row_begin, cell_row_end, cells);
     detail::update_cell_blocks(cells, cell_row_begin, cell_row_end);
 }
 
@@ -369,7 +377,7 @@ detail::RasterTarget detail::BufferState::raster_target(int row_begin, int row_e
                                        stride_,
                                        sample_depth_.empty() ? nullptr : sample_depth_.data(),
                                        sample_depth_stride_};
-    return {planes, sample_width_, sample_height_, row_begin, row_end, detail::selected_rows_kernel(), detail::hidden_skip_enabled()};
+    return {planes, sample_width_, sample_height_, row_begin, row_end, kernels_->raster.rows, detail::hidden_skip_enabled(), kernels_->raster.hidden_test};
 }
 
 bool detail::BufferState::transform_vertices(const TriangleInput& in, const ParallelFor& parallel, detail::VertexClip& cache) {
@@ -379,7 +387,7 @@ bool detail::BufferState::transform_vertices(const TriangleInput& in, const Para
     if (vertex_outcode_.size() < in.vertex_count) vertex_outcode_.resize(in.vertex_count);
     double* planes = vertex_clip_.data();
     cache = {planes, planes + plane, planes + 2 * plane, planes + 3 * plane, vertex_outcode_.data()};
-    const detail::TransformVerticesKernel transform = detail::selected_front_end_kernels().transform_vertices;
+    const detail::TransformVerticesKernel transform = kernels_->raster.front_end.transform_vertices;
     constexpr std::size_t kVerticesPerTask = 16384;
     // The kernel stores whole vectors (up to 8 vertices) past a task's end: only the last task
     // may have a partial vector, into the cache's padding, never into the next task's vertices.
@@ -433,9 +441,9 @@ void detail::BufferState::render_rows(const TriangleInput& in, const ParallelFor
     // Cell records with the list of a clip-space soup, when the buffer keeps cells and they fit a byte.
     const detail::CellRecordSpec record_spec{sample_width_, sample_height_, reference_cells_width_,
                                              detail::reference_cells_height(subtiles_y_), config_.near_w, in.backface};
-    const bool note = detail::hidden_skip_enabled() && detail::selected_refresh_cells() &&
+    const bool note = detail::hidden_skip_enabled() && kernels_->raster.refresh_cells &&
                       record_spec.cells_width <= detail::kMaxNotedCellsPerSide && record_spec.cells_height <= detail::kMaxNotedCellsPerSide;
-    const TriangleInput& drawn = detail::sort_nearest_first(in, cache, config_.near_w, parallel, *draw_order_, sorted, &list, &skipped,
+    const TriangleInput& drawn = detail::sort_nearest_first(kernels_->raster, in, cache, config_.near_w, parallel, *draw_order_, sorted, &list, &skipped,
                                                             note ? &record_spec : nullptr, !parallel.run)
                                      ? sorted
                                      : in;
@@ -470,7 +478,7 @@ void detail::BufferState::render_serial(const TriangleInput& in, const detail::V
     RasterStats stats;
     detail::ChangedSubtiles changed;
     detail::setup_triangle_range(in, cache, 0, in.triangle_count, config_.near_w, config_.edge_margin, sample_width_, sample_height_, &target,
-                                 stats, [&](const detail::RasterTriangle& tri) {
+                                 stats, kernels_->raster.front_end, [&](const detail::RasterTriangle& tri) {
                                      const std::uint64_t n = target.kernel(target, tri);
                                      updated += n;
                                      if (n != 0) changed.add(tri, subtiles_x_, subtiles_y_);
@@ -520,7 +528,7 @@ void detail::BufferState::draw_noted_part(const TriangleInput& in, detail::DrawL
     for (std::size_t begin = 0; begin < in.triangle_count; begin += kCellRefreshTriangles) {
         const std::size_t end = std::min(in.triangle_count, begin + kCellRefreshTriangles);
         detail::setup_noted_range(in, cells, list, begin, end, scratch.undecided.data(), config_.near_w, config_.edge_margin, sample_width_,
-                                  sample_height_, &target, stats, draw);
+                                  sample_height_, &target, stats, kernels_->raster.front_end, kernels_->raster.drop_hidden, draw);
         refresh_reference_cells(cells, changed_begin, changed_end);
         changed_begin = row_end, changed_end = row_begin;
     }
@@ -665,7 +673,7 @@ void detail::BufferState::render_binned(const TriangleInput& in, const ParallelF
                 };
                 const std::size_t end_triangle = std::min(j.in->triangle_count, (c + 1) * kChunkTriangles);
                 detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, end_triangle, b.config_.near_w, b.config_.edge_margin,
-                                             b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, bin);
+                                             b.sample_width_, b.sample_height_, j.drawn_into, chunk.stats, b.kernels_->raster.front_end, bin);
             }, &job);
 
             detail::run_tasks(parallel, bands, [](void* data, std::size_t band) {
@@ -683,7 +691,7 @@ void detail::BufferState::render_binned(const TriangleInput& in, const ParallelF
                         RasterStats ignored;
                         detail::setup_triangle_range(*j.in, j.cache, c * kChunkTriangles, std::min(j.in->triangle_count, (c + 1) * kChunkTriangles),
                                                      b.config_.near_w, b.config_.edge_margin, b.sample_width_, b.sample_height_, nullptr,
-                                                     ignored, [&](const detail::RasterTriangle& tri) {
+                                                     ignored, b.kernels_->raster.front_end, [&](const detail::RasterTriangle& tri) {
                                                          if (tri.j0 < row_end * kH && tri.j1 >= row_begin * kH) updated += target.kernel(target, tri);
                                                      });
                         continue;

@@ -82,10 +82,9 @@ inline InteriorSubtiles interior_subtiles(const RectQuery& q) {
 }
 
 // The exact stage after the coarse check, scanning the subtile rows in SIMD: occluded when
-// every subtile the rectangle reaches hides it. Null when the scalar reference is selected
-// (test_rect then searches the pyramid; the answers are the same).
+// every subtile the rectangle reaches hides it. None for the scalar choice (test_rect then
+// searches the pyramid; the answers are the same): BufferKernels::rect_scan.
 using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q);
-RectScanKernel selected_rect_scan_kernel();
 
 // The eight corners of a box under a model-to-clip matrix, by the incremental corner transform
 // (Zhang: the base corner plus the three transformed edge vectors), in double. Returns a bound
@@ -118,13 +117,12 @@ double orthographic_corners(glm::dvec4 corners[8], double error);
 // The coarse stage's code for a rectangle it leaves to the exact stage.
 constexpr std::uint8_t kUndecided = 0xFF;
 
-// The batched tests of rectangles [0, count), count <= kRectBlock, for the selected instruction
-// set: the coarse stage in SIMD lanes (repeating prepare() and test_rect's coarse check), then
+// The batched tests of rectangles [0, count), count <= kRectBlock, in an instruction set's
+// SIMD lanes: the coarse stage in SIMD lanes (repeating prepare() and test_rect's coarse check), then
 // the exact scan (ScanRect, which RectScan runs for test_rect) of the ones it leaves open: the
-// answers of test_rect. Null when the scalar reference is selected.
+// answers of test_rect. None for the scalar choice: BufferKernels::rect_block.
 constexpr std::size_t kRectBlock = 256;
 using RectBlockKernel = void (*)(const CoarseRectView& view, const SubtileView& subtiles, const ScreenRect* rects, std::size_t count,
                                  Visibility* results);
-RectBlockKernel selected_rect_block_kernel();
 
 }  // namespace homcull::detail

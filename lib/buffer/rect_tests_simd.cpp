@@ -246,15 +246,17 @@ void TestRectBlock(const CoarseRectView& view, const SubtileView& subtiles, cons
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "common/resolved_kernel.hpp"
+#include "buffer/buffer_kernels.hpp"
 
 namespace homcull::detail {
 
 HWY_EXPORT(TestRectBlock);
 HWY_EXPORT(RectScan);
 
-RectBlockKernel selected_rect_block_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(TestRectBlock); }
-RectScanKernel selected_rect_scan_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(RectScan); }
+void resolve_rect_test_kernels(const IsaChoice& choice, BufferKernels& k) {
+    k.rect_block = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, TestRectBlock);
+    k.rect_scan = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RectScan);
+}
 
 }  // namespace homcull::detail
 #endif  // HWY_ONCE

@@ -16,8 +16,10 @@ namespace {
 constexpr const char* kNoFrame = "no frame has begun on this buffer (homcull_buffer_begin_frame)";
 constexpr const char* kTaskListOpen = "a task list is open on this buffer (homcull_buffer_finish_tasks ends it)";
 
-BufferConfig buffer_config(const homcull_buffer_desc& d) {
+// A buffer runs its context's instruction set.
+BufferConfig buffer_config(const homcull_context& context, const homcull_buffer_desc& d) {
     BufferConfig c;
+    c.isa = context.choice->name;
     c.width = d.width;
     c.height = d.height;
     c.samples = d.samples;
@@ -147,11 +149,11 @@ homcull_result homcull_buffer_create(homcull_context* context, const homcull_buf
     if (!context || !desc) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: context or desc is null", fn);
     if (desc->flags & ~uint32_t(HOMCULL_BUFFER_SAMPLE_DEPTH))
         return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: unknown flags 0x%x", fn, unsigned(desc->flags));
-    const homcull_result valid = check_config(context, fn, buffer_config(*desc));
+    const homcull_result valid = check_config(context, fn, buffer_config(*context, *desc));
     if (valid != HOMCULL_OK) return valid;
     homcull_buffer* buffer = nullptr;
     const homcull_result result = capi::guarded(context, fn, [&]() -> homcull_result {
-        buffer = capi::place<homcull_buffer>(context, buffer_config(*desc));
+        buffer = capi::place<homcull_buffer>(context, buffer_config(*context, *desc));
         return HOMCULL_OK;
     });
     if (result == HOMCULL_OK) *out = buffer;

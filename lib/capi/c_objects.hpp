@@ -3,8 +3,8 @@
 //
 // Every object is placed in memory from the engine's allocator, and everything it holds is made
 // inside a MemoryScope of its own account (homcull/detail/memory.hpp): its containers keep that
-// account's hooks for life. Entry points run under the context's instruction set
-// (common/isa_choice.hpp). Errors found here are reported without throwing (report()); those
+// account's hooks for life. A context's buffers run its instruction set (BufferConfig::isa,
+// common/isa_choice.hpp). Errors found here are reported without throwing (report()); those
 // thrown by the C++ library are caught at the entry point (guarded()), so none reaches the caller.
 #include <homcull/homcull.h>
 
@@ -38,7 +38,7 @@ struct homcull_context {
     homcull_error_callback on_error;
     void* error_user;
     homcull_isa isa;
-    homcull::detail::IsaChoice choice;
+    const homcull::detail::IsaChoice* choice = nullptr;
     std::atomic<std::uint64_t> bytes{0};
     homcull::capi::Account own;  // the context's own memory
     explicit homcull_context(const homcull_context_desc& desc);
@@ -88,7 +88,7 @@ homcull_result report(const homcull_context* context, homcull_result result, con
 #endif
     ;
 
-// Runs `body` (which returns a homcull_result) under the context's instruction set, turning
+// Runs `body` (which returns a homcull_result), turning
 // every exception into a result: std::bad_alloc into HOMCULL_ERROR_OUT_OF_MEMORY, homcull::Error
 // (the library's checks) into HOMCULL_ERROR_INVALID_ARGUMENT, anything else into
 // HOMCULL_ERROR_INTERNAL.
@@ -96,7 +96,6 @@ homcull_result exception_result(const homcull_context* context, const char* func
 template <typename Body>
 homcull_result guarded(const homcull_context* context, const char* function, Body&& body) noexcept {
     try {
-        const detail::IsaScope isa(context ? &context->choice : nullptr);
         return body();
     } catch (...) {
         return exception_result(context, function);

@@ -128,7 +128,7 @@ uint32_t homcull_version(void) { return HOMCULL_VERSION; }
 uint32_t homcull_supported_isas(void) {
     uint32_t bits = 0;
     for (homcull_isa isa = 0; isa < HOMCULL_ISA_COUNT; ++isa)
-        if (detail::isa_available(capi::kIsaNames[isa])) bits |= 1u << isa;
+        if (detail::find_isa_choice(capi::kIsaNames[isa])) bits |= 1u << isa;
     return bits;
 }
 
@@ -156,7 +156,7 @@ homcull_result homcull_context_create(const homcull_context_desc* desc, homcull_
         return fail(capi::report(nullptr, HOMCULL_ERROR_OUT_OF_MEMORY, "homcull_context_create: out of memory (the engine's allocator returned null)"));
     homcull_context* context = new (memory) homcull_context(*desc);
     try {
-        context->choice = detail::make_isa_choice(capi::kIsaNames[desc->isa]);
+        context->choice = &detail::isa_choice(capi::kIsaNames[desc->isa]);
     } catch (...) {  // checked above: only a bug gets here
         const homcull_result r = capi::exception_result(nullptr, "homcull_context_create");
         context->~homcull_context();
@@ -178,7 +178,7 @@ void homcull_context_destroy(homcull_context* context) {
 homcull_isa homcull_context_isa(const homcull_context* context) {
     if (!context) return HOMCULL_ISA_BEST;
     for (homcull_isa isa = 1; isa < HOMCULL_ISA_COUNT; ++isa)
-        if (std::strcmp(context->choice.name, capi::kIsaNames[isa]) == 0) return isa;
+        if (std::strcmp(context->choice->name, capi::kIsaNames[isa]) == 0) return isa;
     return HOMCULL_ISA_BEST;
 }
 

@@ -1,6 +1,5 @@
-// The instruction-set choice: the targets homcull knows by name, the process-wide selection
-// (select_isa) and a caller's own (IsaChoice, isa_choice.hpp), which every layer's kernels
-// follow when they look up their Highway dispatch table (resolved_kernel.hpp).
+// The dispatch module (isa_choice.hpp): the targets homcull knows by name, one IsaChoice per
+// target this CPU and build can run, and the process-wide default that select_isa sets.
 #include "common/isa_choice.hpp"
 
 #include <homcull/error.hpp>
@@ -9,10 +8,8 @@
 #include <hwy/highway.h>
 #include <hwy/targets.h>
 
-#include <algorithm>
 #include <atomic>
 #include <cstring>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -21,106 +18,92 @@ namespace detail {
 
 namespace {
 
-// The plain scalar reference paths, process-wide (select_isa("scalar")).
-std::atomic<bool> use_reference{false};
-
 struct NamedTarget {
     const char* name;
     std::int64_t bits;
 };
-// Best first, as Highway prefers them. sve2_128 and sve_256 are Highway's builds for SVE
-// vectors of exactly 128 (with SVE2) and 256 bits: the CPU supports them only at that length.
+// Best first, as Highway prefers them; entry k is IsaChoice id k + 1 (id 0 is scalar).
+// sve2_128 and sve_256 are Highway's builds for SVE vectors of exactly 128 (with SVE2) and 256
+// bits: the CPU supports them only at that length.
 const NamedTarget kTargets[] = {{"avx512", HWY_AVX3},      {"avx2", HWY_AVX2},       {"sse4", HWY_SSE4}, {"sve2_128", HWY_SVE2_128},
                                 {"sve_256", HWY_SVE_256},  {"sve2", HWY_SVE2},       {"sve", HWY_SVE},   {"neon", HWY_NEON},
                                 {"emu128", HWY_EMU128}};
+static_assert(1 + sizeof kTargets / sizeof kTargets[0] == kIsaChoiceCount, "one choice per target, and scalar");
 
-thread_local const IsaChoice* current_choice = nullptr;
+// The choices this CPU and build can run, made once: the dispatch-table entry of each comes
+// from a hwy::ChosenTarget of our own, updated to that one target (the process-wide one, which
+// HWY_DYNAMIC_DISPATCH reads, is left alone).
+struct Choices {
+    IsaChoice choice[kIsaChoiceCount];
+    bool available[kIsaChoiceCount] = {};
+    int best = 0;  // the id "best" gives
 
-// The CPU's own targets, read once, before select_isa forces one: while a target is forced,
-// Highway's SupportedTargets() returns only that one. (Lifting the force to read them again
-// would change what renders and queries on other threads dispatch to.)
-std::int64_t cpu_targets() {
-    static const std::int64_t cpu = hwy::SupportedTargets();
-    return cpu;
-}
-
-// The Highway target bits of a name ("best": 0), or throws. `scalar` tells the reference paths.
-std::int64_t target_bits(const std::string& name, bool& scalar) {
-    scalar = name == "scalar";
-    if (scalar || name == "best") return 0;
-    const auto t = std::find_if(std::begin(kTargets), std::end(kTargets), [&](const auto& k) { return name == k.name; });
-    if (t == std::end(kTargets)) {
-        std::string known;
-        for (const std::string& n : available_isas()) known += (known.empty() ? "" : ", ") + n;
-        throw Error("unknown instruction set '" + name + "' (available: best, " + known + ")");
+    Choices() {
+        const std::int64_t cpu = hwy::SupportedTargets();
+        hwy::ChosenTarget all;
+        all.Update(cpu);
+        choice[0] = {0, true, int(all.GetIndex()), "scalar"};
+        available[0] = true;
+        for (int k = 0; k < kIsaChoiceCount - 1; ++k) {
+            const int id = k + 1;
+            if (!(HWY_TARGETS & kTargets[k].bits) || !(cpu & kTargets[k].bits)) continue;
+            hwy::ChosenTarget one;
+            one.Update(kTargets[k].bits);
+            choice[id] = {id, false, int(one.GetIndex()), kTargets[k].name};
+            available[id] = true;
+            if (best == 0) best = id;
+        }
     }
-    if (!(HWY_TARGETS & t->bits) || !(cpu_targets() & t->bits))
-        throw Error("instruction set '" + name + "' is not available on this machine or in this build");
-    return t->bits;
+};
+
+const Choices& choices() {
+    static const Choices c;
+    return c;
 }
+
+std::atomic<const IsaChoice*> process_default{nullptr};
 
 }  // namespace
 
-bool scalar_reference_selected() {
-    const IsaChoice* choice = current_isa_choice();
-    return choice ? choice->scalar : use_reference.load();
+const IsaChoice* isa_choice_by_id(int id) noexcept {
+    const Choices& c = choices();
+    return id >= 0 && id < kIsaChoiceCount && c.available[id] ? &c.choice[id] : nullptr;
 }
 
-const IsaChoice* current_isa_choice() noexcept { return current_choice; }
-IsaScope::IsaScope(const IsaChoice* choice) noexcept : previous_(current_choice) { current_choice = choice; }
-IsaScope::~IsaScope() { current_choice = previous_; }
-
-bool isa_available(const char* name) noexcept {
-    if (std::strcmp(name, "best") == 0 || std::strcmp(name, "scalar") == 0) return true;
-    for (const auto& t : kTargets)
-        if (std::strcmp(name, t.name) == 0) return (HWY_TARGETS & t.bits) && (cpu_targets() & t.bits);
-    return false;
+const IsaChoice* find_isa_choice(const char* name) noexcept {
+    const Choices& c = choices();
+    if (std::strcmp(name, "best") == 0) return &c.choice[c.best];
+    for (int id = 0; id < kIsaChoiceCount; ++id)
+        if (c.available[id] && std::strcmp(name, c.choice[id].name) == 0) return &c.choice[id];
+    return nullptr;
 }
 
-// The dispatch-table entry comes from a ChosenTarget of our own, updated to the one target (or
-// to every target the CPU has, for "best"): the process-wide one is left alone.
-IsaChoice make_isa_choice(const std::string& name) {
-    IsaChoice choice;
-    const std::int64_t bits = target_bits(name, choice.scalar);
-    const std::int64_t targets = bits ? bits : cpu_targets();
-    hwy::ChosenTarget chosen;
-    chosen.Update(targets);
-    choice.table_index = int(chosen.GetIndex());
-    choice.name = "scalar";
-    if (!choice.scalar)
-        for (const auto& t : kTargets)
-            if (HWY_TARGETS & targets & t.bits) {
-                choice.name = t.name;  // the best one the table will give
-                break;
-            }
-    return choice;
+const IsaChoice& isa_choice(const std::string& name) {
+    if (const IsaChoice* c = find_isa_choice(name.c_str())) return *c;
+    std::string known;
+    for (const std::string& n : available_isas()) known += (known.empty() ? "" : ", ") + n;
+    for (const NamedTarget& t : kTargets)
+        if (name == t.name) throw Error("instruction set '" + name + "' is not available on this machine or in this build (available: best, " + known + ")");
+    throw Error("unknown instruction set '" + name + "' (available: best, " + known + ")");
+}
+
+const IsaChoice& default_isa_choice() noexcept {
+    const IsaChoice* c = process_default.load(std::memory_order_acquire);
+    return c ? *c : *find_isa_choice("best");
 }
 
 }  // namespace detail
 
 std::vector<std::string> available_isas() {
-    std::vector<std::string> names = {"scalar"};
-    const std::int64_t supported = detail::cpu_targets();
-    for (const auto& t : detail::kTargets)
-        if ((HWY_TARGETS & t.bits) && (supported & t.bits)) names.push_back(t.name);
+    std::vector<std::string> names;
+    for (int id = 0; id < detail::kIsaChoiceCount; ++id)
+        if (const detail::IsaChoice* c = detail::isa_choice_by_id(id)) names.push_back(c->name);
     return names;
 }
 
 // Checks the name first: a name that cannot be selected throws and leaves the selection as it was.
-void select_isa(const std::string& name) {
-    bool scalar = false;
-    const std::int64_t bits = detail::target_bits(name, scalar);
-    detail::use_reference = scalar;
-    if (scalar) return;  // the SIMD targets stay as they were: the scalar paths do not dispatch
-    hwy::SetSupportedTargetsForTest(bits);
-}
+void select_isa(const std::string& name) { detail::process_default.store(&detail::isa_choice(name), std::memory_order_release); }
 
-std::string selected_isa() {
-    if (detail::use_reference) return "scalar";
-    const std::int64_t target = hwy::SupportedTargets() & HWY_TARGETS;
-    for (const auto& t : detail::kTargets)
-        if (target & t.bits) return t.name;  // the best one Highway will dispatch to
-    return "unknown";
-}
+std::string selected_isa() { return detail::default_isa_choice().name; }
 
 }  // namespace homcull

@@ -2,12 +2,11 @@
 // Runs tasks 0..count-1 through the caller's job system (ParallelFor) when it has one and there
 // is more than one task, else one after another on the calling thread. Each task runs as the
 // calling thread would: in the library's floating-point environment (float_mode.hpp), with the
-// caller's memory hooks (homcull/detail/memory.hpp) and instruction set (common/isa_choice.hpp),
-// whichever thread runs it. No exception leaves a task into the job system (a C job system
+// caller's memory hooks (homcull/detail/memory.hpp), whichever thread runs it. (The instruction
+// set is the buffer's: its kernel table travels with the task's data.) No exception leaves a task into the job system (a C job system
 // cannot pass one on, and an exception reaching it would end the process): the first one a
 // task throws is kept and thrown again on the calling thread once every task has returned.
 #include "common/float_mode.hpp"
-#include "common/isa_choice.hpp"
 
 #include <homcull/detail/memory.hpp>
 #include <homcull/parallel_for.hpp>
@@ -27,15 +26,13 @@ inline void run_tasks(const ParallelFor& parallel, std::size_t count, void (*tas
         void (*task)(void*, std::size_t);
         void* data;
         const MemoryHooks* hooks;
-        const IsaChoice* isa;
         std::atomic<bool> failed{false};
         std::exception_ptr error;  // the first task's to throw, written once (failed guards it)
-    } wrapped{task, data, current_memory_hooks(), current_isa_choice(), {false}, nullptr};
+    } wrapped{task, data, current_memory_hooks(), {false}, nullptr};
     parallel.run(parallel.user, count, [](void* w, std::size_t i) {
         Wrapped& t = *static_cast<Wrapped*>(w);
         const StandardFloatMode mode;
         const MemoryScope memory(t.hooks);
-        const IsaScope isa(t.isa);
         try {
             t.task(t.data, i);
         } catch (...) {

@@ -11,6 +11,8 @@
 
 namespace homcull::detail {
 
+struct MapKernels;
+
 class MapsState {
 public:
     // The calls of OcclusionMaps, with its contracts.
@@ -39,6 +41,7 @@ public:
     using Level = detail::PyramidLevel;
     OcclusionMapsConfig config_;
     const OcclusionBuffer* built_ = nullptr;     // the buffer of the last build()
+    const MapKernels* built_with_ = nullptr;     // the kernels it ran: its buffer's instruction set's
     int width_ = 0, height_ = 0, samples_ = 1;  // buffer pixels and samples per axis
     float near_w_ = 0.1f;
     double samples_per_display_pixel_ = 1.0;

@@ -11,6 +11,7 @@
 #include <homcull/occlusion_maps.hpp>
 
 #include "buffer/buffer_state.hpp"
+#include "hom/map_kernels.hpp"
 #include "hom/maps_state.hpp"
 #include "common/float_mode.hpp"
 #include "hom/opacity_pyramid.hpp"
@@ -122,10 +123,12 @@ void detail::MapsState::build(const OcclusionBuffer& buffer) {
                                     state.stride_,         buffer.subtiles_x(), buffer.subtiles_y(), width_,
                                     height_,                samples_,            covered_.data(),      hzb,
                                     nbz};
-    const detail::Level0Kernel level0_kernel = detail::selected_level0_kernel();
+    const detail::MapKernels& kernels = detail::map_kernels(*state.isa_);  // the buffer's instruction set
+    built_with_ = &kernels;
+    const detail::Level0Kernel level0_kernel = kernels.level0;
     detail::level0_reference(level0, level0_kernel ? level0_kernel(level0) : 0);
     // Levels 1..: sums of covered samples, minimum (farthest) of the depth maps.
-    const detail::PyramidRowKernel reduce = detail::selected_pyramid_row_kernel();
+    const detail::PyramidRowKernel reduce = kernels.reduce_row;
     for (std::size_t k = 1; k < levels_.size(); ++k) {
         const Level& below = levels_[k - 1];
         const Level& here = levels_[k];

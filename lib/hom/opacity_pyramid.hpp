@@ -27,11 +27,9 @@ struct Level0Maps {
 // covered samples; its farthest covered bound (d0 for samples outside the subtile's working
 // mask, max(d0, d1) inside it) and its nearest; +inf for both when nothing covers it.
 void level0_reference(const Level0Maps& maps, int tx_begin);
-// The SIMD kernel for the selected instruction set (S = 1: a subtile row's 8 pixels as
-// lanes): does the subtile columns [0, returned) whose pixels all exist. Null when the
-// scalar reference is selected.
+// An instruction set's SIMD kernel (S = 1: a subtile row's 8 pixels as lanes): does the
+// subtile columns [0, returned) whose pixels all exist (MapKernels::level0).
 using Level0Kernel = int (*)(const Level0Maps& maps);
-Level0Kernel selected_level0_kernel();
 
 // One row of the level above, from the rows r0 and r1 of the level below (r1 = r0 at an odd
 // bottom edge, counted once). The reduce kernels do the output cells [0, pairs), whose two
@@ -47,10 +45,9 @@ struct PyramidRows {
 // Output cells [begin, end) of a row; below_width is the row length of the level below.
 void reduce_pyramid_row_reference(const PyramidRows& rows, int begin, int end, int below_width);
 
-// The SIMD kernel for the selected instruction set: does cells [0, pairs) and returns how
-// many it did (a multiple of its vector length); the caller finishes the row with the
-// reference. Null when the scalar reference is selected.
+// An instruction set's SIMD kernel (MapKernels::reduce_row): does cells [0, pairs) and returns
+// how many it did (a multiple of its vector length); the caller finishes the row with the
+// reference.
 using PyramidRowKernel = int (*)(const PyramidRows& rows, int pairs);
-PyramidRowKernel selected_pyramid_row_kernel();
 
 }  // namespace homcull::detail

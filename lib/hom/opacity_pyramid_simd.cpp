@@ -91,15 +91,17 @@ int Level0SingleSample(const Level0Maps& m) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "common/resolved_kernel.hpp"
+#include "hom/map_kernels.hpp"
 
 namespace homcull::detail {
 
 HWY_EXPORT(ReducePyramidRow);
 HWY_EXPORT(Level0SingleSample);
 
-PyramidRowKernel selected_pyramid_row_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(ReducePyramidRow); }
-Level0Kernel selected_level0_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(Level0SingleSample); }
+MapKernels resolve_map_kernels(const IsaChoice& choice) {
+    if (choice.scalar) return {nullptr, nullptr};
+    return {HOMCULL_KERNEL_FOR(choice, Level0SingleSample), HOMCULL_KERNEL_FOR(choice, ReducePyramidRow)};
+}
 
 }  // namespace homcull::detail
 #endif  // HWY_ONCE

@@ -1,6 +1,7 @@
 #include "raster/draw_order.hpp"
 
 #include "common/run_tasks.hpp"
+#include "raster/raster_kernels.hpp"
 
 #include "raster/triangle_setup.hpp"
 
@@ -117,7 +118,7 @@ void bucket_from_codes(const Index* indices, std::size_t begin, std::size_t end,
     skipped.outside += outside;
 }
 
-void bucket_range(const TriangleInput& in, const VertexClip* cache, const std::uint32_t* vertex_code, double near_w, std::size_t begin,
+void bucket_range(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, const std::uint32_t* vertex_code, double near_w, std::size_t begin,
                   std::size_t end, std::uint16_t* bucket, std::uint32_t* count, std::uint32_t* excluded, RasterStats& skipped,
                   const CellRecordSpec* spec, CellRecord* noted) {
     if (vertex_code) {
@@ -139,11 +140,11 @@ void bucket_range(const TriangleInput& in, const VertexClip* cache, const std::u
     const std::size_t stride = in.position_stride / sizeof(float);
     // (An orthographic input's w' needs its z too: it takes the double pass.)
     if (!cache && !in.orthographic && !in.indices && float_aligned && stride == std::size_t(in.position_components)) {
-        bucket_packed_soup(positions, in.position_components, begin, end, row, float(near_w), bucket, count, spec, noted);
+        kernels.bucket_packed_soup(positions, in.position_components, begin, end, row, float(near_w), bucket, count, spec, noted);
         return;
     }
     if (!cache && !in.orthographic && in.indices && float_aligned && in.vertex_count > 0 && in.vertex_count <= (std::size_t(1) << 31) / stride) {
-        bucket_indexed(positions, stride, in.position_components, in.indices, in.indices_16bit, in.vertex_count, begin, end, row, float(near_w),
+        kernels.bucket_indexed(positions, stride, in.position_components, in.indices, in.indices_16bit, in.vertex_count, begin, end, row, float(near_w),
                        bucket, count);
         return;
     }
@@ -245,7 +246,7 @@ void check_draw_order(const TriangleInput& in) {
         throw Error("render: DrawOrder::nearest_first sorts at most 2^32 - 1 triangles per call; split the input or use DrawOrder::as_given");
 }
 
-bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
+bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list, RasterStats* skipped, const CellRecordSpec* records,
                         bool may_list) {
     const std::size_t n = in.triangle_count;
@@ -292,6 +293,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     std::fill_n(scratch.skipped.begin(), tasks, RasterStats{});
 
     struct Job {
+        const RasterKernels* kernels;
         const TriangleInput* in;
         const VertexClip* cache;
         const VertexClip* skip_by;
@@ -299,7 +301,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
         DrawOrderScratch* scratch;
         bool listed;
         const CellRecordSpec* records;  // null: no notes
-    } job{&in, cache, skip_by, near_w, &scratch, listed, noting ? records : nullptr};
+    } job{&kernels, &in, cache, skip_by, near_w, &scratch, listed, noting ? records : nullptr};
     if (skip_by) {  // each vertex's bucket and outcode in a word, read by its triangles
         if (scratch.vertex_code.size() < in.vertex_count) scratch.vertex_code.resize(in.vertex_count);
         run_tasks(parallel, (in.vertex_count + kDrawOrderTask - 1) / kDrawOrderTask, [](void* data, std::size_t k) {
@@ -312,7 +314,7 @@ bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double
     run([](void* data, std::size_t k) {
         const Job& j = *static_cast<Job*>(data);
         DrawOrderScratch& s = *j.scratch;
-        bucket_range(*j.in, j.cache, j.skip_by ? s.vertex_code.data() : nullptr, j.near_w, k * kDrawOrderTask,
+        bucket_range(*j.kernels, *j.in, j.cache, j.skip_by ? s.vertex_code.data() : nullptr, j.near_w, k * kDrawOrderTask,
                      std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(), s.count.data() + k * kDrawOrderBuckets,
                      s.excluded.data() + k * kDrawOrderBuckets, s.skipped[k], j.records, j.records ? s.noted.data() : nullptr);
     });

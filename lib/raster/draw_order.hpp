@@ -23,6 +23,8 @@
 
 namespace homcull::detail {
 
+struct RasterKernels;
+
 // Fine buckets of the nearest clip w (64 per doubling of w, draw_order.cpp), the depth classes
 // drawn one after the other (about equal counts of triangles, each a run of buckets), and
 // triangles per task.
@@ -54,22 +56,6 @@ struct DrawOrderScratch {
     Vector<ListedNote> listed_notes;  // the list of a noted soup: the notes in order, with the triangles' numbers
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
-
-// The first pass of the sort for an input without indices whose vertices are packed 3 or 4
-// floats: the bucket of each triangle of [begin, end) into bucket[t], counted into count[].
-// In float lanes (draw_order_simd.cpp), the same on every instruction set; row is the
-// matrix's last row (m[3], m[7], m[11], m[15]).
-// With `records` (and its spec; the matrix must then be the identity), also the cell record
-// of each triangle into records[t] (reference_cells.hpp).
-void bucket_packed_soup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
-                        std::uint16_t* bucket, std::uint32_t* count, const CellRecordSpec* spec = nullptr, CellRecord* records = nullptr);
-
-// The same for an indexed input, its positions gathered `stride` floats apart (stride *
-// vertex_count <= 2^31, vertex_count > 0); a triangle with an index out of range takes the
-// last bucket.
-void bucket_indexed(const float* positions, std::size_t stride, int components, const void* indices, bool indices_16bit,
-                    std::size_t vertex_count, std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
-                    std::uint32_t* count);
 
 // When in.order is DrawOrder::nearest_first, sorts the input's triangles into kDrawOrderClasses
 // classes by the smallest clip w of their three vertices, each class in input order, and
@@ -116,7 +102,7 @@ void bucket_indexed(const float* positions, std::size_t stride, int components, 
 // vectors (DropHiddenKernel), about 0.3, and every part of the rows reads all of them
 // (render_parts). Otherwise list->notes is null. may_list false (a render with a job system):
 // no list otherwise, the sorted copy.
-bool sort_nearest_first(const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
+bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
                         DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr,
                         const CellRecordSpec* records = nullptr, bool may_list = true);
 

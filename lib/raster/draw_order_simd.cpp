@@ -251,23 +251,16 @@ void BucketIndexed(const float* positions, std::size_t stride, int components, c
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "common/resolved_kernel.hpp"
+#include "raster/raster_kernels.hpp"
 
 namespace homcull::detail {
 
 HWY_EXPORT(BucketPackedSoup);
 HWY_EXPORT(BucketIndexed);
 
-void bucket_packed_soup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
-                        std::uint16_t* bucket, std::uint32_t* count, const CellRecordSpec* spec, CellRecord* records) {
-    HOMCULL_RESOLVED_KERNEL(BucketPackedSoup)(positions, components, begin, end, row, near_w, bucket, count, spec, records);
-}
-
-void bucket_indexed(const float* positions, std::size_t stride, int components, const void* indices, bool indices_16bit,
-                    std::size_t vertex_count, std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
-                    std::uint32_t* count) {
-    HOMCULL_RESOLVED_KERNEL(BucketIndexed)(positions, stride, components, indices, indices_16bit, vertex_count, begin, end, row, near_w,
-                                           bucket, count);
+void resolve_draw_order_kernels(const IsaChoice& choice, RasterKernels& k) {
+    k.bucket_packed_soup = HOMCULL_KERNEL_FOR(choice, BucketPackedSoup);
+    k.bucket_indexed = HOMCULL_KERNEL_FOR(choice, BucketIndexed);
 }
 
 }  // namespace homcull::detail

@@ -40,6 +40,10 @@ struct RasterTriangle;
 // [i0, i1]), then the subtile-row update. Returns the number of subtiles updated (those where
 // the triangle covers a sample and is in front of the reference layer).
 using TriangleRowsKernel = std::uint64_t (*)(const RasterTarget& target, const RasterTriangle& triangle);
+struct SubtilePlanes;
+// hidden_behind_reference_layer as an instruction set's kernel: the SIMD row loop's test (a
+// vector of subtiles per step, the same comparisons, so the same answer), or the scalar one.
+using HiddenTestKernel = bool (*)(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
 
 // The widest SIMD vector the kernels use, in 32-bit lanes: subtile rows are padded so that a
 // vector of this many subtiles loads and stores within the row (see BufferState::stride_).
@@ -62,6 +66,7 @@ struct RasterTarget {
     int row_begin, row_end;  // the subtile rows [row_begin, row_end) this call may write
     TriangleRowsKernel kernel;
     bool skip_hidden;  // hidden_skip_enabled() when the target was made
+    HiddenTestKernel hidden_test;  // the same instruction set's: the setup's test before drawing (triangle_batch.hpp)
 };
 
 // The subtile rows [ty0, ty1] that hold sample rows [j0, j1] and lie within subtile rows
@@ -337,18 +342,11 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& target, const RasterT
 void set_hidden_skip(bool enabled);
 bool hidden_skip_enabled();
 
-// The kernel for the selected instruction set (see select_isa in homcull/isa.hpp).
-TriangleRowsKernel selected_rows_kernel();
-// hidden_behind_reference_layer for the selected instruction set: the SIMD row loop's test
-// (a vector of subtiles per step, the same comparisons, so the same answer), or the scalar one.
-using HiddenTestKernel = bool (*)(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
-HiddenTestKernel selected_hidden_test();
 // subtile_row_intervals for the sample rows [row0, row0 + rows) at once (rows a multiple of
 // 4), the rows as SIMD lanes: the row loop's double intervals, with the same operations, so
 // the same intervals on every row in [j0, j1] (first > last elsewhere, with other values).
-// Writes up to kMaxSimdLanes entries past `rows`. Null when the scalar reference is selected.
+// Writes up to kMaxSimdLanes entries past `rows`. (The scalar reference has none: RasterKernels.)
 using RowIntervalsKernel = void (*)(const TriangleEdges& edges, int i0, int i1, int j0, int j1, int row0, int rows,
                                     std::int32_t* first, std::int32_t* last);
-RowIntervalsKernel selected_row_intervals_kernel();
 
 }  // namespace homcull::detail

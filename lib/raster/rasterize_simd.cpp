@@ -469,8 +469,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 #include <homcull/error.hpp>
 
-#include "common/isa_choice.hpp"
-#include "common/resolved_kernel.hpp"
+#include "raster/raster_kernels.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -489,13 +488,11 @@ namespace {
 std::atomic<bool> skip_hidden{true};
 }  // namespace
 
-TriangleRowsKernel selected_rows_kernel() {
-    return scalar_reference_selected() ? &rasterize_rows_reference : HOMCULL_RESOLVED_KERNEL(RasterizeRows);
+void resolve_rasterize_kernels(const IsaChoice& choice, RasterKernels& k) {
+    k.rows = choice.scalar ? &rasterize_rows_reference : HOMCULL_KERNEL_FOR(choice, RasterizeRows);
+    k.hidden_test = choice.scalar ? &hidden_behind_reference_layer : HOMCULL_KERNEL_FOR(choice, HiddenBehindReferenceLayerKernel);
+    k.row_intervals = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RowIntervals);
 }
-HiddenTestKernel selected_hidden_test() {
-    return scalar_reference_selected() ? &hidden_behind_reference_layer : HOMCULL_RESOLVED_KERNEL(HiddenBehindReferenceLayerKernel);
-}
-RowIntervalsKernel selected_row_intervals_kernel() { return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(RowIntervals); }
 void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
 bool hidden_skip_enabled() { return skip_hidden; }
 

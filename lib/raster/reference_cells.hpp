@@ -127,10 +127,8 @@ inline std::size_t drop_hidden_noted(const ReferenceCells& cells, const ListedNo
 // takes only its subtiles within it). Min is exact: every target gives the same cells.
 using RefreshCellsKernel = void (*)(const SubtilePlanes& planes, int subtiles_x, int subtiles_y, int cell_row_begin, int cell_row_end,
                                     const ReferenceCells& cells);
-RefreshCellsKernel selected_refresh_cells();
 
 // drop_hidden_noted in vectors: the same triangles kept, the same count.
 using DropHiddenKernel = std::size_t (*)(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided);
-DropHiddenKernel selected_drop_hidden();
 
 }  // namespace homcull::detail

@@ -99,7 +99,7 @@ std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "common/resolved_kernel.hpp"
+#include "raster/raster_kernels.hpp"
 
 namespace homcull::detail {
 
@@ -108,11 +108,10 @@ HWY_EXPORT(DropHiddenNoted);
 
 // Only the setup's hidden test reads the cells, and the scalar reference sets triangles up one
 // by one without it: no cells then.
-RefreshCellsKernel selected_refresh_cells() {
-    return scalar_reference_selected() ? nullptr : HOMCULL_RESOLVED_KERNEL(RefreshReferenceCells);
+void resolve_reference_cells_kernels(const IsaChoice& choice, RasterKernels& k) {
+    k.refresh_cells = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RefreshReferenceCells);
+    k.drop_hidden = HOMCULL_KERNEL_FOR(choice, DropHiddenNoted);  // integer work: one answer everywhere
 }
-
-DropHiddenKernel selected_drop_hidden() { return HOMCULL_RESOLVED_KERNEL(DropHiddenNoted); }
 
 void update_cell_blocks(const ReferenceCells& cells, int cell_row_begin, int cell_row_end) {
     const int width = cells.width, height = cells.height;

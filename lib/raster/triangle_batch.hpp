@@ -131,7 +131,7 @@ using SetupEdgesKernel = void (*)(int count, double edge_margin, std::uint32_t s
 // triangle with edge flags `shared_bits`; false when it has no area or covers no sample's box.
 bool assemble_raster_triangle(const BatchSetup& setup, int t, std::uint8_t shared_bits, double edge_margin, RasterTriangle& out);
 
-// The reference or the SIMD kernels, following select_isa. Every kernel gives the same clip
+// The reference or the SIMD kernels of one instruction set (RasterKernels). Every kernel gives the same clip
 // coordinates, outcodes, counts and bits.
 struct FrontEndKernels {
     TransformVerticesKernel transform_vertices;
@@ -179,8 +179,6 @@ struct DrawList {
     // (order is then null).
     const ListedNote* notes = nullptr;
 };
-
-FrontEndKernels selected_front_end_kernels();
 
 // Whether lane t of SetupPlanes' output is hidden in the target's rows: its box reaches none
 // of them, or every subtile of its box there lies behind the reference layer at the nearest
@@ -234,9 +232,8 @@ inline std::uint8_t edges_across(const TriangleInput& in, const VertexClip* cach
 template <typename Emit>
 void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std::size_t begin, std::size_t end, double near_w,
                           double edge_margin, int sample_width, int sample_height, const RasterTarget* drawn_into, RasterStats& stats,
-                          Emit&& emit, DrawList list = {}) {
-    const FrontEndKernels kernels = selected_front_end_kernels();
-    const HiddenTestKernel hidden_test = drawn_into && drawn_into->skip_hidden ? selected_hidden_test() : nullptr;
+                          const FrontEndKernels& kernels, Emit&& emit, DrawList list = {}) {
+    const HiddenTestKernel hidden_test = drawn_into && drawn_into->skip_hidden ? drawn_into->hidden_test : nullptr;
     TriangleBatch batch{};  // zeroed: the last vector of a batch may read lanes past count
     BatchSetup simple;
     for (std::size_t first = begin; first < end;) {
@@ -325,12 +322,13 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
 template <typename Emit>
 void setup_noted_range(const TriangleInput& in, const ReferenceCells& cells, DrawList list, std::size_t begin, std::size_t end,
                        std::uint32_t* undecided, double near_w, double edge_margin, int sample_width, int sample_height,
-                       const RasterTarget* drawn_into, RasterStats& stats, Emit&& emit) {
-    const std::uint64_t hidden = std::uint64_t(end - begin) - selected_drop_hidden()(cells, list.notes + begin, end - begin, undecided);
+                       const RasterTarget* drawn_into, RasterStats& stats, const FrontEndKernels& kernels, DropHiddenKernel drop_hidden,
+                       Emit&& emit) {
+    const std::uint64_t hidden = std::uint64_t(end - begin) - drop_hidden(cells, list.notes + begin, end - begin, undecided);
     stats.triangles_in += hidden;
     stats.rasterized += hidden;
     setup_triangle_range(in, nullptr, 0, (end - begin) - std::size_t(hidden), near_w, edge_margin, sample_width, sample_height, drawn_into,
-                         stats, std::forward<Emit>(emit), DrawList{undecided, nullptr});
+                         stats, kernels, std::forward<Emit>(emit), DrawList{undecided, nullptr});
 }
 
 }  // namespace homcull::detail

@@ -410,7 +410,7 @@ void SetupEdges(int count, double edge_margin, std::uint32_t silhouette_only, st
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#include "common/resolved_kernel.hpp"
+#include "raster/raster_kernels.hpp"
 
 namespace homcull::detail {
 
@@ -423,13 +423,15 @@ HWY_EXPORT(SetupPlanes);
 HWY_EXPORT(SetupEdges);
 HWY_EXPORT(BeyondSidePlane);
 
-FrontEndKernels selected_front_end_kernels() {
-    if (scalar_reference_selected())
-        return {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr, nullptr,
-                &beyond_side_plane_reference, &transform_batch_plain_reference};
-    return {HOMCULL_RESOLVED_KERNEL(TransformVertices), HOMCULL_RESOLVED_KERNEL(TransformBatch), HOMCULL_RESOLVED_KERNEL(ClassifyBatch),
-            HOMCULL_RESOLVED_KERNEL(SetupPlanes), HOMCULL_RESOLVED_KERNEL(SetupEdges),
-            HOMCULL_RESOLVED_KERNEL(GatherDirectBatch), HOMCULL_RESOLVED_KERNEL(BeyondSidePlane), HOMCULL_RESOLVED_KERNEL(TransformBatchPlain)};
+void resolve_front_end_kernels(const IsaChoice& choice, RasterKernels& k) {
+    if (choice.scalar) {
+        k.front_end = {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr, nullptr,
+                       &beyond_side_plane_reference, &transform_batch_plain_reference};
+        return;
+    }
+    k.front_end = {HOMCULL_KERNEL_FOR(choice, TransformVertices), HOMCULL_KERNEL_FOR(choice, TransformBatch), HOMCULL_KERNEL_FOR(choice, ClassifyBatch),
+                   HOMCULL_KERNEL_FOR(choice, SetupPlanes),       HOMCULL_KERNEL_FOR(choice, SetupEdges),     HOMCULL_KERNEL_FOR(choice, GatherDirectBatch),
+                   HOMCULL_KERNEL_FOR(choice, BeyondSidePlane),   HOMCULL_KERNEL_FOR(choice, TransformBatchPlain)};
 }
 
 }  // namespace homcull::detail

@@ -44,6 +44,7 @@ BufferConfig scene_buffer_config(const SceneCullerConfig& c, float near_w) {
     BufferConfig b;
     b.samples = samples;
     b.near_w = near_w;
+    b.isa = c.isa;
     b.sample_depth = c.sample_depth && resolved_occludee_shape(c) == OccludeeShape::samples;
     if (c.buffer.width == 0 && c.buffer.height == 0) {
         if (c.display.width % samples != 0 || c.display.height % samples != 0)
@@ -78,6 +79,7 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
       hierarchy_(ObjectHierarchy::build(scene, config.hierarchy_leaf_size)),
       buffer_(scene_buffer_config(config, 0.1f)),
       maps_(buffer_, maps_config(config)) {
+    config_.isa = buffer_.config().isa;  // the choice made now, for the buffers made when the near plane changes
     const detail::StandardFloatMode mode;  // float_mode.hpp
     if (config.strategy == CullStrategy::progressive && config.progressive_batch_triangles == 0)
         throw Error("progressive culling needs a batch of at least one triangle");

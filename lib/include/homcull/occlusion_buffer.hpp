@@ -69,6 +69,11 @@ struct BufferConfig {
     // holds occluders at different depths, at silhouettes; per-sample depth does not, which
     // test_triangles uses. Costs 4 bytes a sample and a plane evaluation per covered sample.
     bool sample_depth = false;
+    // The instruction set of this buffer's kernels, by a name select_isa takes ("best",
+    // "scalar", "avx2", ...: homcull/isa.hpp); null: select_isa's choice when the buffer is made
+    // or configured. Every one gives the same bits. config() then names the one in use ("best"
+    // becomes the best one's name).
+    const char* isa = nullptr;
 };
 
 // The largest work a buffer will be given (OcclusionBuffer::reserve). Zeros reserve nothing.

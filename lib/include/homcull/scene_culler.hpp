@@ -54,6 +54,9 @@ struct SceneCullerConfig {
     // buffer): 1 for a buffer the display's size, 4 x 4 for a low-resolution one (a quarter of
     // the display or less).
     int samples = 0;
+    // The buffer's instruction set (BufferConfig::isa); null: select_isa's choice when the
+    // culler is made. The culler keeps it for life.
+    const char* isa = nullptr;
     OcclusionMapsConfig maps;  // display_width/height are taken from `display`
     // Back faces are surfaces to ground truth and to the eye: none are culled by default.
     Backface backface = Backface::none;

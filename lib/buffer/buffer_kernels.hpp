@@ -1,0 +1,26 @@
+#pragma once
+// The occlusion buffer's kernels for one instruction set: the raster layer's table and the
+// queries' own, resolved once per choice (common/isa_choice.hpp). A buffer holds a pointer to
+// the table of the instruction set it was made with (BufferConfig::isa) and every render,
+// task and query it runs, on any thread, reads its kernels there.
+#include "buffer/occludee_depth.hpp"
+#include "buffer/rect_tests.hpp"
+#include "raster/raster_kernels.hpp"
+
+namespace homcull::detail {
+
+struct BufferKernels {
+    RasterKernels raster;
+    // The queries' SIMD kernels; null for the scalar choice (the scalar paths answer the same).
+    OccludeeRowKernel occludee_row;  // occludee_depth.hpp
+    RectScanKernel rect_scan;        // rect_tests.hpp
+    RectBlockKernel rect_block;
+};
+
+const BufferKernels& buffer_kernels(const IsaChoice& choice);
+
+// Each SIMD translation unit's part of the table (they hold the HWY_EXPORTs).
+void resolve_occludee_row_kernels(const IsaChoice& choice, BufferKernels& kernels);
+void resolve_rect_test_kernels(const IsaChoice& choice, BufferKernels& kernels);
+
+}  // namespace homcull::detail
