@@ -41,6 +41,7 @@ inline TriangleInput clip_space_input(const std::vector<float>& xyzw) {
     in.triangle_count = in.vertex_count / 3;
     in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     in.backface = Backface::none;
+    in.clip_space = true;
     return in;
 }
 

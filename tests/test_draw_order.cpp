@@ -270,7 +270,7 @@ TEST(DrawOrder, FromTheVertexCacheLeavesOutWhatTheSetupWouldSkipWithoutReorderin
             TriangleInput all, left;
             RasterStats skipped;
             ASSERT_TRUE(sort_nearest_first(default_kernels(), in, &cache, 1.0, parallel, all_scratch, all));
-            ASSERT_TRUE(sort_nearest_first(default_kernels(), in, &cache, 1.0, parallel, left_scratch, left, nullptr, &skipped));
+            ASSERT_TRUE(sort_nearest_first_leaving_out(default_kernels(), in, cache, 1.0, parallel, left_scratch, left, skipped));
             EXPECT_EQ(skipped.invalid, expected.invalid) << where;
             EXPECT_EQ(skipped.outside, expected.outside) << where;
             EXPECT_EQ(skipped.triangles_in, in.triangle_count - kept_count) << where;

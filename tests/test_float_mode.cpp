@@ -60,6 +60,7 @@ Result render_and_test(const ParallelFor& parallel, unsigned caller_mode) {
     const std::vector<float> xyzw = far_triangle();
     TriangleInput in = test::clip_space_input(xyzw);
     in.model_to_clip = {1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f};
+    in.clip_space = false;  // drawn through that matrix
     OcclusionBuffer buffer(test::buffer_config(64, 300, 1, 1.0f));  // 3 bands of subtile rows: tasks on the job system
     buffer.render_frame(in, parallel);
     Result r{buffer.subtiles(), {}};

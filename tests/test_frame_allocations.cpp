@@ -136,12 +136,14 @@ TEST(FrameAllocations, NoneFromTheFirstFrameAfterAReserve) {
     std::vector<std::uint32_t> many_indices(many_xyzw.size() / 4);
     for (std::size_t k = 0; k < many_indices.size(); ++k) many_indices[k] = std::uint32_t(k);
     TriangleInput many = test::clip_space_input(many_xyzw);
+    many.clip_space = false;  // indexed: through the identity matrix
     many.indices = many_indices.data();
     std::vector<float> crossing_xyzw = test::random_clip_triangles(7, 5000, 0.2f, 0.8f);
     for (std::size_t v = 0; v < crossing_xyzw.size(); v += 12) {  // each triangle's first vertex behind the near plane
         for (int c = 0; c < 4; ++c) crossing_xyzw[v + std::size_t(c)] *= 0.02f / crossing_xyzw[v + 3];  // w 0.02, the near plane 0.1
     }
     TriangleInput crossing = test::clip_space_input(crossing_xyzw);
+    crossing.clip_space = false;
     crossing.indices = many_indices.data();
     const test::CityStreet street;
     const WorldTriangles& occluders = street.occluders;

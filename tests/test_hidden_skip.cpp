@@ -204,6 +204,7 @@ TEST(HiddenTriangleSkip, TrianglesWithoutADepthBoundStillCover) {
     const std::vector<float> xyzw = {-0.5f * w, -0.5f * w, 0.0f, w, 0.9f * w, -0.5f * w, 0.0f, w, 0.0f, 0.9f * w, 0.0f, w};
     TriangleInput in = test::clip_space_input(xyzw);
     in.model_to_clip = {1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f, 0, 0, 0, 0, 1e30f};
+    in.clip_space = false;  // drawn through that matrix
     OcclusionBuffer buffer(test::buffer_config(64, 48, 1, 1.0f));
     buffer.render_frame(in);
     ASSERT_EQ(buffer.stats().rasterized, 1u);

@@ -191,6 +191,7 @@ TEST(MalformedInput, OccluderArraysAndCounts) {
     TriangleInput in = test::clip_space_input(std::vector<float>(positions, positions + 9));
     in.position_components = 3;
     in.position_stride = 12;
+    in.clip_space = false;
     in.vertex_count = 3;
     in.triangle_count = std::numeric_limits<std::size_t>::max() / 3 + 1;  // 3 * count wraps around to 2
     EXPECT_THROW(buffer.render(in), Error);

@@ -35,6 +35,7 @@ struct Occluders {
     }
     TriangleInput input() const {
         TriangleInput in = test::clip_space_input(xyzw);
+        in.clip_space = false;  // shared edges: drawn through the identity matrix
         in.shared_edges = shared.data();
         in.edge_apexes = apexes.data();
         return in;

@@ -103,22 +103,22 @@ TEST(ReferenceCells, NotesBoundWhatDrawingTheTriangleCanDo) {
     const int subtiles_x = (alone.sample_width() + kW - 1) / kW, subtiles_y = (alone.sample_height() + kH - 1) / kH;
     std::size_t noted = 0, not_noted = 0, covering = 0;
     for (const Backface backface : {Backface::none, Backface::cw, Backface::ccw}) {
-        const CellRecordSpec spec{alone.sample_width(), alone.sample_height(), reference_cells_width(subtiles_x),
+        const CellNoteSpec spec{alone.sample_width(), alone.sample_height(), reference_cells_width(subtiles_x),
                                   reference_cells_height(subtiles_y), near_w, backface};
         const float row[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // the identity's last row
-        std::vector<CellRecord> records, first_records;
+        std::vector<CellNote> records, first_records;
         for (const std::string& isa : available_isas()) {
             if (isa == "scalar") continue;
             std::vector<std::uint16_t> bucket(n);
             std::vector<std::uint32_t> count(kDrawOrderBuckets, 0u);
-            records.assign(n, CellRecord{});
+            records.assign(n, CellNote{});
             raster_kernels(isa_choice(isa)).bucket_packed_soup(xyzw.data(), 4, 0, n, row, near_w, bucket.data(), count.data(), &spec, records.data());
             if (first_records.empty()) first_records = records;
-            else EXPECT_EQ(std::memcmp(records.data(), first_records.data(), n * sizeof(CellRecord)), 0) << isa;
+            else EXPECT_EQ(std::memcmp(records.data(), first_records.data(), n * sizeof(CellNote)), 0) << isa;
         }
         if (records.empty()) GTEST_SKIP() << "no SIMD instruction set";
         for (std::size_t t = 0; t < n; ++t) {
-            const CellRecord& r = records[t];
+            const CellNote& r = records[t];
             if (std::isnan(r.nearest)) {
                 ++not_noted;
                 continue;
@@ -213,7 +213,7 @@ TEST(ReferenceCells, ANewFrameForgetsTheLastFramesCells) {
 }
 
 // The vector drop (block tables) decides every note as the scalar loop over the cells does
-// (drop_hidden_noted, on hidden_by_record): boxes of 1 x 1 to 6 x 9 cells (more than 8: the
+// (drop_hidden_noted, on hidden_by_note): boxes of 1 x 1 to 6 x 9 cells (more than 8: the
 // kernel's own fallback), notes missing (NaN depth, box zeroed as the notes kernel leaves it),
 // depths equal to a cell's, counts that leave a partial vector. Then the tables follow changed
 // rows (update_cell_blocks on those rows only).
@@ -225,15 +225,15 @@ TEST(ReferenceCells, TheDropKernelKeepsWhatTheScalarDropKeeps) {
     for (std::size_t c = 0; c < std::size_t(width * height); ++c)
         cells[c] = depth(rng) < 0.3f ? std::numeric_limits<float>::infinity() : depth(rng);  // infinite: another part's rows
     const std::size_t n = 5000 + 7;
-    std::vector<ListedNote> notes(n);
+    std::vector<TriangleNote> notes(n);
     for (std::size_t k = 0; k < n; ++k) {
         notes[k].triangle = std::uint32_t(rng());
-        CellRecord& r = notes[k].note;
+        CellNote& r = notes[k].note;
         const int span_x = rng() % 4 == 0 ? int(rng() % 6) : int(rng() % 2), span_y = rng() % 4 == 0 ? int(rng() % 9) : int(rng() % 2);
         r.cx0 = std::uint8_t(rng() % std::uint64_t(width - span_x)), r.cy0 = std::uint8_t(rng() % std::uint64_t(height - span_y));
         r.cx1 = std::uint8_t(r.cx0 + span_x), r.cy1 = std::uint8_t(r.cy0 + span_y);
         r.nearest = rng() % 3 == 0 ? cells[std::size_t(r.cy0 * width + r.cx0)] : depth(rng);
-        if (rng() % 10 == 0) r = CellRecord{0, 0, 0, 0, std::numeric_limits<float>::quiet_NaN()};
+        if (rng() % 10 == 0) r = CellNote{0, 0, 0, 0, std::numeric_limits<float>::quiet_NaN()};
     }
     const ReferenceCells view{cells.data(), width, height};
     update_cell_blocks(view, 0, height);

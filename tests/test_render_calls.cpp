@@ -3,9 +3,11 @@
 // the reference cells the last call left. Both must leave what a full rebuild would.
 #include "support.hpp"
 
+#include <homcull/error.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
+#include "buffer/buffer_state.hpp"   // choose_triangle_path
 #include "raster/rasterize.hpp"  // set_hidden_skip
 
 #include <gtest/gtest.h>
@@ -99,6 +101,65 @@ TEST(RenderCalls, ClustersAndIndexedCallsKeepThePyramidExact) {
         if (call % 10 == 0) expect_pyramid_and_answers_exact(buffer, "after clustered call " + std::to_string(call));
     }
     expect_pyramid_and_answers_exact(buffer, "at the end");
+}
+
+// The render path is chosen by one function from the input's declared form and the caller's
+// job system, never guessed from the data: a clip-space soup goes through its cell notes only
+// when it says so (TriangleInput::clip_space), and gives the bits of the same triangles drawn
+// through the identity matrix, on one thread and with a job system, on every instruction set.
+TEST(RenderCalls, ClipSpaceSoupsSayWhatTheyAreAndGiveTheIdentityMatrixBits) {
+    using detail::TrianglePath;
+    const std::vector<float> xyzw = test::random_clip_triangles(21, 20000, 0.3f);
+    TriangleInput soup = test::clip_space_input(xyzw);
+    EXPECT_EQ(detail::choose_triangle_path(soup, false, true), TrianglePath::noted);
+    EXPECT_EQ(detail::choose_triangle_path(soup, true, true), TrianglePath::noted_parts);
+    EXPECT_EQ(detail::choose_triangle_path(soup, false, false), TrianglePath::serial);  // no cells: the scalar reference
+    TriangleInput plain = soup;
+    plain.clip_space = false;  // the same floats and the identity matrix: no longer taken for a soup
+    EXPECT_EQ(detail::choose_triangle_path(plain, false, true), TrianglePath::serial);
+    EXPECT_EQ(detail::choose_triangle_path(plain, true, true), TrianglePath::binned);
+    TriangleInput as_given = soup;
+    as_given.order = DrawOrder::as_given;  // notes come with the sort
+    EXPECT_EQ(detail::choose_triangle_path(as_given, false, true), TrianglePath::serial);
+    // model_to_clip is not read: a soup with a matrix of garbage draws as with the identity.
+    TriangleInput ignored = soup;
+    ignored.model_to_clip = {3, 1, 4, 1, 5, 9, 2, 6, 5, 3, 5, 8, 9, 7, 9, 3};
+    for (const std::string& isa : available_isas()) {
+        const test::ScopedIsa selected(isa);
+        for (const bool threads : {false, true}) {
+            const ParallelFor parallel = threads ? test::parallel_jobs() : ParallelFor{};
+            OcclusionBuffer noted(test::buffer_config(257, 131, 2, 1.0f)), through_matrix(test::buffer_config(257, 131, 2, 1.0f)),
+                garbage(test::buffer_config(257, 131, 2, 1.0f));
+            noted.render_frame(soup, parallel);
+            through_matrix.render_frame(plain, parallel);
+            garbage.render_frame(ignored, parallel);
+            EXPECT_TRUE(test::same_subtiles(noted, through_matrix)) << isa << (threads ? ", job system" : "");
+            EXPECT_TRUE(test::same_pyramid(noted, through_matrix)) << isa << (threads ? ", job system" : "");
+            EXPECT_TRUE(noted.stats() == through_matrix.stats()) << isa << (threads ? ", job system" : "");
+            EXPECT_TRUE(test::same_subtiles(noted, garbage)) << isa << (threads ? ", job system" : "");
+        }
+    }
+    // A soup that breaks the form is refused, naming it, before anything changes.
+    std::vector<std::uint32_t> indices(3 * soup.triangle_count);
+    for (std::size_t k = 0; k < indices.size(); ++k) indices[k] = std::uint32_t(k);
+    std::vector<std::uint8_t> flags(soup.triangle_count, 0);
+    std::vector<std::uint32_t> apexes(3 * soup.triangle_count, kNoApex);
+    std::vector<TriangleInput> broken(4, soup);
+    broken[0].position_components = 3;
+    broken[1].indices = indices.data();
+    broken[2].shared_edges = flags.data(), broken[2].edge_apexes = apexes.data();
+    broken[3].position_stride = 20;
+    OcclusionBuffer buffer(test::buffer_config(64, 32, 1, 1.0f));
+    for (const TriangleInput& in : broken) {
+        try {
+            buffer.render(in);
+            ADD_FAILURE() << "a broken clip_space input was drawn";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("clip_space"), std::string::npos) << e.what();
+        }
+        EXPECT_EQ(buffer.stats().triangles_in, 0u);
+        EXPECT_THROW((void)buffer.test_triangles(in), Error);
+    }
 }
 
 }  // namespace

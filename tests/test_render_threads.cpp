@@ -84,6 +84,7 @@ TEST(RenderThreads, ChunksClippedBeyondTheirRoomGiveTheSameBits) {
         indices.insert(indices.end(), {3 * t + 2, 3 * t, 3 * t + 1});
     }
     TriangleInput in = test::clip_space_input(xyzw);
+    in.clip_space = false;  // indexed: through the identity matrix
     in.indices = indices.data();
     in.triangle_count = indices.size() / 3;
     BufferConfig config;
@@ -213,8 +214,6 @@ bool pyramid_matches_subtiles(const OcclusionBuffer& buffer) {
 // shared-edge flags (all zero: the same triangles) the same soup goes in waves (two runs each).
 TEST(RenderThreads, ARenderFailingPartWayLeavesAMatchingConservativeBuffer) {
     const std::vector<float> last = test::random_clip_triangles(31, 3000, 0.4f, 0.5f), frame = test::random_clip_triangles(32, 30000, 0.3f);
-    const std::vector<std::uint8_t> no_shared_edges(frame.size() / 12, 0);
-    const std::vector<std::uint32_t> no_apexes(frame.size() / 4, kNoApex);
     BufferConfig config;
     config.width = 301;
     config.height = 277;
@@ -222,7 +221,7 @@ TEST(RenderThreads, ARenderFailingPartWayLeavesAMatchingConservativeBuffer) {
     config.near_w = 1.0f;
     for (const bool in_parts : {true, false}) {
         TriangleInput in = test::clip_space_input(frame);
-        if (!in_parts) in.shared_edges = no_shared_edges.data(), in.edge_apexes = no_apexes.data();
+        in.clip_space = in_parts;  // else the same triangles through the identity matrix: the binned path
         OcclusionBuffer whole(config);
         whole.render(test::clip_space_input(last));
         whole.render_frame(in);

@@ -25,11 +25,23 @@ struct DrawList;
 struct RasterTriangle;
 struct DrawOrderScratch;
 struct ReferenceCells;
-struct CellRecord;
+struct CellNote;
 struct ChangedSubtiles;
 struct BufferSizes;
 struct BufferKernels;
 struct IsaChoice;
+
+// The paths a render of triangles takes, all giving the same bits. One function chooses:
+// - serial: one thread, each triangle set up and drawn over the whole buffer, in (sorted) order;
+// - noted: one thread, a clip-space soup (TriangleInput::clip_space) drawn nearest first
+//   through its cell notes, dropping most hidden triangles unread (render_noted.cpp);
+// - noted_parts: the same with a job system, a task per part of the rows;
+// - binned: a job system, chunks set up in tasks, then bands of rows drawn in tasks
+//   (render_binned.cpp).
+// The noted paths need the buffer to keep reference cells (`cells_kept`: the hidden-triangle
+// skip on, an instruction set with the refresh kernel, cells that fit a note).
+enum class TrianglePath : std::uint8_t { serial, noted, noted_parts, binned };
+TrianglePath choose_triangle_path(const TriangleInput& in, bool job_system, bool cells_kept);
 
 class BufferState {
 public:
@@ -126,17 +138,20 @@ public:
     Visibility test_prepared_rect(const RectQuery& q) const;
     SubtileView subtile_view() const;
 
-    // Rendering (occlusion_buffer.cpp): without a job system straight through, with one in
-    // parts of rows (a noted soup) or binned by bands of subtile rows; the same bits either way.
+    // Rendering triangles (render_triangles.cpp chooses the path: choose_triangle_path).
     RasterTarget raster_target(int row_begin, int row_end);
     // clear_first: render_frame, which clears the rows where it rasterizes them.
     void render_rows(const TriangleInput& in, const ParallelFor& parallel, bool clear_first);
     void render_serial(const TriangleInput& in, const VertexClip* cache, bool clear_first, DrawList list);
+    // A clip-space soup through its cell notes (render_noted.cpp): on one thread, or in parts of
+    // rows with a job system.
+    void render_noted(const TriangleInput& in, bool clear_first, DrawList list);
     void render_parts(const TriangleInput& in, const ParallelFor& parallel, bool clear_first, DrawList list);
     // Part `part` of a noted render: the list's triangles drawn into subtile rows [row_begin,
     // row_end) with that part's cells; its statistics counted as for the whole buffer.
     void draw_noted_part(const TriangleInput& in, DrawList list, bool clear_first, std::size_t part, int row_begin, int row_end,
                          bool cells_current = false);
+    // With a job system (render_binned.cpp).
     void render_binned(const TriangleInput& in, const ParallelFor& parallel, const VertexClip* cache, bool clear_first);
     // Transforms an indexed input's vertices to clip space into the scratch below and points
     // `cache` at it (triangle_batch.hpp); false when transforming them triangle by triangle is cheaper.

@@ -154,7 +154,7 @@ void detail::BufferState::append_placed(const ClusteredInput& in, std::size_t co
 struct detail::BufferState::ClusterPass {
     detail::BufferState& b;
     detail::HiddenTestKernel hidden_test = b.kernels_->raster.hidden_test;
-    const detail::FrontEndKernels& kernels = b.kernels_->raster.front_end;
+    detail::FrontEndKernels kernels = b.kernels_->raster.front_end;
 
     std::size_t plane() const { return b.task_list_vertices_ + detail::kVertexClipPadding; }
     // Scratch for one cluster's transformed vertices (triangle_batch.hpp's cache), one per band.

@@ -278,9 +278,11 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
 
 }  // namespace
 
-OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const TriangleInput& in, std::uint64_t tolerated_samples,
+OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const TriangleInput& given, std::uint64_t tolerated_samples,
                                                               std::size_t first_triangle) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
+    TriangleInput identity;
+    const TriangleInput& in = detail::with_clip_space_matrix(given, identity);
     TriangleTest result;
     if (in.triangle_count == 0) return result;
     detail::check_triangle_input(in, "test_triangles");

@@ -31,6 +31,7 @@ TriangleInput WorkloadS1::occluder_input() const {
     in.triangle_count = occluder_count();
     in.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     in.backface = Backface::cw;
+    in.clip_space = true;  // clip-space points already: drawn through cell notes
     return in;
 }
 

@@ -120,7 +120,7 @@ void bucket_from_codes(const Index* indices, std::size_t begin, std::size_t end,
 
 void bucket_range(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, const std::uint32_t* vertex_code, double near_w, std::size_t begin,
                   std::size_t end, std::uint16_t* bucket, std::uint32_t* count, std::uint32_t* excluded, RasterStats& skipped,
-                  const CellRecordSpec* spec, CellRecord* noted) {
+                  const CellNoteSpec* spec, CellNote* noted) {
     if (vertex_code) {
         with_typed_indices(in, [&](const auto* indices) {
             bucket_from_codes(indices, begin, end, in.vertex_count, vertex_code, bucket, count, excluded, skipped);
@@ -180,10 +180,10 @@ void place_triangles(std::size_t begin, std::size_t end, const std::uint16_t* bu
 
 void place_range(const TriangleInput& in, bool listed, bool some_skipped, std::size_t begin, std::size_t end, const std::uint16_t* bucket,
                  const std::uint8_t* class_of, std::uint32_t* start, std::uint32_t* data, std::uint8_t* shared_edges,
-                 std::uint32_t* edge_apexes, std::uint32_t* placed_at, const CellRecord* noted, ListedNote* listed_notes) {
+                 std::uint32_t* edge_apexes, std::uint32_t* placed_at, const CellNote* noted, TriangleNote* sorted_notes) {
     if (listed && noted) {  // the notes with the triangles' numbers: the list of a noted soup
         place_triangles(begin, end, bucket, class_of, start, some_skipped,
-                        [&](std::size_t t, std::size_t p) { listed_notes[p] = {noted[t], std::uint32_t(t)}; });
+                        [&](std::size_t t, std::size_t p) { sorted_notes[p] = {noted[t], std::uint32_t(t)}; });
         return;
     }
     if (listed) {  // the triangles' numbers only (DrawList): shared-edge flags stay the input's
@@ -246,31 +246,27 @@ void check_draw_order(const TriangleInput& in) {
         throw Error("render: DrawOrder::nearest_first sorts at most 2^32 - 1 triangles per call; split the input or use DrawOrder::as_given");
 }
 
-bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
-                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list, RasterStats* skipped, const CellRecordSpec* records,
-                        bool may_list) {
+namespace {
+
+// What one counting sort does (the three entry points below): `skip_by` leaves out the
+// triangles its outcodes skip; `listed` places numbers (or, with `note_spec`, notes) instead of
+// copies. Returns the triangles left out.
+struct SortJob {
+    const RasterKernels* kernels;
+    const TriangleInput* in;
+    const VertexClip* cache;    // where the clip w comes from (null: computed)
+    const VertexClip* skip_by;  // the cache whose outcodes leave triangles out, or null
+    double near_w;
+    DrawOrderScratch* scratch;
+    bool listed;
+    const CellNoteSpec* note_spec;  // null: no notes
+};
+
+std::size_t counting_sort(SortJob job, const ParallelFor& parallel, RasterStats* skipped) {
+    const TriangleInput& in = *job.in;
+    DrawOrderScratch& scratch = *job.scratch;
     const std::size_t n = in.triangle_count;
-    if (list) *list = DrawList{};
-    const VertexClip* skip_by = skipped ? cache : nullptr;  // the cache whose outcodes leave triangles out
-    if (in.order == DrawOrder::as_given || n == 0) return false;
-    check_draw_order(in);
-    // Notes for the cells: bucket_range's pass over a packed soup of 4 floats per vertex in clip
-    // space, without shared-edge flags, drawn through a list (with or without a job system:
-    // with notes, the list's scattered reads are mostly of the notes).
-    const bool clip_space_soup = list && records && !cache && !in.indices && !in.shared_edges && !in.orthographic && is_identity(in.model_to_clip) &&
-                                 in.position_stride == 4 * sizeof(float);
-    const bool listed = (may_list || clip_space_soup) && list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
-    const bool noting = clip_space_soup && listed;
-    // A counting sort in tasks of kDrawOrderTask triangles, in two passes:
-    // 1. each task buckets its triangles (fine buckets, about 1 % of w each) and counts them
-    //    per bucket;
-    // 2. the buckets, in order, are grouped into kDrawOrderClasses depth classes of about equal
-    //    counts, and every (class, task) gets its first position, classes in order and tasks in
-    //    order within a class; each task then copies its triangles there.
-    // Stable, so the order does not depend on the tasks. Few classes rather than every bucket:
-    // the copies then go to a few sequential streams instead of scattering over the whole copy
-    // (S1's render with 1,024 classes was slower than with none), and drawing S1 in 32 classes
-    // of depth is within 2 % of drawing it fully sorted (docs/occlusion-buffer.md, "Draw order").
+    const bool listed = job.listed, noting = job.note_spec != nullptr;
     const std::size_t tasks = (n + kDrawOrderTask - 1) / kDrawOrderTask;
     const std::size_t words = noting        ? 0
                               : listed      ? n
@@ -287,36 +283,26 @@ bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, c
     if (scratch.start.size() < tasks * kDrawOrderClasses) scratch.start.resize(tasks * kDrawOrderClasses);
     if (scratch.skipped.size() < tasks) scratch.skipped.resize(tasks);
     if (noting && scratch.noted.size() < n) scratch.noted.resize(n);
-    if (noting && scratch.listed_notes.size() < n) scratch.listed_notes.resize(n);
+    if (noting && scratch.sorted_notes.size() < n) scratch.sorted_notes.resize(n);
     std::fill_n(scratch.count.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.excluded.begin(), tasks * kDrawOrderBuckets, 0u);
     std::fill_n(scratch.skipped.begin(), tasks, RasterStats{});
 
-    struct Job {
-        const RasterKernels* kernels;
-        const TriangleInput* in;
-        const VertexClip* cache;
-        const VertexClip* skip_by;
-        double near_w;
-        DrawOrderScratch* scratch;
-        bool listed;
-        const CellRecordSpec* records;  // null: no notes
-    } job{&kernels, &in, cache, skip_by, near_w, &scratch, listed, noting ? records : nullptr};
-    if (skip_by) {  // each vertex's bucket and outcode in a word, read by its triangles
+    if (job.skip_by) {  // each vertex's bucket and outcode in a word, read by its triangles
         if (scratch.vertex_code.size() < in.vertex_count) scratch.vertex_code.resize(in.vertex_count);
         run_tasks(parallel, (in.vertex_count + kDrawOrderTask - 1) / kDrawOrderTask, [](void* data, std::size_t k) {
-            const Job& j = *static_cast<Job*>(data);
+            const SortJob& j = *static_cast<const SortJob*>(data);
             code_vertices(*j.skip_by, j.near_w, k * kDrawOrderTask, std::min(j.in->vertex_count, (k + 1) * kDrawOrderTask),
                           j.scratch->vertex_code.data());
         }, &job);
     }
     const auto run = [&](void (*task)(void*, std::size_t)) { run_tasks(parallel, tasks, task, &job); };
     run([](void* data, std::size_t k) {
-        const Job& j = *static_cast<Job*>(data);
+        const SortJob& j = *static_cast<const SortJob*>(data);
         DrawOrderScratch& s = *j.scratch;
         bucket_range(*j.kernels, *j.in, j.cache, j.skip_by ? s.vertex_code.data() : nullptr, j.near_w, k * kDrawOrderTask,
                      std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask), s.bucket.data(), s.count.data() + k * kDrawOrderBuckets,
-                     s.excluded.data() + k * kDrawOrderBuckets, s.skipped[k], j.records, j.records ? s.noted.data() : nullptr);
+                     s.excluded.data() + k * kDrawOrderBuckets, s.skipped[k], j.note_spec, j.note_spec ? s.noted.data() : nullptr);
     });
     // The triangles left out, counted as the setup would have (in any task order: sums).
     std::size_t left_out = 0;
@@ -356,24 +342,25 @@ bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, c
             sum += count;
         }
     run([](void* data, std::size_t k) {
-        const Job& j = *static_cast<Job*>(data);
+        const SortJob& j = *static_cast<const SortJob*>(data);
         DrawOrderScratch& s = *j.scratch;
         place_range(*j.in, j.listed, j.skip_by != nullptr, k * kDrawOrderTask, std::min(j.in->triangle_count, (k + 1) * kDrawOrderTask),
                     s.bucket.data(), s.class_of, s.start.data() + k * kDrawOrderClasses, s.data.data(),
                     j.in->shared_edges && !j.listed ? s.shared_edges.data() : nullptr, s.edge_apexes.data(),
-                    j.in->shared_edges && !j.listed && !j.in->indices ? s.placed_at.data() : nullptr, j.records ? s.noted.data() : nullptr,
-                    s.listed_notes.data());
+                    j.in->shared_edges && !j.listed && !j.in->indices ? s.placed_at.data() : nullptr, j.note_spec ? s.noted.data() : nullptr,
+                    s.sorted_notes.data());
     });
     if (copies_flags && !in.indices) remap_soup_apexes(scratch.edge_apexes.data(), scratch.placed_at.data(), n);
+    return left_out;
+}
 
+// `sorted`: the input as the copy in scratch draws it (indices, or a soup's positions, and
+// the flags), left_out triangles fewer.
+void point_at_copy(const TriangleInput& in, DrawOrderScratch& scratch, std::size_t left_out, TriangleInput& sorted) {
+    const std::size_t n = in.triangle_count;
     sorted = in;
     sorted.order = DrawOrder::as_given;
     sorted.triangle_count = n - left_out;
-    if (listed) {
-        if (noting) list->notes = scratch.listed_notes.data();
-        else list->order = scratch.data.data();
-        return true;
-    }
     sorted.shared_edges = in.shared_edges ? scratch.shared_edges.data() : nullptr;
     sorted.edge_apexes = in.shared_edges ? scratch.edge_apexes.data() : nullptr;
     if (in.indices) {
@@ -383,6 +370,43 @@ bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, c
         sorted.position_stride = std::size_t(in.position_components) * sizeof(float);
         sorted.vertex_count = 3 * n;
     }
+}
+
+}  // namespace
+
+bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, double near_w,
+                        const ParallelFor& parallel, DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list) {
+    if (list) *list = DrawList{};
+    if (in.order == DrawOrder::as_given || in.triangle_count == 0) return false;
+    check_draw_order(in);
+    const bool listed = list && !cache && gather_listed_ready(in, 0, std::size_t(TriangleBatch::kSize));
+    const std::size_t left_out = counting_sort({&kernels, &in, cache, nullptr, near_w, &scratch, listed, nullptr}, parallel, nullptr);
+    if (listed) {
+        sorted = in;
+        sorted.order = DrawOrder::as_given;
+        list->order = scratch.data.data();
+        return true;
+    }
+    point_at_copy(in, scratch, left_out, sorted);
+    return true;
+}
+
+bool sort_nearest_first_leaving_out(const RasterKernels& kernels, const TriangleInput& in, const VertexClip& cache, double near_w,
+                                    const ParallelFor& parallel, DrawOrderScratch& scratch, TriangleInput& sorted, RasterStats& skipped) {
+    if (in.order == DrawOrder::as_given || in.triangle_count == 0) return false;
+    check_draw_order(in);
+    const std::size_t left_out = counting_sort({&kernels, &in, &cache, &cache, near_w, &scratch, false, nullptr}, parallel, &skipped);
+    point_at_copy(in, scratch, left_out, sorted);
+    return true;
+}
+
+bool sort_noting_cells(const RasterKernels& kernels, const TriangleInput& soup, double near_w, const ParallelFor& parallel,
+                       DrawOrderScratch& scratch, const CellNoteSpec& spec, DrawList& list) {
+    list = DrawList{};
+    if (soup.order == DrawOrder::as_given || soup.triangle_count == 0) return false;
+    check_draw_order(soup);
+    counting_sort({&kernels, &soup, nullptr, nullptr, near_w, &scratch, true, &spec}, parallel, nullptr);
+    list.notes = scratch.sorted_notes.data();
     return true;
 }
 

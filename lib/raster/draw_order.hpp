@@ -52,61 +52,62 @@ struct DrawOrderScratch {
     Vector<std::uint8_t> shared_edges;
     Vector<std::uint32_t> edge_apexes;  // 3 per triangle, with the flags
     Vector<std::uint32_t> placed_at;    // a soup's: each input triangle's place in the copy (its apexes are renumbered)
-    Vector<CellRecord> noted;  // with the list of a clip-space soup: each triangle's cell record
-    Vector<ListedNote> listed_notes;  // the list of a noted soup: the notes in order, with the triangles' numbers
+    Vector<CellNote> noted;  // with the list of a clip-space soup: each triangle's cell note
+    Vector<TriangleNote> sorted_notes;  // the list of a noted soup: the notes in order, with the triangles' numbers
 };
 static_assert(kDrawOrderClasses <= 256, "classes are bytes");
 
-// When in.order is DrawOrder::nearest_first, sorts the input's triangles into kDrawOrderClasses
-// classes by the smallest clip w of their three vertices, each class in input order, and
-// returns true with `sorted` the same triangles in that order: the same positions with sorted
-// indices, or without indices sorted copies of each triangle's positions (3 or 4 components,
-// packed); shared-edge flags and their apexes follow their triangles (a soup's apexes renumbered
-// as its copy numbers its vertices), and `sorted` draws as given.
+// The draw order's three jobs, one function each, on one stable counting sort (draw_order.cpp).
+// Each returns false, with nothing computed, for DrawOrder::as_given or no triangle; else true,
+// with its result pointing into `scratch`. Each runs in tasks of `parallel` when it has a job
+// system, and throws homcull::Error for 2^32 triangles or more (check_draw_order: render checks
+// before it changes anything).
 //
-// The clip w comes from `cache` (double) when there is one; else it is computed in float lanes
-// (bucket_packed_soup, bucket_indexed) when the positions are float-aligned (address and
-// stride) and, without indices, packed; else in double as transform_to_clip computes it. Which of these an input takes depends
-// on the input alone (its layout and address, and use_vertex_cache), never on the instruction
-// set or the job system, so neither does the order; but the same triangles at another address
-// or stride may be ordered apart at a bucket's edge.
+// 1. sort_nearest_first: sorts the input's triangles into kDrawOrderClasses classes by the
+// smallest clip w of their three vertices, each class in input order, into `sorted`: the same
+// positions with sorted indices, or without indices sorted copies of each triangle's positions
+// (3 or 4 components, packed); shared-edge flags and their apexes follow their triangles (a
+// soup's apexes renumbered as its copy numbers its vertices), and `sorted` draws as given.
+// Triangles with an index out of range or a coordinate that is not a number come last; those
+// reaching in front of near_w (> 0) first.
+//
+// The clip w is computed in float lanes (RasterKernels' bucket passes) when the positions are
+// float-aligned (address and stride) and, without indices, packed; else in double as
+// transform_to_clip computes it, or read from `cache` (the vertices transformed: use_vertex_cache)
+// when there is one. Which of these an input takes
+// depends on the input alone (its layout and address, and use_vertex_cache), never on the
+// instruction set or the job system, so neither does the order; but the same triangles at
+// another address or stride may be ordered apart at a bucket's edge.
 //
 // A copy rather than a list of numbers: the setup then reads its input front to back (reading
 // S1's triangles through a sorted list of numbers cost 1.9 ms of an 8.8 ms render on two
-// threads). But given `list` (a render on one thread), an input without indices, without a
-// cache and of 4 floats per vertex (gather_listed_ready) is sorted as a list of numbers
-// instead, list->order, and `sorted` is the input itself: with the setup prefetching the next
-// batch, S1 on one thread 7.90 -> 7.63 ms, less memory traffic than copying 48 bytes a
-// triangle; on two threads it was slower, 4.70 -> 4.75 ms. Otherwise list->order is null.
-// Triangles with an index out of range or a coordinate that is not a number come last; those
-// reaching in front of near_w (> 0) first. Returns false, with nothing computed, for
-// DrawOrder::as_given. Runs in tasks of `parallel` when it has a job system. `sorted` and the
-// list point into `scratch`. Throws homcull::Error for 2^32 triangles or more (render checks
-// this before it changes anything).
-//
-// Given `skipped` and a cache, the triangles the setup would skip by their indices and
-// outcodes (gather_cached_batch: an index out of range, a vertex not finite, all three
-// vertices beyond one frustum plane) are left out of `sorted` (its triangle_count is then
-// smaller) and counted into *skipped as the setup counts them (triangles_in, invalid,
-// outside); the others keep the order they would have with them. The sort reads each vertex's
-// w anyway, and its three outcodes decide without a branch per triangle where the setup's
-// loop mispredicted (castle view C0, one input, one thread: see docs/occlusion-buffer.md).
-//
-// Given `records` as well as `list`, an input that is a clip-space soup of 4 packed floats per
-// vertex (the identity matrix, no shared-edge flags) is listed whatever may_list says, and the
-// first pass also notes each of its triangles for the reference cells (bucket_packed_soup);
-// the second copies each note, with its triangle's number, into its place: list->notes, 12
-// bytes a triangle (list->order null), so that the render reads the notes in order and drops
-// most hidden triangles without reading them (BufferState::draw_noted_part). Read through
-// a list of numbers, the notes took about 1.0 ms of S1's 5.9 on one thread; in order, in
-// vectors (DropHiddenKernel), about 0.3, and every part of the rows reads all of them
-// (render_parts). Otherwise list->notes is null. may_list false (a render with a job system):
-// no list otherwise, the sorted copy.
-bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, double near_w, const ParallelFor& parallel,
-                        DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr, RasterStats* skipped = nullptr,
-                        const CellRecordSpec* records = nullptr, bool may_list = true);
+// threads). But given `list` (a render on one thread), an input without a cache or indices and of 4 floats
+// per vertex (gather_listed_ready) is sorted as a list of numbers instead, list->order, and
+// `sorted` is the input itself: with the setup prefetching the next batch, less memory traffic
+// than copying 48 bytes a triangle. Otherwise list->order is null.
+bool sort_nearest_first(const RasterKernels& kernels, const TriangleInput& in, const VertexClip* cache, double near_w,
+                        const ParallelFor& parallel, DrawOrderScratch& scratch, TriangleInput& sorted, DrawList* list = nullptr);
 
-// Throws homcull::Error when sort_nearest_first would refuse the input (nearest first, 2^32
+// 2. The same sort from a vertex cache (with the vertices' outcodes), leaving out the triangles the setup would skip by their indices and
+// outcodes (gather_cached_batch: an index out of range, a vertex not finite, all three vertices
+// beyond one frustum plane): `sorted` (a copy) has fewer triangles, and they are counted into
+// `skipped` as the setup counts them (triangles_in, invalid, outside); the others keep the
+// order they would have with them. The sort reads each vertex's w anyway, and its three
+// outcodes decide without a branch per triangle where the setup's loop mispredicted.
+bool sort_nearest_first_leaving_out(const RasterKernels& kernels, const TriangleInput& in, const VertexClip& cache, double near_w,
+                                    const ParallelFor& parallel, DrawOrderScratch& scratch, TriangleInput& sorted, RasterStats& skipped);
+
+// 3. A clip-space soup (TriangleInput::clip_space) sorted as a list of cell notes: the first
+// pass also notes each triangle for the reference cells (bucket_packed_soup with `spec`), the
+// second places each note, with its triangle's number, into the list: list.notes, 12 bytes a
+// triangle (list.order null), so that the render reads the notes in order and drops most hidden
+// triangles without reading them (BufferState::draw_noted_part), with or without a job system.
+// `soup` must be clip_space (4 packed floats a vertex, no indices, no shared-edge flags, the
+// identity as its matrix).
+bool sort_noting_cells(const RasterKernels& kernels, const TriangleInput& soup, double near_w, const ParallelFor& parallel,
+                       DrawOrderScratch& scratch, const CellNoteSpec& spec, DrawList& list);
+
+// Throws homcull::Error when the sorts would refuse the input (nearest first, 2^32
 // triangles or more), so that render can check before it changes anything.
 void check_draw_order(const TriangleInput& in);
 

@@ -37,7 +37,7 @@ HWY_INLINE hn::Vec<hn::RebindToUnsigned<DF>> Buckets(DF /* df */, hn::Vec<DF> w0
     return hn::IfThenElse(hn::RebindMask(du, is_nan), hn::Set(du, kDrawOrderBuckets - 1), bucket);
 }
 
-// The cell records (reference_cells.hpp) of `count` triangles of a clip-space soup, their
+// The cell notes (reference_cells.hpp) of `count` triangles of a clip-space soup, their
 // corners' coordinates in corner[c][k][i] (c: x, y, z, w; k: corner; i: triangle). A triangle is
 // noted when the setup would surely count it as rasterized: its fate in double lanes exactly as
 // ClassifyBatch decides it (its clip coordinates are its positions, exact in double), z finite
@@ -46,7 +46,7 @@ HWY_INLINE hn::Vec<hn::RebindToUnsigned<DF>> Buckets(DF /* df */, hn::Vec<DF> w0
 // sample (the float projection below is within a fifth of a sample of the setup's for any
 // buffer of at most 256 cells a side), and its depth is 1/(smallest w) rounded up.
 template <class DF>
-HWY_INLINE void NoteTriangles(DF df, const CellRecordSpec& spec, const float (*corner)[3][16], std::size_t count, CellRecord* records) {
+HWY_INLINE void NoteTriangles(DF df, const CellNoteSpec& spec, const float (*corner)[3][16], std::size_t count, CellNote* notes) {
     const hn::CappedTag<double, 8> dd;
     const hn::Rebind<float, decltype(dd)> dh;
     const std::size_t lanes = hn::Lanes(df);
@@ -94,14 +94,14 @@ HWY_INLINE void NoteTriangles(DF df, const CellRecordSpec& spec, const float (*c
     const auto nearest = hn::IfThenElse(noted, hn::Mul(hn::Div(one, w_min), hn::Set(df, 1.0f + 0x1.0p-20f)),
                                         hn::Set(df, std::numeric_limits<float>::quiet_NaN()));
     box = hn::IfThenElseZero(hn::RebindMask(du, noted), box);
-    static_assert(sizeof(CellRecord) == 2 * sizeof(std::uint32_t) && offsetof(CellRecord, nearest) == sizeof(std::uint32_t),
-                  "a record is its four cell bytes (little-endian: cx0 lowest) and its float");
+    static_assert(sizeof(CellNote) == 2 * sizeof(std::uint32_t) && offsetof(CellNote, nearest) == sizeof(std::uint32_t),
+                  "a note is its four cell bytes (little-endian: cx0 lowest) and its float");
     if (count == lanes) {
-        hn::StoreInterleaved2(box, hn::BitCast(du, nearest), du, reinterpret_cast<std::uint32_t*>(records));
+        hn::StoreInterleaved2(box, hn::BitCast(du, nearest), du, reinterpret_cast<std::uint32_t*>(notes));
     } else {
         HWY_ALIGN std::uint32_t both[2 * 16];
         hn::StoreInterleaved2(box, hn::BitCast(du, nearest), du, both);
-        std::memcpy(records, both, count * sizeof(CellRecord));
+        std::memcpy(notes, both, count * sizeof(CellNote));
     }
 }
 
@@ -110,7 +110,7 @@ HWY_INLINE void NoteTriangles(DF df, const CellRecordSpec& spec, const float (*c
 // m[15]).
 template <int kComponents>
 HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_t end, const float* row, float near_w, std::uint16_t* bucket,
-                           std::uint32_t* count, const CellRecordSpec* spec, CellRecord* records) {
+                           std::uint32_t* count, const CellNoteSpec* spec, CellNote* notes) {
     const hn::CappedTag<float, 16> df;
     const hn::RebindToUnsigned<decltype(df)> du;
     constexpr std::size_t kMaxLanes = 16;
@@ -150,7 +150,7 @@ HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_
         }
         // The clip w of the 3 * lanes vertices in vertex order, then regrouped by corner.
         for (std::size_t k = 0; k < 3; ++k) hn::Store(clip_w(p + k * lanes * kComponents), df, w + k * lanes);
-        if (records) {  // the positions, by corner (the matrix is the identity)
+        if (notes) {  // the positions, by corner (the matrix is the identity)
             HWY_ALIGN float by_vertex[4][3 * kMaxLanes];
             for (std::size_t k = 0; k < 3; ++k) {
                 hn::Vec<decltype(df)> x, y, z, v;
@@ -169,7 +169,7 @@ HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_
                 hn::LoadInterleaved3(df, by_vertex[c], c0, c1, c2);
                 hn::Store(c0, df, corner[c][0]), hn::Store(c1, df, corner[c][1]), hn::Store(c2, df, corner[c][2]);
             }
-            NoteTriangles(df, *spec, corner, n, records + t);
+            NoteTriangles(df, *spec, corner, n, notes + t);
         }
         hn::Vec<decltype(df)> w0, w1, w2;
         hn::LoadInterleaved3(df, w, w0, w1, w2);
@@ -182,9 +182,9 @@ HWY_INLINE void BucketSoup(const float* positions, std::size_t begin, std::size_
 }
 
 void BucketPackedSoup(const float* positions, int components, std::size_t begin, std::size_t end, const float* row, float near_w,
-                      std::uint16_t* bucket, std::uint32_t* count, const CellRecordSpec* spec, CellRecord* records) {
-    if (components == 4) BucketSoup<4>(positions, begin, end, row, near_w, bucket, count, spec, records);
-    else BucketSoup<3>(positions, begin, end, row, near_w, bucket, count, spec, records);
+                      std::uint16_t* bucket, std::uint32_t* count, const CellNoteSpec* spec, CellNote* notes) {
+    if (components == 4) BucketSoup<4>(positions, begin, end, row, near_w, bucket, count, spec, notes);
+    else BucketSoup<3>(positions, begin, end, row, near_w, bucket, count, spec, notes);
 }
 
 // Buckets triangles [begin, end) of an indexed input, a triangle per lane: its three vertex

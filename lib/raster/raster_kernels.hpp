@@ -15,11 +15,11 @@ namespace homcull::detail {
 // packed 3 or 4 floats: the bucket of each triangle of [begin, end) into bucket[t], counted into
 // count[]. In float lanes, the same on every instruction set (no scalar reference: the scalar
 // choice runs the best target's); row is the matrix's last row (m[3], m[7], m[11], m[15]).
-// With `records` (and its spec; the matrix must then be the identity), also the cell record
-// of each triangle into records[t] (reference_cells.hpp).
+// With `notes` (and its spec; the matrix must then be the identity), also the cell note
+// of each triangle into notes[t] (reference_cells.hpp).
 using BucketPackedSoupKernel = void (*)(const float* positions, int components, std::size_t begin, std::size_t end, const float* row,
-                                        float near_w, std::uint16_t* bucket, std::uint32_t* count, const CellRecordSpec* spec,
-                                        CellRecord* records);
+                                        float near_w, std::uint16_t* bucket, std::uint32_t* count, const CellNoteSpec* spec,
+                                        CellNote* notes);
 // The same for an indexed input, its positions gathered `stride` floats apart (stride *
 // vertex_count <= 2^31, vertex_count > 0); a triangle with an index out of range takes the
 // last bucket.

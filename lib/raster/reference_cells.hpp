@@ -1,7 +1,7 @@
 #pragma once
 // A coarse lower bound of the reference layer while a render draws: the smallest d0 of each
 // cell of 8 x 8 subtiles (64 x 32 samples; 30 x 34 cells, 4 KB, at 1080p). With the notes the
-// draw order takes of a clip-space soup (CellRecord below), the render drops most hidden
+// draw order takes of a clip-space soup (CellNote below), the render drops most hidden
 // triangles from their note and a few cells in L1, without reading the triangle, setting it up
 // or reading some ten rows of d0 (BufferState::draw_noted_part, on one thread for the whole
 // buffer, with a job system for each part of its rows): on S1 at 1080p about 80,000 of 100,000
@@ -14,7 +14,7 @@
 // when it clears the buffer first, else computes them from d0, and refreshes those of the rows
 // it drew into every 4,096 triangles (each part of the rows its own copy of the cells). The cells
 // are the render's scratch: nothing reads them outside a render, and they change no bit (see
-// CellRecord).
+// CellNote).
 //
 // Greene, Kass and Miller's hierarchical Z-buffer (SIGGRAPH 1993) keeps such a pyramid exact
 // after every update; refreshing a stale but safe level in batches costs less here, where nine
@@ -72,20 +72,20 @@ inline int reference_cells_height(int subtiles_y) { return (subtiles_y + (1 << k
 // lower it. So if every subtile's d0 is at least that depth (and positive), drawing the
 // triangle changes no d0, d1 or mask, nor a covered mask (full wherever d0 > 0) or a sample
 // depth (at least d0 wherever d0 > 0).
-struct CellRecord {
+struct CellNote {
     std::uint8_t cx0, cx1, cy0, cy1;  // cells [cx0, cx1] x [cy0, cy1]
     float nearest;                    // at least the largest 1/w of its vertices and 2^-64; NaN: no note
 };
-static_assert(sizeof(CellRecord) == 8, "a record is 8 bytes");
+static_assert(sizeof(CellNote) == 8, "a note is 8 bytes");
 
-// A buffer with more cells than this a side takes no notes: a record holds cell numbers in bytes.
+// A buffer with more cells than this a side takes no notes: a note holds cell numbers in bytes.
 constexpr int kMaxNotedCellsPerSide = 256;
 
 // What the first pass needs to note a triangle: the buffer's samples and cells (at most
 // kMaxNotedCellsPerSide a side), and the setup's near plane and backface mode, to note only the
 // triangles whose setup would surely count them as rasterized (not invalid, outside, clipped,
 // degenerate or backfacing), so that dropping them keeps the statistics.
-struct CellRecordSpec {
+struct CellNoteSpec {
     int sample_width, sample_height;
     int cells_width, cells_height;
     float near_w;
@@ -95,7 +95,7 @@ struct CellRecordSpec {
 // Whether a noted triangle is hidden behind the cells: every cell holding its box bounds d0
 // at or above its depth (positive, or NaN for no note). Cell by cell: the reference of the drop
 // kernel (which reads block minima), and its answer for boxes wider than 8 cells.
-inline bool hidden_by_record(const ReferenceCells& cells, const CellRecord& r) {
+inline bool hidden_by_note(const ReferenceCells& cells, const CellNote& r) {
     const float* row0 = cells.min_d0 + std::size_t(r.cy0) * std::size_t(cells.width);
     for (int cy = r.cy0; cy <= r.cy1; ++cy, row0 += cells.width)
         for (int cx = r.cx0; cx <= r.cx1; ++cx)
@@ -105,19 +105,19 @@ inline bool hidden_by_record(const ReferenceCells& cells, const CellRecord& r) {
 
 // A triangle's note in the draw order's list (sort_nearest_first): what the render reads of a
 // noted soup before it decides to read the triangle itself.
-struct ListedNote {
-    CellRecord note;
+struct TriangleNote {
+    CellNote note;
     std::uint32_t triangle;  // its number in the input
 };
-static_assert(sizeof(ListedNote) == 12, "a listed note is 12 bytes");
+static_assert(sizeof(TriangleNote) == 12, "a listed note is 12 bytes");
 
-// Writes the triangles of notes [0, count) not hidden behind the cells (hidden_by_record) to
+// Writes the triangles of notes [0, count) not hidden behind the cells (hidden_by_note) to
 // undecided[], in order, and returns how many it kept. The reference of the vector kernel below.
-inline std::size_t drop_hidden_noted(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided) {
+inline std::size_t drop_hidden_noted(const ReferenceCells& cells, const TriangleNote* notes, std::size_t count, std::uint32_t* undecided) {
     std::size_t kept = 0;
     for (std::size_t k = 0; k < count; ++k) {
         undecided[kept] = notes[k].triangle;
-        kept += !hidden_by_record(cells, notes[k].note);
+        kept += !hidden_by_note(cells, notes[k].note);
     }
     return kept;
 }
@@ -129,6 +129,6 @@ using RefreshCellsKernel = void (*)(const SubtilePlanes& planes, int subtiles_x,
                                     const ReferenceCells& cells);
 
 // drop_hidden_noted in vectors: the same triangles kept, the same count.
-using DropHiddenKernel = std::size_t (*)(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided);
+using DropHiddenKernel = std::size_t (*)(const ReferenceCells& cells, const TriangleNote* notes, std::size_t count, std::uint32_t* undecided);
 
 }  // namespace homcull::detail

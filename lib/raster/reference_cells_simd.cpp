@@ -46,11 +46,11 @@ void RefreshReferenceCells(const SubtilePlanes& planes, int subtiles_x, int subt
 // drop_hidden_noted over `count` notes, a vector at a time: the smallest cell of each note's
 // box from four reads of a block table (kCellTables: blocks of 2^kx x 2^ky cells at the box's
 // corners, overlapping), the kept triangles' numbers compressed into undecided[]; a lane whose
-// box spans more than 8 cells a side is decided by hidden_by_record itself. Min and >= are
+// box spans more than 8 cells a side is decided by hidden_by_note itself. Min and >= are
 // exact: the same answers as the scalar loop. (The scalar loop took about 17 cycles a note on
 // S1, its branch on the box's size mispredicted; gathering every cell of the vector's largest
 // box about 12.)
-std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes, std::size_t count, std::uint32_t* undecided) {
+std::size_t DropHiddenNoted(const ReferenceCells& cells, const TriangleNote* notes, std::size_t count, std::uint32_t* undecided) {
     const hn::ScalableTag<std::uint32_t> du;
     const hn::RebindToSigned<decltype(du)> di;
     const hn::RebindToFloat<decltype(du)> df;
@@ -87,7 +87,7 @@ std::size_t DropHiddenNoted(const ReferenceCells& cells, const ListedNote* notes
             HWY_ALIGN std::int32_t wide_lanes[hn::MaxLanes(di)];
             hn::Store(hn::VecFromMask(di, wide), di, wide_lanes);
             for (std::size_t l = 0; l < lanes; ++l)
-                if (wide_lanes[l]) hidden_lanes[l] = hidden_by_record(cells, notes[k + l].note) ? ~0u : 0u;
+                if (wide_lanes[l]) hidden_lanes[l] = hidden_by_note(cells, notes[k + l].note) ? ~0u : 0u;
             hidden = hn::MaskFromVec(hn::Load(du, hidden_lanes));
         }
         kept += hn::CompressStore(triangle, hn::Not(hidden), du, undecided + kept);

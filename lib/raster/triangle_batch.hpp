@@ -177,7 +177,7 @@ struct DrawList {
     const std::uint32_t* order = nullptr;  // null: the input's own order
     // A noted soup (sort_nearest_first): the list is its notes, each with its triangle's number
     // (order is then null).
-    const ListedNote* notes = nullptr;
+    const TriangleNote* notes = nullptr;
 };
 
 // Whether lane t of SetupPlanes' output is hidden in the target's rows: its box reaches none
@@ -232,7 +232,8 @@ inline std::uint8_t edges_across(const TriangleInput& in, const VertexClip* cach
 template <typename Emit>
 void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std::size_t begin, std::size_t end, double near_w,
                           double edge_margin, int sample_width, int sample_height, const RasterTarget* drawn_into, RasterStats& stats,
-                          const FrontEndKernels& kernels, Emit&& emit, DrawList list = {}) {
+                          const FrontEndKernels& kernel_table, Emit&& emit, DrawList list = {}) {
+    const FrontEndKernels kernels = kernel_table;  // a local copy: the loop's stores cannot alias it
     const HiddenTestKernel hidden_test = drawn_into && drawn_into->skip_hidden ? drawn_into->hidden_test : nullptr;
     TriangleBatch batch{};  // zeroed: the last vector of a batch may read lanes past count
     BatchSetup simple;

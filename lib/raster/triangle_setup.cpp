@@ -22,6 +22,16 @@ void check_triangle_input(const TriangleInput& in, const char* caller) {
         fail("without indices, vertex_count must be at least 3 * triangle_count");
     if (!in.indices && in.triangle_count > std::size_t(std::numeric_limits<std::uint32_t>::max()) / 3)
         fail("without indices, at most 2^32 / 3 triangles per call (vertex numbers are 32-bit, as indices)");
+    if (in.clip_space && (in.position_components != 4 || in.position_stride != 4 * sizeof(float) || in.indices || in.shared_edges || in.orthographic))
+        fail("a clip_space input is 4 packed floats a vertex (position_components 4, position_stride 16), without indices, "
+             "shared-edge flags or an orthographic projection");
+}
+
+const TriangleInput& with_clip_space_matrix(const TriangleInput& in, TriangleInput& storage) {
+    if (!in.clip_space) return in;
+    storage = in;
+    storage.model_to_clip = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    return storage;
 }
 
 bool fetch_clip_triangle(const TriangleInput& in, std::size_t t, glm::dvec4 model[3], glm::dvec4 clip[3], bool plain) {

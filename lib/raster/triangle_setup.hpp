@@ -111,6 +111,9 @@ inline glm::dvec4 input_to_clip_plain(const TriangleInput& in, double x, double 
 // components, positions and a stride of at least one position, and without indices, enough
 // vertices for every triangle, numbered in 32 bits.
 void check_triangle_input(const TriangleInput& in, const char* caller);
+// The input as drawn: a clip_space one with the identity as its matrix (in `storage`), any
+// other as it is.
+const TriangleInput& with_clip_space_matrix(const TriangleInput& in, TriangleInput& storage);
 
 // Vertex number k of triangle t: from 16- or 32-bit indices, or 3t + k without them (indices
 // null; render() checks that 3t + k fits 32 bits).

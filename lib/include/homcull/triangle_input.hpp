@@ -99,6 +99,16 @@ struct TriangleInput {
     // model_to_clip is an orthographic projection (BufferConfig::orthographic): it must match
     // the buffer's (render and test_triangles throw homcull::Error otherwise).
     bool orthographic = false;
+    // The positions are clip-space points already, (x, y, z, w): 4 packed floats a vertex
+    // (position_components 4, position_stride 16), no indices and no shared-edge flags;
+    // model_to_clip is not read (the identity). The form of an occluder soup an engine has
+    // transformed itself, and of workload S1. Drawn nearest first, such a soup is sorted as
+    // notes of the reference cells each triangle covers, and the render drops most hidden
+    // triangles without reading them (docs/occlusion-buffer.md, "Reference cells"); the bits
+    // are those of the same triangles drawn with the identity matrix. render() and
+    // test_triangles throw homcull::Error for a clip_space input that breaks these rules or is
+    // orthographic.
+    bool clip_space = false;
 };
 
 // Finds the edges that two triangles of a mesh share (the same two positions, bit for bit,
