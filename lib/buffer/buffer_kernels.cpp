@@ -9,7 +9,7 @@ BufferKernels resolve_buffer_kernels(const IsaChoice& choice) {
     BufferKernels k{};
     k.raster = raster_kernels(choice);
     resolve_occludee_row_kernels(choice, k);
-    resolve_rect_test_kernels(choice, k);
+    resolve_rect_query_kernels(choice, k);
     return k;
 }
 }  // namespace

@@ -4,7 +4,7 @@
 // the table of the instruction set it was made with (BufferConfig::isa) and every render,
 // task and query it runs, on any thread, reads its kernels there.
 #include "buffer/occludee_depth.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "raster/raster_kernels.hpp"
 
 namespace homcull::detail {
@@ -13,7 +13,7 @@ struct BufferKernels {
     RasterKernels raster;
     // The queries' SIMD kernels; null for the scalar choice (the scalar paths answer the same).
     OccludeeRowKernel occludee_row;  // occludee_depth.hpp
-    RectScanKernel rect_scan;        // rect_tests.hpp
+    RectScanKernel rect_scan;        // rect_queries.hpp
     RectBlockKernel rect_block;
 };
 
@@ -21,6 +21,6 @@ const BufferKernels& buffer_kernels(const IsaChoice& choice);
 
 // Each SIMD translation unit's part of the table (they hold the HWY_EXPORTs).
 void resolve_occludee_row_kernels(const IsaChoice& choice, BufferKernels& kernels);
-void resolve_rect_test_kernels(const IsaChoice& choice, BufferKernels& kernels);
+void resolve_rect_query_kernels(const IsaChoice& choice, BufferKernels& kernels);
 
 }  // namespace homcull::detail

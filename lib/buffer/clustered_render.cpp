@@ -6,7 +6,7 @@
 
 #include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "buffer/render_bands.hpp"
 #include "common/run_tasks.hpp"
 #include "raster/rasterize.hpp"

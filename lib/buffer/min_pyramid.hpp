@@ -17,6 +17,17 @@ struct PyramidLevel {
     std::size_t offset;
 };
 
+// Cells [begin, end) of a row of the level above, from rows row0 and row1 of the level below
+// (row1 = row0 at an odd bottom edge), whose rows are below_width cells long: each the minimum
+// of its 2 x 2 children (a missing right child repeats the left one). The one reduction of
+// every min pyramid (the maps' SIMD kernel computes the same minima in lanes).
+inline void reduce_min_row(const float* row0, const float* row1, int begin, int end, int below_width, float* out) {
+    for (int x = begin; x < end; ++x) {
+        const std::size_t a = std::size_t(2 * x), b = std::size_t(std::min(2 * x + 1, below_width - 1));
+        out[x] = std::min(std::min(row0[a], row0[b]), std::min(row1[a], row1[b]));
+    }
+}
+
 // Whether every level-0 cell of [x0, x1] x [y0, y1] under cell (x, y) of level k holds more
 // than d: a cell whose minimum is above d is done; one inside the range whose minimum is not
 // above d contains such a cell.

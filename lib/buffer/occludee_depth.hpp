@@ -4,7 +4,7 @@
 // test_triangles, occludee_triangles.cpp): a scalar reference and a SIMD kernel, a subtile per
 // lane (occludee_rows_simd.cpp), which give the same masks and the same answers.
 #include "buffer/raised_vertex_plane.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>

@@ -19,7 +19,7 @@
 #include "common/float_mode.hpp"
 #include "buffer/occludee_depth.hpp"
 #include "buffer/raised_vertex_plane.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 #include "raster/triangle_setup.hpp"

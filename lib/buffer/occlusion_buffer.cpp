@@ -277,16 +277,11 @@ void detail::BufferState::reduce_pyramid_rows(int level, int y_begin, int y_end)
 void detail::BufferState::reduce_pyramid_cells(int level, int x_begin, int x_end, int y_begin, int y_end) {
     const detail::PyramidLevel& below = levels_[std::size_t(level) - 1];
     const detail::PyramidLevel& here = levels_[std::size_t(level)];
-    for (int y = y_begin; y < y_end; ++y)
-        for (int x = x_begin; x < x_end; ++x) {
-            float m = min_d0(level - 1, 2 * x, 2 * y);
-            if (2 * x + 1 < below.width) m = std::min(m, min_d0(level - 1, 2 * x + 1, 2 * y));
-            if (2 * y + 1 < below.height) {
-                m = std::min(m, min_d0(level - 1, 2 * x, 2 * y + 1));
-                if (2 * x + 1 < below.width) m = std::min(m, min_d0(level - 1, 2 * x + 1, 2 * y + 1));
-            }
-            pyramid_[here.offset + std::size_t(y) * std::size_t(here.width) + std::size_t(x)] = m;
-        }
+    for (int y = y_begin; y < y_end; ++y) {
+        const float* row0 = pyramid_.data() + below.offset + std::size_t(2 * y) * std::size_t(below.width);
+        const float* row1 = 2 * y + 1 < below.height ? row0 + below.width : row0;
+        detail::reduce_min_row(row0, row1, x_begin, x_end, below.width, pyramid_.data() + here.offset + std::size_t(y) * std::size_t(here.width));
+    }
 }
 
 void detail::BufferState::read_pyramid(std::vector<float>& cells) const {

@@ -1,5 +1,5 @@
 // OcclusionBuffer's calls, each forwarded to its state (buffer/buffer_state.hpp), where the
-// implementation lives (occlusion_buffer.cpp, clustered_render.cpp, occludee_tests.cpp,
+// implementation lives (occlusion_buffer.cpp, clustered_render.cpp, occludee_queries.cpp,
 // occludee_triangles.cpp).
 #include "buffer/buffer_state.hpp"
 

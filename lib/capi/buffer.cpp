@@ -4,7 +4,7 @@
 
 #include <homcull/aabb.hpp>
 
-#include "buffer/rect_tests.hpp"  // box_rectangle
+#include "buffer/rect_queries.hpp"  // box_rectangle
 
 #include <algorithm>
 #include <cmath>

@@ -15,7 +15,7 @@
 #include "hom/maps_state.hpp"
 #include "common/float_mode.hpp"
 #include "hom/opacity_pyramid.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>

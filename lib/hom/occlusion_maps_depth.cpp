@@ -20,7 +20,7 @@
 #include "hom/maps_state.hpp"
 #include "common/float_mode.hpp"
 #include "buffer/min_pyramid.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>

@@ -2,6 +2,8 @@
 // the SIMD kernels are in opacity_pyramid_simd.cpp.
 #include "hom/opacity_pyramid.hpp"
 
+#include "buffer/min_pyramid.hpp"
+
 #include <homcull/occlusion_buffer.hpp>
 
 #include <algorithm>
@@ -47,9 +49,9 @@ void reduce_pyramid_row_reference(const PyramidRows& r, int begin, int end, int 
         std::uint32_t covered = r.covered0[a] + second_column * r.covered0[b];
         if (r.second_row) covered += r.covered1[a] + second_column * r.covered1[b];
         r.covered_out[x] = covered;
-        if (r.far_out) r.far_out[x] = std::min(std::min(r.far0[a], r.far0[b]), std::min(r.far1[a], r.far1[b]));
-        if (r.near_out) r.near_out[x] = std::min(std::min(r.near0[a], r.near0[b]), std::min(r.near1[a], r.near1[b]));
     }
+    if (r.far_out) reduce_min_row(r.far0, r.far1, begin, end, below_width, r.far_out);
+    if (r.near_out) reduce_min_row(r.near0, r.near1, begin, end, below_width, r.near_out);
 }
 
 }  // namespace homcull::detail

@@ -1,7 +1,7 @@
 #pragma once
 // The coarse stage of the batched rectangle tests (detail::BufferState::test_rects), shared by
 // the scalar path (detail::BufferState::prepare and the start of test_rect) and the SIMD kernel
-// in rect_tests_simd.cpp, which must decide exactly the rectangles the scalar path decides
+// in rect_queries_simd.cpp, which must decide exactly the rectangles the scalar path decides
 // at that stage, with the same answers.
 #include <homcull/occlusion_buffer.hpp>
 

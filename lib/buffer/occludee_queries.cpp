@@ -1,12 +1,12 @@
 // Occludee tests against the occlusion buffer: screen rectangles (one at a time, or in batches
-// whose first, coarse stage runs in SIMD lanes: rect_tests_simd.cpp) and world boxes.
+// whose first, coarse stage runs in SIMD lanes: rect_queries_simd.cpp) and world boxes.
 #include <homcull/occlusion_buffer.hpp>
 
 #include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
 #include "common/float_mode.hpp"
 #include "buffer/min_pyramid.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_setup.hpp"
 

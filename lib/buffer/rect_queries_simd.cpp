@@ -8,13 +8,13 @@
 // - The others are packed with the query computed here and go on to the exact scan (ScanRect),
 //   which test_rect also uses (RectScan).
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "buffer/rect_tests_simd.cpp"
+#define HWY_TARGET_INCLUDE "buffer/rect_queries_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
 #include <hwy/highway.h>
 
 #include "buffer/buffer_state.hpp"
-#include "buffer/rect_tests.hpp"
+#include "buffer/rect_queries.hpp"
 #include "common/lane_bits-inl.h"
 #include "raster/rasterize.hpp"
 
@@ -253,7 +253,7 @@ namespace homcull::detail {
 HWY_EXPORT(TestRectBlock);
 HWY_EXPORT(RectScan);
 
-void resolve_rect_test_kernels(const IsaChoice& choice, BufferKernels& k) {
+void resolve_rect_query_kernels(const IsaChoice& choice, BufferKernels& k) {
     k.rect_block = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, TestRectBlock);
     k.rect_scan = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RectScan);
 }
