@@ -58,6 +58,16 @@ inline std::vector<ScreenRect> random_screen_rects(std::uint64_t seed, int count
     return rects;
 }
 
+// A buffer's answers to rectangles, one test_rect call each (or test_rect_exhaustive's, the
+// search without the pyramid), for comparing buffers or the two searches.
+inline std::vector<Visibility> rect_answers(const OcclusionBuffer& b, const std::vector<ScreenRect>& rects, bool exhaustive = false) {
+    std::vector<Visibility> answers;
+    for (const ScreenRect& r : rects)
+        answers.push_back(exhaustive ? b.test_rect_exhaustive(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min)
+                                     : b.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min));
+    return answers;
+}
+
 // A job system (ParallelFor::run) that runs the tasks last to first on the calling thread, and
 // allocates nothing itself.
 inline void run_backwards(void*, std::size_t count, void (*task)(void*, std::size_t), void* data) {

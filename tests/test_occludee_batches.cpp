@@ -76,8 +76,8 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
 
         for (const std::string& isa : available_isas()) {
             const test::ScopedIsa selected(isa);
-            std::vector<Visibility> single, batch(rects.size()), box_batch(boxes.size());
-            for (const ScreenRect& r : rects) single.push_back(buffer.test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min));
+            const std::vector<Visibility> single = test::rect_answers(buffer, rects);
+            std::vector<Visibility> batch(rects.size()), box_batch(boxes.size());
             buffer.test_rects(rects.data(), rects.size(), batch.data());
             buffer.test_aabbs(boxes.data(), boxes.size(), m, box_batch.data());
             std::size_t single_wrong = 0, batch_wrong = 0, box_wrong = 0;
