@@ -30,7 +30,7 @@ case "$kind" in
     # renders, queries, clusters, the draw order, the reference cells and the C interface
     # (test::parallel_jobs: std::threads under TSan). Tests that cast ground truth are left
     # out: the truth library runs Embree and its tiles on oneTBB, which TSan cannot see into.
-    filter=(-R "RenderThreads|HiddenTriangleSkip|FrameAllocations|OccluderClusters|ClusteredRender\.(TaskList|SameBits|ManyClusters)|ReferenceCells|DrawOrder|CApi|RenderCalls")
+    filter=(-R "RenderThreads|HiddenTriangleSkip|FrameAllocations|OccluderClusters|ClusteredRender\.(TaskList|SameBits|ManyClusters)|ReferenceCells|DrawOrder|CApi|RenderCalls|IsaChoice")
     ;;
   *) echo "sanitize.sh: unknown kind '$kind' (asan or tsan)" >&2; exit 2 ;;
 esac
