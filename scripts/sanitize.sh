@@ -18,10 +18,10 @@ case "$kind" in
     export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
     # Leaks inside uninstrumented system libraries (fontconfig through OpenImageIO's text) are theirs.
     export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0"
-    # Not instrumented code: the Arm check runs a cross-built binary under qemu, the package
-    # test builds a consumer of its own, and Python cannot load an instrumented libhomcull.so
-    # without preloading the sanitizer runtime (c_interface_ctypes). The main run has all three.
-    filter=(-E "simd_kernels_on_arm_give_the_reference_bits|package_consumer|c_interface_ctypes")
+    # Not instrumented code: the Arm check runs a cross-built binary under qemu, the packaging
+    # tests build homcull and consumers of their own, and Python cannot load an instrumented libhomcull.so
+    # without preloading the sanitizer runtime (c_interface_ctypes). The main run has all of them.
+    filter=(-E "simd_kernels_on_arm_give_the_reference_bits|package_|subproject_|c_interface_ctypes")
     ;;
   tsan)
     flags="-fsanitize=thread -fno-omit-frame-pointer"

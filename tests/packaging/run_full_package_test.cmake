@@ -1,16 +1,12 @@
-# Installs the homcull build tree into a private prefix, then configures, builds and runs
-# the consumer project against it, and builds the C99 engine host (tests/c_host) against it.
-# Variables: HOMCULL_BUILD_DIR, CONSUMER_SOURCE_DIR, C_HOST_SOURCE_DIR, WORK_DIR.
+# Installs the homcull build tree into a private prefix, then configures, builds and runs the
+# consumer of every component (full_consumer) against it, and builds the C99 engine host
+# (tests/c_host) against it. Variables: HOMCULL_BUILD_DIR, PACKAGING_DIR, C_HOST_SOURCE_DIR,
+# WORK_DIR.
+include("${CMAKE_CURRENT_LIST_DIR}/run_step.cmake")
 file(REMOVE_RECURSE "${WORK_DIR}")
 set(prefix "${WORK_DIR}/prefix")
-function(run_step)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL 0)
-    message(FATAL_ERROR "step failed (${code}): ${ARGN}\n${out}\n${err}")
-  endif()
-endfunction()
 run_step(${CMAKE_COMMAND} --install "${HOMCULL_BUILD_DIR}" --prefix "${prefix}")
-run_step(${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${WORK_DIR}/build" -DCMAKE_PREFIX_PATH=${prefix}
+run_step(${CMAKE_COMMAND} -S "${PACKAGING_DIR}/full_consumer" -B "${WORK_DIR}/build" -DCMAKE_PREFIX_PATH=${prefix}
          -DCMAKE_BUILD_TYPE=Release)
 run_step(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 run_step("${WORK_DIR}/build/consumer" "${WORK_DIR}/city.glb")

@@ -1,0 +1,41 @@
+# engine_parent builds homcull with add_subdirectory: its checks run at configure time; then
+# its app is built and run, and the compile commands show that the engine's sources keep the
+# engine's flags (-O2 -g, none of homcull's warnings or -O3) while homcull's get -O3, and that
+# homcull wrote no install rules into the engine's.
+# Variables: HOMCULL_SOURCE_DIR, PACKAGING_DIR, WORK_DIR, GENERATOR.
+include("${CMAKE_CURRENT_LIST_DIR}/run_step.cmake")
+file(REMOVE_RECURSE "${WORK_DIR}")
+cmake_host_system_information(RESULT cores QUERY NUMBER_OF_LOGICAL_CORES)
+run_step(${CMAKE_COMMAND} -S "${PACKAGING_DIR}/engine_parent" -B "${WORK_DIR}" -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release
+         -DHOMCULL_SOURCE_DIR=${HOMCULL_SOURCE_DIR} -DCMAKE_EXPORT_COMPILE_COMMANDS=ON)
+run_step(${CMAKE_COMMAND} --build "${WORK_DIR}" --target engine_app --parallel ${cores})
+run_step("${WORK_DIR}/engine_app")
+
+file(READ "${WORK_DIR}/compile_commands.json" commands)
+string(JSON count LENGTH "${commands}")
+math(EXPR last "${count} - 1")
+set(engine_checked 0)
+set(homcull_checked 0)
+foreach(k RANGE ${last})
+  string(JSON file GET "${commands}" ${k} file)
+  string(JSON command GET "${commands}" ${k} command)
+  if(file MATCHES "engine_parent/app\\.cpp$")
+    if(NOT command MATCHES " -O2 -g" OR command MATCHES " -O3" OR command MATCHES "-Wshadow")
+      message(FATAL_ERROR "the engine's own source got homcull's flags: ${command}")
+    endif()
+    math(EXPR engine_checked "${engine_checked} + 1")
+  elseif(file MATCHES "/lib/(raster|buffer)/[a-z_]+\\.cpp$")
+    if(NOT command MATCHES " -O3" OR NOT command MATCHES "-Wshadow")
+      message(FATAL_ERROR "homcull's own source lacks its -O3 or warnings: ${command}")
+    endif()
+    math(EXPR homcull_checked "${homcull_checked} + 1")
+  endif()
+endforeach()
+if(NOT engine_checked EQUAL 1 OR homcull_checked LESS 10)
+  message(FATAL_ERROR "compile commands: ${engine_checked} engine source and ${homcull_checked} homcull sources checked")
+endif()
+file(READ "${WORK_DIR}/homcull/cmake_install.cmake" install_rules)
+if(install_rules MATCHES "homcull_core|homcullConfig")
+  message(FATAL_ERROR "homcull wrote install rules into the engine's build")
+endif()
+message(STATUS "add_subdirectory(homcull): the engine's flags and build type unchanged, ${homcull_checked} homcull sources with -O3")
