@@ -51,10 +51,10 @@ inline bool min_pyramid_above(const float* data, const PyramidLevel* levels, int
 // y1) spans at most 2 x 2 cells: coarse_level_by_search's answer without the search. With span
 // the larger of x1 - x0 and y1 - y0, and b = floor(log2(span)) (0 for a span below 2): at a level
 // k < b a cell is at most span / 2 wide, so the range spans 3 cells or more; at b + 1 a cell is
-// wider than span, so it spans at most 2. So the level is b or b + 1 (one test), capped. (The
-// search level by level took a variable shift per level: single test_rect calls went from 14.9
-// to 18.6 M/s on S1 with this and the branch-free corners. The batches' SIMD coarse stage still
-// counts the levels, one vector op per level for 16 rectangles.)
+// wider than span, so it spans at most 2. So the level is b or b + 1 (one test), capped. (A
+// search level by level takes a variable shift per level, which single test_rect calls paid
+// for; the batches' SIMD coarse stage still counts the levels, one vector op per level for 16
+// rectangles.)
 inline int coarse_level(int x0, int x1, int y0, int y1, int level_count) {
     const unsigned span = unsigned(std::max(x1 - x0, y1 - y0));
     int k = 0;

@@ -17,14 +17,12 @@ namespace homcull {
 namespace detail {
 
 // Subtile rows rasterized per task (128 sample rows), the same whatever the threads: a
-// triangle crossing into another band is set up once but entered once per band (16 rows: S1
-// at 1080p, two threads, 13.5 ms and castle C0 1.02 ms; 32 rows: 12.8 and 0.96 ms; 64 rows: 3
-// bands at 720p, castle 1.12 ms).
+// triangle crossing into another band is set up once but entered once per band (16 rows gave
+// more entries, 64 rows too few bands at 720p to share among threads).
 constexpr int kBandSubtileRows = 32;
 // The pyramid levels a band builds from its own rows, right after rasterizing them: the cells
 // of level l span 2^l subtile rows, within one band while 2^l divides the band's rows. Built on
-// the calling thread instead, they had to read every band's d0 from the other core's cache
-// (castle C0, two threads: 0.15 ms of 1.0).
+// the calling thread instead, they had to read every band's d0 from the other core's cache.
 constexpr int kBandPyramidLevels = 5;
 static_assert((1 << kBandPyramidLevels) == kBandSubtileRows, "a band's rows hold whole cells of its levels");
 

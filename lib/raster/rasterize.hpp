@@ -294,8 +294,8 @@ inline void sample_span(double lo, double hi, int count, int& first, int& last) 
     hi = hi <= top ? std::max(hi, -1.0) : (hi > top ? top : -1.0);   // NaN: -1
     // ceil and floor of numbers in [-1.5, count + 0.5] by truncation: exact for any int count,
     // and cheaper than std::ceil and std::floor, which the baseline x86-64 target (no SSE4.1
-    // round) computes with a range check and two conversions (single test_rect calls on S1:
-    // 18.6 -> 19.2 M/s).
+    // round) computes with a range check and two conversions (measurably so on single
+    // test_rect calls).
     const double first_edge = lo - 0.5, last_edge = hi - 0.5;
     const int first_truncated = int(first_edge), last_truncated = int(last_edge);
     first = std::max(0, first_truncated + int(double(first_truncated) < first_edge));
