@@ -357,6 +357,39 @@ TEST(Cli, BenchPrintsItsTimingsAndRefusesBadOptions) {
     expect_refused("bench --s1 " + s1 + " --resolution 0x0", 1, "--resolution: expected WxH");
 }
 
+// homcull bench --workload frame: whole frames of the scene culler per view, with their stages
+// and their accuracy against Embree, from random viewpoints and along a walk of a generated
+// city (small and quick: only the keys, their sense and the zero false culls are checked).
+TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
+    for (const std::string views : {"--random 3", "--walk 3"}) {
+        const CliRun r = run_cli("bench --workload frame --scene gen:city:seed=2,blocks=3 " + views +
+                                 " --resolution 160x90 --repeat 2 --occludees box --clusters 64 --json");
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const nlohmann::json j = nlohmann::json::parse(r.out);
+        EXPECT_EQ(j["workload"], "frame");
+        EXPECT_EQ(j["display"][0], 160);
+        EXPECT_EQ(j["config"]["occludees"], "box");
+        EXPECT_EQ(j["config"]["clusters"], "on");
+        ASSERT_EQ(j["per_view"].size(), 3u) << views;
+        for (const nlohmann::json& v : j["per_view"]) {
+            EXPECT_GT(v["frame_ms"].get<double>(), 0.0);
+            EXPECT_LE(v["frame_min_ms"].get<double>(), v["frame_ms"].get<double>());
+            for (const char* stage : {"select", "render", "maps", "tests"}) EXPECT_GE(v["stages_ms"][stage].get<double>(), 0.0) << stage;
+            EXPECT_EQ(v["false_culls"], 0) << views;
+            EXPECT_GE(v["efficiency"].get<double>(), 0.0);
+            EXPECT_LE(v["efficiency"].get<double>(), 1.0);
+            EXPECT_LE(v["culled_outright"].get<std::size_t>(), v["hidden_outright"].get<std::size_t>());
+        }
+        EXPECT_EQ(j["summary"]["views"], 3);
+        EXPECT_EQ(j["summary"]["false_culls"], 0);
+        EXPECT_GE(j["summary"]["frame_ms"]["max"].get<double>(), j["summary"]["frame_ms"]["mean"].get<double>());
+    }
+    expect_refused("bench --workload frame --scene gen:city --random 2 --walk 2", 1, "give exactly one of --views P, --walk N and --random N");
+    expect_refused("bench --workload frame --scene gen:city --random 2 --vs-scalar", 1, "--vs-scalar and --sample-depth are for s1 and castle");
+    expect_refused("bench --workload s1 --walk 3", 1, "--walk and --random are for --workload frame");
+    expect_refused("bench --workload frame --scene /nonexistent.glb --random 2", 1, "/nonexistent.glb");
+}
+
 TEST(Cli, BadInputExitsWithOneAndSaysWhatIsWrong) {
     CliRun r = run_cli("info --scene /nonexistent/scene.glb");
     EXPECT_EQ(r.exit_code, 1);

@@ -2,6 +2,9 @@
 // A render is timed as an engine's frame calls it: render_frame, the clear included.
 //   s1:     ../shared/workloads/s1, the 100k triangles and 1M rectangles Intel MOC was measured on
 //   castle: the castle's role=occluder nodes from the views of data/views/castle.json
+//   frame:  whole frames of the scene culler, with efficiency and false culls against Embree
+//           (bench_frame.cpp)
+#include "bench_frame.hpp"
 #include "commands.hpp"
 #include "options.hpp"
 
@@ -25,11 +28,34 @@ namespace homcull::cli {
 namespace {
 
 struct BenchOptions {
-    std::string workload = "s1", resolution = "1920x1080", isa = "best";
-    std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views = "data/views/castle.json";
+    std::string workload = "s1", resolution, isa = "best";  // resolution: 1920x1080 (s1, castle) or 1280x720 (frame)
+    std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views;
     int samples = 1, threads = 1, repeat = 0, clusters = 0;
     bool json = false, sample_depth = false, vs_scalar = false;
+    int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
+    std::uint64_t seed = 1;
+    std::string occludees = "auto";
 };
+
+constexpr const char* kCastleViews = "data/views/castle.json";
+
+void run_frame_workload(const BenchOptions& o) {
+    if (o.vs_scalar || o.sample_depth) throw Error("bench --workload frame: --vs-scalar and --sample-depth are for s1 and castle");
+    if (o.clusters < 0) throw Error("bench: --clusters must be 0 (off) or more, got " + std::to_string(o.clusters));
+    FrameBenchOptions f;
+    f.scene = o.scene;
+    f.views = o.views.empty() && o.walk == 0 && o.random == 0 ? kCastleViews : o.views;
+    f.walk = o.walk, f.random = o.random, f.seed = o.seed;
+    f.rounds = o.repeat > 0 ? o.repeat : 15;
+    f.threads = o.threads;
+    f.isa = o.isa;
+    f.json = o.json;
+    f.cull.resolution = o.resolution.empty() ? "1280x720" : o.resolution;
+    f.cull.samples = o.samples;
+    f.cull.occludees = o.occludees;
+    f.cull.clusters = o.clusters > 0 ? "on" : "off";
+    run_frame_bench(f);
+}
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -138,7 +164,9 @@ nlohmann::json time_workload(const BenchOptions& o, const BufferConfig& base, co
 }
 
 void run_bench(const BenchOptions& o) {
-    if (o.workload != "s1" && o.workload != "castle") throw Error("bench: unknown workload '" + o.workload + "' (s1 or castle)");
+    if (o.workload == "frame") return run_frame_workload(o);
+    if (o.workload != "s1" && o.workload != "castle") throw Error("bench: unknown workload '" + o.workload + "' (s1, castle or frame)");
+    if (o.walk != 0 || o.random != 0) throw Error("bench: --walk and --random are for --workload frame");
     if (o.clusters != 0 && o.workload != "castle") throw Error("bench: --clusters is for --workload castle");
     if (o.clusters < 0) throw Error("bench: --clusters must be 0 (the triangles as one input) or triangles per cluster, got " +
                                     std::to_string(o.clusters));
@@ -152,7 +180,7 @@ void run_bench(const BenchOptions& o) {
     // One thread: the library's serial path. More: TBB limited to that many threads.
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
     const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
-    const Resolution res = parse_resolution(o.resolution);
+    const Resolution res = parse_resolution(o.resolution.empty() ? "1920x1080" : o.resolution);
     BufferConfig config;
     config.width = res.width;
     config.height = res.height;
@@ -173,7 +201,7 @@ void run_bench(const BenchOptions& o) {
         inputs.s1 = s1.get();
     } else {
         castle = std::make_unique<Scene>(load_scene(o.scene));
-        views = std::make_unique<CameraPath>(read_camera_path(o.views));
+        views = std::make_unique<CameraPath>(read_camera_path(o.views.empty() ? kCastleViews : o.views));
         occluders = std::make_unique<WorldTriangles>(gather_world_triangles(*castle, objects_with_role(*castle, "occluder")));
         inputs.views = views.get();
         inputs.occluders = occluders.get();
@@ -219,22 +247,33 @@ void run_bench(const BenchOptions& o) {
 
 void register_bench(CLI::App& app) {
     auto o = std::make_shared<BenchOptions>();
-    CLI::App* cmd = app.add_subcommand("bench", "Time the occlusion buffer on a fixed workload (s1 or castle); a benchmark, not a test");
-    cmd->add_option("--workload", o->workload, "s1 (../shared/workloads/s1) or castle (role=occluder nodes, data/views/castle.json)")
+    CLI::App* cmd = app.add_subcommand("bench", "Time the occlusion buffer (s1, castle) or whole culled frames (frame) on a fixed "
+                                                "workload; a benchmark, not a test");
+    cmd->add_option("--workload", o->workload,
+                    "s1 (../shared/workloads/s1), castle (role=occluder nodes, data/views/castle.json), or frame (whole frames of the "
+                    "scene culler on --scene, per view: time, stages, efficiency and false culls against Embree)")
         ->capture_default_str();
-    cmd->add_option("--resolution", o->resolution, "Occlusion buffer resolution WxH (pixels)")->capture_default_str();
+    cmd->add_option("--resolution", o->resolution,
+                    "Occlusion buffer resolution WxH (pixels; default 1920x1080); frame: the display (default 1280x720)");
     cmd->add_option("--samples", o->samples, "S x S samples per pixel (1, 2 or 4)")->capture_default_str();
     cmd->add_option("--threads", o->threads, "Threads (1 to 256)")->capture_default_str();
     cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
         ->capture_default_str();
-    cmd->add_option("--repeat", o->repeat, "Runs to take the median of (0 = 5 for s1, 21 for castle)");
+    cmd->add_option("--repeat", o->repeat, "Runs to take the median of (0 = 5 for s1, 21 for castle, 15 rounds over the views for frame)");
     cmd->add_option("--s1", o->s1_folder, "Folder of workload S1")->capture_default_str();
-    cmd->add_option("--scene", o->scene, "Castle scene for --workload castle")->capture_default_str();
+    cmd->add_option("--scene", o->scene, "Scene for --workload castle and frame (frame: any scene file or gen:...)")->capture_default_str();
     cmd->add_option("--clusters", o->clusters,
                     "castle: split the occluders into clusters of at most N triangles (a multiple of 4, <= 512) and render those "
-                    "(OccluderClusters); 0 = the triangles as one input")
+                    "(OccluderClusters); 0 = the triangles as one input. frame: N > 0 draws the occluders as clusters (cull "
+                    "--clusters on)")
         ->capture_default_str();
-    cmd->add_option("--views", o->views, "Camera path with the views for --workload castle")->capture_default_str();
+    cmd->add_option("--views", o->views, "Camera path with the views for --workload castle and frame (default data/views/castle.json)");
+    cmd->add_option("--walk", o->walk, "frame: a walk of N frames through the scene instead of --views (walk_path)")->check(CLI::Range(1, 100000));
+    cmd->add_option("--random", o->random, "frame: N random viewpoints in the scene's free space instead of --views (random_views)")
+        ->check(CLI::Range(1, 100000));
+    cmd->add_option("--seed", o->seed, "frame: seed of --walk or --random")->capture_default_str();
+    cmd->add_option("--occludees", o->occludees, "frame: how objects are tested, as cull --occludees: box, rects, samples or auto")
+        ->capture_default_str();
     cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");
     cmd->add_flag("--vs-scalar", o->vs_scalar,
                   "Also time the scalar reference path (same threads and runs): \"scalar\" and \"speedup_vs_scalar\" (its median "

@@ -1,0 +1,167 @@
+// homcull bench --workload frame (bench_frame.hpp).
+#include "bench_frame.hpp"
+
+#include "cull_report.hpp"
+#include "options.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/io/camera_path.hpp>
+#include <homcull/scene_culler.hpp>
+#include <homcull/tbb_parallel_for.hpp>
+#include <homcull/truth/culling_accuracy.hpp>
+#include <homcull/truth/ground_truth.hpp>
+#include <homcull/truth/ray_scene.hpp>
+#include <homcull/truth/walk_path.hpp>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace homcull::cli {
+namespace {
+
+double median_of(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// What one view measured: every round's times, and the answers scored against Embree.
+struct ViewFigures {
+    std::vector<double> frame, select, render, maps, tests;
+    CullingTally tally;
+    std::size_t counts[3] = {};  // visible, occluded, view-culled
+};
+
+CameraPath frame_bench_views(const FrameBenchOptions& o, const RayScene& rays, const Scene& scene) {
+    if (!o.views.empty()) return read_camera_path(o.views);
+    if (o.walk > 0) {
+        WalkOptions w;
+        w.frames = o.walk;
+        w.seed = o.seed;
+        return walk_path(rays, scene, w);
+    }
+    return random_views(rays, scene, o.random, o.seed);
+}
+
+nlohmann::json accuracy_json(const CullingTally& t) {
+    const std::size_t hidden_outright = t.hidden_in_frustum - t.hidden_through_ties;
+    return {{"efficiency", t.robust_efficiency()},
+            {"efficiency_plain", t.efficiency()},
+            {"false_culls", t.false_culls},
+            {"robust_false_culls", t.robust_false_culls},
+            {"hidden_outright", hidden_outright},
+            {"culled_outright", t.culled_hidden - t.culled_through_ties},
+            {"hidden_in_frustum", t.hidden_in_frustum},
+            {"culled_hidden", t.culled_hidden}};
+}
+
+}  // namespace
+
+void run_frame_bench(const FrameBenchOptions& o) {
+    if (o.rounds < 1 || o.rounds > 10000) throw Error("bench --workload frame: --repeat must be in [1, 10000], got " + std::to_string(o.rounds));
+    if (o.threads < 1 || o.threads > 256) throw Error("bench: --threads must be in [1, 256], got " + std::to_string(o.threads));
+    if (int(!o.views.empty()) + int(o.walk > 0) + int(o.random > 0) != 1)
+        throw Error("bench --workload frame: give exactly one of --views P, --walk N and --random N");
+    select_isa(o.isa);
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
+    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+    SceneCullerConfig config = scene_culler_config(o.cull);
+    const Scene scene = load_chosen_scene(SceneChoice{o.scene, 0});
+    const RayScene rays(scene);
+    const CameraPath path = frame_bench_views(o, rays, scene);
+    if (path.frames.empty()) throw Error("bench --workload frame: the camera path has no views");
+    const CullResources resources = prepare_cull_resources(o.cull, scene, config);
+    SceneCuller culler(scene, resources.occluders, config);
+
+    // One untimed cull per view (the scratch grows to the largest frame), then the timed rounds,
+    // the views interleaved so that the machine's load spreads over all of them alike.
+    const std::size_t views = path.frames.size();
+    std::vector<ViewFigures> figures(views);
+    std::vector<OccludeeAnswer> answers;
+    for (const Camera& camera : path.frames) culler.cull(camera, answers, parallel);
+    for (int r = 0; r < o.rounds; ++r)
+        for (std::size_t v = 0; v < views; ++v) {
+            const long long start = now_ns();
+            culler.cull(path.frames[v], answers, parallel);
+            const double frame_ms = elapsed_ms(start);
+            const SceneCullTimings& t = culler.timings();
+            ViewFigures& f = figures[v];
+            f.frame.push_back(frame_ms);
+            f.select.push_back(t.select_ms), f.render.push_back(t.render_ms), f.maps.push_back(t.maps_ms), f.tests.push_back(t.test_ms);
+        }
+
+    // The answers of each view, against Embree at the display's pixel centres (not timed).
+    TruthOptions truth_options;
+    truth_options.resolution = config.display;
+    CullingTally total;
+    nlohmann::json per_view = nlohmann::json::array();
+    std::vector<double> frame_medians;
+    double stage_sums[4] = {};
+    for (std::size_t v = 0; v < views; ++v) {
+        const Camera& camera = path.frames[v];
+        culler.cull(camera, answers, parallel);
+        const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
+        ViewFigures& f = figures[v];
+        tally_answers(scene, truth, answers, camera, f.tally);
+        for (const OccludeeAnswer& a : answers) ++f.counts[int(a.visibility)];
+        total += f.tally;
+        const double stages[4] = {median_of(f.select), median_of(f.render), median_of(f.maps), median_of(f.tests)};
+        for (int s = 0; s < 4; ++s) stage_sums[s] += stages[s];
+        frame_medians.push_back(median_of(f.frame));
+        nlohmann::json view = {{"view", v},
+                               {"camera", camera_json(camera)},
+                               {"frame_ms", frame_medians.back()},
+                               {"frame_min_ms", *std::min_element(f.frame.begin(), f.frame.end())},
+                               {"stages_ms", {{"select", stages[0]}, {"render", stages[1]}, {"maps", stages[2]}, {"tests", stages[3]}}},
+                               {"answers", {{"visible", f.counts[0]}, {"occluded", f.counts[1]}, {"view_culled", f.counts[2]}}}};
+        view.update(accuracy_json(f.tally));
+        per_view.push_back(std::move(view));
+    }
+    double mean_frame = 0.0;
+    for (const double ms : frame_medians) mean_frame += ms / double(views);
+    const double worst_frame = *std::max_element(frame_medians.begin(), frame_medians.end());
+    nlohmann::json summary = {{"views", views},
+                              {"frame_ms", {{"mean", mean_frame}, {"max", worst_frame}, {"median", median_of(frame_medians)}}},
+                              {"stages_ms_mean",
+                               {{"select", stage_sums[0] / double(views)}, {"render", stage_sums[1] / double(views)},
+                                {"maps", stage_sums[2] / double(views)}, {"tests", stage_sums[3] / double(views)}}}};
+    summary.update(accuracy_json(total));
+    const std::string source = !o.views.empty() ? o.views : o.walk > 0 ? "walk:" + std::to_string(o.walk) + ",seed=" + std::to_string(o.seed)
+                                                                        : "random:" + std::to_string(o.random) + ",seed=" + std::to_string(o.seed);
+    if (o.json) {
+        const nlohmann::json out = {
+            {"workload", "frame"},
+            {"scene", scene.source},
+            {"views_from", source},
+            {"display", {config.display.width, config.display.height}},
+            {"buffer", {culler.buffer().config().width, culler.buffer().config().height}},
+            {"samples", culler.buffer().config().samples},
+            {"isa", culler.buffer().config().isa},
+            {"threads", o.threads},
+            {"rounds", o.rounds},
+            {"config", {{"mode", o.cull.mode}, {"depth", o.cull.depth}, {"occludees", o.cull.occludees}, {"clusters", o.cull.clusters},
+                        {"strategy", o.cull.strategy}, {"occluders", o.cull.occluders}, {"lod", o.cull.lod}}},
+            {"per_view", per_view},
+            {"summary", summary}};
+        fmt::print("{}\n", out.dump(1));
+        return;
+    }
+    fmt::print("frame bench: {} ({} objects), {} views from {}, {}x{} display, {} rounds, {} thread(s), {}\n", scene.source,
+               scene.objects.size(), views, source, config.display.width, config.display.height, o.rounds, o.threads,
+               culler.buffer().config().isa);
+    fmt::print("view  frame ms  (select  render    maps   tests)  efficiency (plain)  false culls\n");
+    for (const nlohmann::json& v : per_view)
+        fmt::print("{:4}  {:8.3f}  ({:6.3f} {:7.3f} {:7.3f} {:7.3f})  {:8.1f} % ({:5.1f} %)  {}\n", v["view"].get<std::size_t>(),
+                   v["frame_ms"].get<double>(), v["stages_ms"]["select"].get<double>(), v["stages_ms"]["render"].get<double>(),
+                   v["stages_ms"]["maps"].get<double>(), v["stages_ms"]["tests"].get<double>(), 100.0 * v["efficiency"].get<double>(),
+                   100.0 * v["efficiency_plain"].get<double>(), v["false_culls"].get<std::size_t>());
+    fmt::print("all   mean {:.3f} ms, worst {:.3f} ms; efficiency {:.1f} % of {} objects hidden outright ({:.1f} % of all hidden); "
+               "{} false culls\n",
+               mean_frame, worst_frame, 100.0 * total.robust_efficiency(), total.hidden_in_frustum - total.hidden_through_ties,
+               100.0 * total.efficiency(), total.false_culls);
+}
+
+}  // namespace homcull::cli
