@@ -21,6 +21,7 @@ packages=(
   clang libclang-rt-14-dev        # the fuzzers (libFuzzer, scripts/fuzz.sh)
   libgmp-dev                      # the conservativeness tests' exact rational oracle (gmpxx)
   python3                         # the C interface's ctypes test (tests/python)
+  python3-matplotlib              # scripts/frontier_plot.py (the efficiency / frame-time plot)
   g++-aarch64-linux-gnu           # the test that the SIMD kernels compile for Arm NEON/SVE (scripts/check-neon.sh)
 )
 # ... and give the scalar path's bits there, run under qemu (scripts/check-neon.sh --run): arm64

@@ -1,0 +1,137 @@
+#!/usr/bin/env python3
+"""Draws the efficiency / whole-frame-time frontier from scripts/frontier.sh's results.
+
+usage: frontier_plot.py OUT [PEERS_SUMMARY_MD]
+
+OUT holds `homcull bench --workload frame --json` outputs named <config>_castle.json (the views
+of data/views/castle.json) and <config>_random.json (random viewpoints). PEERS_SUMMARY_MD is a
+../shared/peers/measure.sh summary.md: its per-view whole-frame tables give the peers' points
+(Intel MOC, rawrunprotected), scored by the peers' summarize.py over every hidden object.
+Writes OUT/frontier.png (a panel per castle view, one for the random views) and OUT/frontier.md
+(the same figures as a table). Efficiency is plotted over every hidden object, the basis the
+peers are scored on; the table gives homcull's over the objects hidden outright beside it.
+"""
+import glob
+import json
+import os
+import re
+import sys
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def pareto(points):
+    """The points no other point beats on both time (lower) and efficiency (higher), by time."""
+    front, best = [], -1.0
+    for ms, eff in sorted(points):
+        if eff > best:
+            front.append((ms, eff))
+            best = eff
+    return front
+
+
+def load_homcull(out):
+    """{config: {'castle': json, 'random': json}} from OUT's bench outputs."""
+    points = {}
+    for path in sorted(glob.glob(os.path.join(out, '*_castle.json')) + glob.glob(os.path.join(out, '*_random.json'))):
+        base = os.path.basename(path)[:-len('.json')]
+        config, kind = base.rsplit('_', 1)
+        with open(path) as f:
+            doc = json.load(f)
+        c = doc['config']
+        label = ('boxes' if c['occludees'] == 'box' else 'triangles') + (', clusters' if c['clusters'] == 'on' else '')
+        points.setdefault(label, {})[kind] = doc
+    return points
+
+
+def load_peers(summary):
+    """{label: [(frame_ms, efficiency %), ...] per castle view} from a measure.sh summary.md."""
+    peers, label = {}, None
+    row = re.compile(r'^\| C(\d+) \| [^|]* \| ([0-9.]+) \[[0-9.]+\] \| [^|]* \| ([0-9.]+) % ')
+    with open(summary) as f:
+        for line in f:
+            if line.startswith('### '):
+                label = line[4:].strip()
+                continue
+            m = row.match(line)
+            if label and m and not label.startswith('homcull'):
+                peers.setdefault(label, []).append((float(m.group(2)), float(m.group(3))))
+    return peers
+
+
+def main():
+    if len(sys.argv) not in (2, 3):
+        sys.exit(__doc__)
+    out = sys.argv[1]
+    homcull = load_homcull(out)
+    if not homcull:
+        sys.exit('frontier_plot.py: no *_castle.json or *_random.json in ' + out)
+    peers = load_peers(sys.argv[2]) if len(sys.argv) == 3 else {}
+    views = max(len(d['castle']['per_view']) for d in homcull.values() if 'castle' in d)
+    has_random = any('random' in d for d in homcull.values())
+    panels = views + (1 if has_random else 0)
+    columns = min(3, panels)
+    rows = (panels + columns - 1) // columns
+    fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows + 1.0), sharey=True, squeeze=False)
+    markers = 'osD^vP*X'
+    for p in range(rows * columns):
+        ax = axes[p // columns][p % columns]
+        if p >= panels:
+            ax.axis('off')
+            continue
+        random_panel = has_random and p == views
+        mine = []
+        for k, (label, docs) in enumerate(sorted(homcull.items())):
+            if random_panel and 'random' in docs:
+                s = docs['random']['summary']
+                point = (s['frame_ms']['mean'], 100 * s['efficiency_plain'])
+            elif not random_panel and 'castle' in docs:
+                v = docs['castle']['per_view'][p]
+                point = (v['frame_ms'], 100 * v['efficiency_plain'])
+            else:
+                continue
+            mine.append(point)
+            ax.plot(*point, markers[k % len(markers)], color='C0', label='homcull ' + label)
+        front = pareto(mine)
+        ax.step([f[0] for f in front], [f[1] for f in front], where='post', color='C0', alpha=0.4, label='homcull frontier')
+        if not random_panel:
+            for k, (label, per_view) in enumerate(sorted(peers.items())):
+                if p < len(per_view):
+                    color = 'C1' if label.startswith('MOC') else 'C2'
+                    ax.plot(per_view[p][0], per_view[p][1], markers[k % len(markers)], color=color, mfc='none', label=label)
+        ax.set_xlim(left=0)
+        ax.set_title('random views (mean)' if random_panel else 'castle C%d' % p)
+        ax.set_xlabel('whole frame, ms (one thread)')
+        ax.grid(True, which='both', alpha=0.3)
+    for r in range(rows):
+        axes[r][0].set_ylabel('efficiency, % of hidden objects culled')
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc='lower center', ncol=3, fontsize='small', frameon=False)
+    fig.tight_layout(rect=(0, 0.8 / (3.4 * rows + 1.0) + 0.04, 1, 1))
+    fig.savefig(os.path.join(out, 'frontier.png'), dpi=110)
+
+    with open(os.path.join(out, 'frontier.md'), 'w') as f:
+        f.write('| culler | view | frame ms | efficiency, hidden outright | efficiency, all hidden | false culls |\n')
+        f.write('|---|---|---|---|---|---|\n')
+        for label, docs in sorted(homcull.items()):
+            for kind in ('castle', 'random'):
+                if kind not in docs:
+                    continue
+                doc = docs[kind]
+                rows = [('C%d' % v['view'], v) for v in doc['per_view']] if kind == 'castle' else []
+                s = doc['summary']
+                rows.append(('%s, mean of %d' % (kind, s['views']), dict(s, frame_ms=s['frame_ms']['mean'])))
+                for name, v in rows:
+                    f.write('| homcull %s | %s | %.3f | %.1f %% | %.1f %% | %d |\n' % (
+                        label, name, v['frame_ms'], 100 * v['efficiency'], 100 * v['efficiency_plain'], v['false_culls']))
+        for label, per_view in sorted(peers.items()):
+            for v, (ms, eff) in enumerate(per_view):
+                f.write('| %s | C%d | %.3f | | %.1f %% | |\n' % (label, v, ms, eff))
+    print('frontier_plot.py: wrote %s and %s' % (os.path.join(out, 'frontier.png'), os.path.join(out, 'frontier.md')))
+
+
+if __name__ == '__main__':
+    main()
