@@ -15,7 +15,6 @@
 #include <thread>
 
 namespace homcull::test {
-namespace {
 
 std::uint32_t add_object_with_own_mesh(Scene& scene, Mesh mesh) {
     Object object;
@@ -26,8 +25,6 @@ std::uint32_t add_object_with_own_mesh(Scene& scene, Mesh mesh) {
     scene.finalize();
     return std::uint32_t(scene.objects.size() - 1);
 }
-
-}  // namespace
 
 std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
     Mesh mesh;

@@ -21,6 +21,8 @@ class RayScene;
 
 namespace homcull::test {
 
+// Appends an object holding `mesh` (a mesh of its own), and finalizes the scene.
+std::uint32_t add_object_with_own_mesh(Scene& scene, Mesh mesh);
 // Appends an object holding a quad (two CCW triangles a, b, c, d) with its own mesh.
 std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d);
 // Appends an axis-aligned box object (12 triangles, CCW outward).

@@ -351,6 +351,50 @@ TEST(SceneCulling, TemporalDrawsAnOccluderThatComesIntoViewAtOnce) {
     EXPECT_EQ(temporal.work().renders, 2u);  // the second pass
 }
 
+// Closed occluder meshes enclosing a positive volume are drawn without the triangles facing
+// away from the eye (SceneCullerConfig::skip_closed_back_faces); open meshes and closed ones
+// wound inside out keep every triangle. The answers are those of drawing everything, as
+// triangles and as clusters (whose closed meshes are drawn with Backface::cw).
+TEST(SceneCulling, ClosedOccludersAreDrawnWithoutTheirBackFaces) {
+    Scene scene;
+    const std::uint32_t wall = test::add_box(scene, "solid wall", {-5, -5, -20}, {5, 5, -10});
+    Mesh inverted;  // a box wound inside out: its volume is negative, so it is left whole
+    inverted.name = "inside-out box";
+    for (int k = 0; k < 8; ++k) inverted.positions.emplace_back((k & 1) ? 9.0f : 7.0f, (k & 2) ? 1.0f : -1.0f, (k & 4) ? -12.0f : -14.0f);
+    inverted.indices = {0, 6, 4, 0, 2, 6, 1, 7, 3, 1, 5, 7, 0, 5, 1, 0, 4, 5, 2, 7, 6, 2, 3, 7, 0, 3, 2, 0, 1, 3, 4, 7, 5, 4, 6, 7};
+    const std::uint32_t inside_out = test::add_object_with_own_mesh(scene, std::move(inverted));
+    const std::uint32_t quad = test::add_quad(scene, "open quad", {-9, -1, -12}, {-7, -1, -12}, {-7, 1, -12}, {-9, 1, -12});
+    const std::uint32_t hidden = test::add_box(scene, "behind the wall", {-1, -1, -30}, {1, 1, -28});
+    scene.finalize();
+    const std::vector<std::uint32_t> candidates = {wall, inside_out, quad};
+    const Camera camera = test::camera_down_minus_z(90.0);
+    for (const bool clusters : {false, true}) {
+        SceneCullerConfig config;
+        config.display = {160, 120};
+        config.occluder_clusters = clusters;
+        SceneCuller skipping(scene, candidates, config);
+        config.skip_closed_back_faces = false;
+        SceneCuller drawing(scene, candidates, config);
+        std::vector<OccludeeAnswer> skipped, drawn;
+        skipping.cull(camera, skipped);
+        drawing.cull(camera, drawn);
+        ASSERT_EQ(skipped.size(), drawn.size());
+        for (std::size_t id = 0; id < drawn.size(); ++id) EXPECT_EQ(skipped[id].visibility, drawn[id].visibility) << id;
+        EXPECT_EQ(skipped[hidden].visibility, Visibility::occluded);
+        EXPECT_EQ(drawing.work().back_faces_skipped, 0u);
+        if (clusters) {
+            // The eye sees the wall's front face only: the rasterizer culls its other five faces.
+            EXPECT_EQ(skipping.buffer().stats().backface_culled, 10u);
+            EXPECT_EQ(drawing.buffer().stats().backface_culled, 0u);
+        } else {
+            // Seen from straight in front, five of the wall's six faces face away; the
+            // inside-out box and the quad keep all their triangles.
+            EXPECT_EQ(skipping.work().back_faces_skipped, 10u);
+            EXPECT_EQ(skipping.work().occluder_triangles, drawing.work().occluder_triangles);
+        }
+    }
+}
+
 // An orthographic camera is refused with an error that names it, not answered as a perspective
 // one (its w = 1 everywhere would cull nothing, silently); the culler stays usable.
 TEST(SceneCulling, OrthographicCamerasAreRefused) {

@@ -109,6 +109,7 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     for (const Object& object : scene.objects) object_boxes_.push_back(anchored_box(object.world_bounds, anchor_));
     node_boxes_.reserve(hierarchy_.nodes.size());
     for (const ObjectHierarchy::Node& node : hierarchy_.nodes) node_boxes_.push_back(anchored_box(node.bounds, anchor_));
+    find_closed_candidates();
     gather_lods();
     build_clusters();
     drawn_.assign(occluders.size(), 0);
@@ -156,6 +157,8 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_rendered_ = 0;  // the buffer is cleared by the frame's first render (render_frame), or by build_maps
     frame_clusters_.clear();
     frame_clusters_rendered_ = 0;
+    frame_closed_clusters_.clear();
+    frame_closed_clusters_rendered_ = 0;
     frame_cluster_triangles_waiting_ = 0;
     frame_started_ = false;
 
@@ -273,6 +276,42 @@ void detail::SceneCullerState::build_clusters() {
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
     frame_clusters_.reserve(clusters_.clusters.size());
+    frame_closed_clusters_.reserve(clusters_.clusters.size());
+}
+
+// A candidate is closed when every edge of its triangles is shared within the object, in
+// opposite order (own_shared_edges_: all three bits), and it encloses a positive volume (the
+// divergence theorem over its triangles: the counter-clockwise normals point out of the solid,
+// so an eye in free space sees their front sides). Its triangles' front planes are kept for
+// the per-frame test.
+void detail::SceneCullerState::find_closed_candidates() {
+    closed_.assign(occluder_ids_.size(), 0);
+    if (!config_.skip_closed_back_faces || config_.backface != Backface::none) return;
+    front_planes_.assign(4 * occluders_.triangle_count(), 0.0f);
+    const auto vertex = [&](std::uint32_t v) {
+        return glm::dvec3(occluders_.positions[3 * std::size_t(v)], occluders_.positions[3 * std::size_t(v) + 1],
+                          occluders_.positions[3 * std::size_t(v) + 2]);
+    };
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+        const std::size_t first = first_triangle_[k], last = first_triangle_[k + 1];
+        bool closed = last > first;
+        double volume = 0.0;
+        for (std::size_t t = first; t < last && closed; ++t) {
+            closed = own_shared_edges_[t] == 7;
+            const glm::dvec3 a = vertex(occluders_.indices[3 * t]), b = vertex(occluders_.indices[3 * t + 1]),
+                             c = vertex(occluders_.indices[3 * t + 2]);
+            volume += glm::dot(a, glm::cross(b, c));  // 6 times the signed volume of (origin, a, b, c)
+        }
+        if (!closed || !(volume > 0.0)) continue;
+        closed_[k] = 1;
+        for (std::size_t t = first; t < last; ++t) {
+            const glm::dvec3 a = vertex(occluders_.indices[3 * t]), b = vertex(occluders_.indices[3 * t + 1]),
+                             c = vertex(occluders_.indices[3 * t + 2]);
+            const glm::dvec3 n = glm::cross(b - a, c - a);
+            float* plane = front_planes_.data() + 4 * t;
+            plane[0] = float(n.x), plane[1] = float(n.y), plane[2] = float(n.z), plane[3] = float(glm::dot(n, a));
+        }
+    }
 }
 
 bool detail::SceneCullerState::draws_lod(std::uint32_t id, const Camera& camera) const {
@@ -293,9 +332,28 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& c
     ++work_.occluder_objects;
     work_.occluder_triangles += last - first;
     work_.occluder_lods += lod;
+    const bool closed = !lod && closed_[k];
     if (config_.occluder_clusters && !lod) {
-        for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) frame_clusters_.push_back(c);
+        std::vector<std::uint32_t>& list = closed ? frame_closed_clusters_ : frame_clusters_;
+        for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) list.push_back(c);
         frame_cluster_triangles_waiting_ += last - first;
+        return;
+    }
+    if (closed) {
+        // The triangles facing the eye (find_closed_candidates); a triangle seen edge-on, or one
+        // whose sign rounds the wrong way, may go either way: leaving it out only loses occlusion.
+        const glm::dvec3 eye = camera.eye - anchor_;
+        const float ex = float(eye.x), ey = float(eye.y), ez = float(eye.z);
+        for (std::uint32_t t = first; t < last; ++t) {
+            const float* p = front_planes_.data() + 4 * std::size_t(t);
+            if (!(p[0] * ex + p[1] * ey + p[2] * ez > p[3])) {
+                ++work_.back_faces_skipped;
+                continue;
+            }
+            frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::ptrdiff_t(t), indices.begin() + 3 * std::ptrdiff_t(t + 1));
+            frame_shared_.push_back(flags[t]);
+            frame_apexes_.insert(frame_apexes_.end(), apexes.begin() + 3 * std::ptrdiff_t(t), apexes.begin() + 3 * std::ptrdiff_t(t + 1));
+        }
         return;
     }
     frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::size_t(first), indices.begin() + 3 * std::size_t(last));
@@ -346,8 +404,20 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
 // frame's first render clears the buffer (render_frame clears each band where it rasterizes).
 void detail::SceneCullerState::render_pending(const Frame& frame, const ParallelFor& parallel) {
     const std::size_t clusters = frame_clusters_.size() - frame_clusters_rendered_, count = frame_shared_.size() - frame_rendered_;
-    if (clusters == 0 && count == 0) return;
+    const std::size_t closed_clusters = frame_closed_clusters_.size() - frame_closed_clusters_rendered_;
+    if (clusters == 0 && count == 0 && closed_clusters == 0) return;
     const auto start = Clock::now();
+    if (closed_clusters > 0) {  // closed meshes' clusters: back faces culled (find_closed_candidates)
+        ClusteredInput in{&clusters_, frame.clip, Backface::cw};
+        in.cluster_ids = frame_closed_clusters_.data() + frame_closed_clusters_rendered_;
+        in.cluster_count = closed_clusters;
+        if (!frame_started_) buffer_.render_frame(in, parallel);
+        else buffer_.render(in, parallel);
+        frame_started_ = true;
+        frame_closed_clusters_rendered_ += closed_clusters;
+        frame_cluster_triangles_waiting_ = 0;
+        ++work_.renders;
+    }
     if (clusters > 0) {
         ClusteredInput in{&clusters_, frame.clip, config_.backface};
         in.cluster_ids = frame_clusters_.data() + frame_clusters_rendered_;

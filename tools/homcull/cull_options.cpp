@@ -55,6 +55,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "on: split each occluder into clusters when the scene is loaded, and draw the frame's clusters nearest first, "
                    "skipping those outside the view or hidden (faster render); off: every drawn triangle is set up")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
+    app.add_option("--closed-back-faces", o.closed_back_faces,
+                   "skip: draw closed occluder meshes without their triangles facing away from the eye (they lie behind the "
+                   "front ones); draw: every triangle")
+        ->capture_default_str()->check(CLI::IsMember({"skip", "draw"}));
     app.add_option("--occluders", o.occluders, "Occluder candidates: role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
     app.add_option("--complexity", o.complexity,
@@ -103,6 +107,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
                 : o.occludees == "samples" ? OccludeeShape::samples : OccludeeShape::automatic;
     c.sample_depth = o.sample_depth == "on";
     c.occluder_clusters = o.clusters == "on";
+    c.skip_closed_back_faces = o.closed_back_faces == "skip";
     c.strategy = o.strategy == "progressive" ? CullStrategy::progressive : o.strategy == "temporal" ? CullStrategy::temporal
                                                                                                  : CullStrategy::one_pass;
     c.occluder_budget.ranking = o.rank == "distance" ? OccluderRanking::distance : o.rank == "area" ? OccluderRanking::area

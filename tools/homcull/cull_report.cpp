@@ -30,7 +30,8 @@ nlohmann::json timings_json(const SceneCullTimings& ms) {
 nlohmann::json work_json(const SceneCullWork& w) {
     return {{"occluder_objects", w.occluder_objects}, {"occluder_triangles", w.occluder_triangles},
             {"occluder_lods", w.occluder_lods},       {"renders", w.renders},
-            {"nodes_tested", w.nodes_tested},         {"objects_tested", w.objects_tested}};
+            {"nodes_tested", w.nodes_tested},         {"objects_tested", w.objects_tested},
+            {"back_faces_skipped", w.back_faces_skipped}};
 }
 
 }  // namespace homcull::cli

@@ -60,6 +60,12 @@ struct SceneCullerConfig {
     OcclusionMapsConfig maps;  // display_width/height are taken from `display`
     // Back faces are surfaces to ground truth and to the eye: none are culled by default.
     Backface backface = Backface::none;
+    // With backface none: the occluders that are closed meshes enclosing a positive volume
+    // (every edge shared by two triangles of the object, in opposite order) are drawn without
+    // the triangles that face away from the eye. From any eye outside the solid they lie behind
+    // the mesh's front faces, so the buffer loses nothing; leaving occluder triangles out can
+    // never hide what is visible. With clusters, their clusters are drawn with Backface::cw.
+    bool skip_closed_back_faces = true;
     // Occludee shape: the world box alone, or, where the box is found visible, the object's
     // triangles (much tighter for objects whose box reaches past what hides them, at the cost
     // of transforming their vertices). Objects with more than triangle_test_limit triangles
@@ -105,6 +111,9 @@ struct SceneCullTimings {
 struct SceneCullWork {
     std::size_t occluder_objects = 0;    // objects rendered into the buffer
     std::size_t occluder_triangles = 0;  // their triangles (as drawn: LODs' where used)
+    // Of those, the closed meshes' triangles facing away from the eye, left out
+    // (skip_closed_back_faces; with clusters the rasterizer culls them instead, RasterStats::backface_culled).
+    std::size_t back_faces_skipped = 0;
     std::size_t occluder_lods = 0;       // occluders drawn with their LOD
     std::size_t renders = 0;             // render calls (progressive: batches)
     std::size_t nodes_tested = 0;        // inner hierarchy nodes tested
