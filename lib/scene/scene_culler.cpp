@@ -157,8 +157,6 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_rendered_ = 0;  // the buffer is cleared by the frame's first render (render_frame), or by build_maps
     frame_clusters_.clear();
     frame_clusters_rendered_ = 0;
-    frame_closed_clusters_.clear();
-    frame_closed_clusters_rendered_ = 0;
     frame_cluster_triangles_waiting_ = 0;
     frame_started_ = false;
 
@@ -276,7 +274,6 @@ void detail::SceneCullerState::build_clusters() {
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
     frame_clusters_.reserve(clusters_.clusters.size());
-    frame_closed_clusters_.reserve(clusters_.clusters.size());
 }
 
 // A candidate is closed when every edge of its triangles is shared within the object, in
@@ -286,7 +283,7 @@ void detail::SceneCullerState::build_clusters() {
 // the per-frame test.
 void detail::SceneCullerState::find_closed_candidates() {
     closed_.assign(occluder_ids_.size(), 0);
-    if (!config_.skip_closed_back_faces || config_.backface != Backface::none) return;
+    if (!config_.skip_closed_back_faces || config_.backface != Backface::none || config_.occluder_clusters) return;
     front_planes_.assign(4 * occluders_.triangle_count(), 0.0f);
     const auto vertex = [&](std::uint32_t v) {
         return glm::dvec3(occluders_.positions[3 * std::size_t(v)], occluders_.positions[3 * std::size_t(v) + 1],
@@ -332,14 +329,12 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& c
     ++work_.occluder_objects;
     work_.occluder_triangles += last - first;
     work_.occluder_lods += lod;
-    const bool closed = !lod && closed_[k];
     if (config_.occluder_clusters && !lod) {
-        std::vector<std::uint32_t>& list = closed ? frame_closed_clusters_ : frame_clusters_;
-        for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) list.push_back(c);
+        for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) frame_clusters_.push_back(c);
         frame_cluster_triangles_waiting_ += last - first;
         return;
     }
-    if (closed) {
+    if (!lod && closed_[k]) {
         // The triangles facing the eye (find_closed_candidates); a triangle seen edge-on, or one
         // whose sign rounds the wrong way, may go either way: leaving it out only loses occlusion.
         const glm::dvec3 eye = camera.eye - anchor_;
@@ -404,20 +399,8 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
 // frame's first render clears the buffer (render_frame clears each band where it rasterizes).
 void detail::SceneCullerState::render_pending(const Frame& frame, const ParallelFor& parallel) {
     const std::size_t clusters = frame_clusters_.size() - frame_clusters_rendered_, count = frame_shared_.size() - frame_rendered_;
-    const std::size_t closed_clusters = frame_closed_clusters_.size() - frame_closed_clusters_rendered_;
-    if (clusters == 0 && count == 0 && closed_clusters == 0) return;
+    if (clusters == 0 && count == 0) return;
     const auto start = Clock::now();
-    if (closed_clusters > 0) {  // closed meshes' clusters: back faces culled (find_closed_candidates)
-        ClusteredInput in{&clusters_, frame.clip, Backface::cw};
-        in.cluster_ids = frame_closed_clusters_.data() + frame_closed_clusters_rendered_;
-        in.cluster_count = closed_clusters;
-        if (!frame_started_) buffer_.render_frame(in, parallel);
-        else buffer_.render(in, parallel);
-        frame_started_ = true;
-        frame_closed_clusters_rendered_ += closed_clusters;
-        frame_cluster_triangles_waiting_ = 0;
-        ++work_.renders;
-    }
     if (clusters > 0) {
         ClusteredInput in{&clusters_, frame.clip, config_.backface};
         in.cluster_ids = frame_clusters_.data() + frame_clusters_rendered_;

@@ -43,7 +43,7 @@ public:
     // shared with an object that is not drawn is a silhouette and needs its margin).
     std::vector<std::uint8_t> own_shared_edges_;
     std::vector<std::uint32_t> own_edge_apexes_;  // their apexes (3 per triangle, into occluders_.positions)
-    // config_.skip_closed_back_faces: per candidate k, whether it is a closed mesh enclosing a
+    // config_.skip_closed_back_faces (triangles, not clusters): per candidate k, whether it is a closed mesh enclosing a
     // positive volume (find_closed_candidates), and per triangle of occluders_ the plane of its
     // front side, (n, d) with n the counter-clockwise normal: facing the eye when n.eye > d
     // (positions and eye relative to the anchor). Zero planes for the other candidates.
@@ -75,8 +75,6 @@ public:
     std::size_t frame_rendered_ = 0;              // triangles of frame_indices_ already rendered
     std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
     std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
-    std::vector<std::uint32_t> frame_closed_clusters_;  // those of closed candidates: drawn with Backface::cw
-    std::size_t frame_closed_clusters_rendered_ = 0;
     std::size_t frame_cluster_triangles_waiting_ = 0;
     bool frame_started_ = false;                  // something was rendered this frame (the buffer is cleared)
     std::vector<std::uint32_t> temporal_pool_;    // temporal: the candidates not occluded last frame
