@@ -158,6 +158,7 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_clusters_.clear();
     frame_clusters_rendered_ = 0;
     frame_cluster_triangles_waiting_ = 0;
+    frame_back_faces_waiting_ = 0;
     frame_started_ = false;
 
     // one_pass (and temporal's first frame): the candidates in the frustum. temporal: those not
@@ -343,6 +344,7 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& c
             const float* p = front_planes_.data() + 4 * std::size_t(t);
             if (!(p[0] * ex + p[1] * ey + p[2] * ez > p[3])) {
                 ++work_.back_faces_skipped;
+                ++frame_back_faces_waiting_;
                 continue;
             }
             frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::ptrdiff_t(t), indices.begin() + 3 * std::ptrdiff_t(t + 1));
@@ -399,6 +401,7 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
 // frame's first render clears the buffer (render_frame clears each band where it rasterizes).
 void detail::SceneCullerState::render_pending(const Frame& frame, const ParallelFor& parallel) {
     const std::size_t clusters = frame_clusters_.size() - frame_clusters_rendered_, count = frame_shared_.size() - frame_rendered_;
+    frame_back_faces_waiting_ = 0;
     if (clusters == 0 && count == 0) return;
     const auto start = Clock::now();
     if (clusters > 0) {

@@ -76,6 +76,9 @@ public:
     std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
     std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
     std::size_t frame_cluster_triangles_waiting_ = 0;
+    // Closed candidates' back faces left out and not rendered yet: they count towards
+    // progressive's batches as if drawn, so that skipping them does not delay a batch.
+    std::size_t frame_back_faces_waiting_ = 0;
     bool frame_started_ = false;                  // something was rendered this frame (the buffer is cleared)
     std::vector<std::uint32_t> temporal_pool_;    // temporal: the candidates not occluded last frame
     std::vector<std::uint32_t> ranked_;           // rank_occluders' choice
@@ -96,7 +99,9 @@ public:
     void gather_lods();
     void build_clusters();
     // Triangles appended and not rendered yet (progressive draws every batch of them).
-    std::size_t triangles_waiting() const { return frame_shared_.size() - frame_rendered_ + frame_cluster_triangles_waiting_; }
+    std::size_t triangles_waiting() const {
+        return frame_shared_.size() - frame_rendered_ + frame_cluster_triangles_waiting_ + frame_back_faces_waiting_;
+    }
     void render_pending(const Frame& frame, const ParallelFor& parallel);
     void build_maps(const Frame& frame);
     void draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
