@@ -387,6 +387,7 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
     expect_refused("bench --workload frame --scene gen:city --random 2 --walk 2", 1, "give exactly one of --views P, --walk N and --random N");
     expect_refused("bench --workload frame --scene gen:city --random 2 --vs-scalar", 1, "--vs-scalar and --sample-depth are for s1 and castle");
     expect_refused("bench --workload s1 --walk 3", 1, "--walk and --random are for --workload frame");
+    expect_refused("bench --workload frame --scene gen:city --random 2 --repeat -1", 1, "--repeat must be at least 1");
     expect_refused("bench --workload frame --scene /nonexistent.glb --random 2", 1, "/nonexistent.glb");
 }
 

@@ -23,11 +23,6 @@
 namespace homcull::cli {
 namespace {
 
-double median_of(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
-
 // What one view measured: every round's times, and the answers scored against Embree.
 struct ViewFigures {
     std::vector<double> frame, select, render, maps, tests;
@@ -108,9 +103,9 @@ void run_frame_bench(const FrameBenchOptions& o) {
         tally_answers(scene, truth, answers, camera, f.tally);
         for (const OccludeeAnswer& a : answers) ++f.counts[int(a.visibility)];
         total += f.tally;
-        const double stages[4] = {median_of(f.select), median_of(f.render), median_of(f.maps), median_of(f.tests)};
+        const double stages[4] = {median(f.select), median(f.render), median(f.maps), median(f.tests)};
         for (int s = 0; s < 4; ++s) stage_sums[s] += stages[s];
-        frame_medians.push_back(median_of(f.frame));
+        frame_medians.push_back(median(f.frame));
         nlohmann::json view = {{"view", v},
                                {"camera", camera_json(camera)},
                                {"frame_ms", frame_medians.back()},
@@ -124,7 +119,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     for (const double ms : frame_medians) mean_frame += ms / double(views);
     const double worst_frame = *std::max_element(frame_medians.begin(), frame_medians.end());
     nlohmann::json summary = {{"views", views},
-                              {"frame_ms", {{"mean", mean_frame}, {"max", worst_frame}, {"median", median_of(frame_medians)}}},
+                              {"frame_ms", {{"mean", mean_frame}, {"max", worst_frame}, {"median", median(frame_medians)}}},
                               {"stages_ms_mean",
                                {{"select", stage_sums[0] / double(views)}, {"render", stage_sums[1] / double(views)},
                                 {"maps", stage_sums[2] / double(views)}, {"tests", stage_sums[3] / double(views)}}}};

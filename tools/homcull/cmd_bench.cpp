@@ -42,6 +42,7 @@ constexpr const char* kCastleViews = "data/views/castle.json";
 void run_frame_workload(const BenchOptions& o) {
     if (o.vs_scalar || o.sample_depth) throw Error("bench --workload frame: --vs-scalar and --sample-depth are for s1 and castle");
     if (o.clusters < 0) throw Error("bench: --clusters must be 0 (off) or more, got " + std::to_string(o.clusters));
+    if (o.repeat < 0) throw Error("bench: --repeat must be at least 1 (0: the workload's default), got " + std::to_string(o.repeat));
     FrameBenchOptions f;
     f.scene = o.scene;
     f.views = o.views.empty() && o.walk == 0 && o.random == 0 ? kCastleViews : o.views;
@@ -58,10 +59,6 @@ void run_frame_workload(const BenchOptions& o) {
     run_frame_bench(f);
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 // The timings of one workload under the selected instruction set: the render (median `ms`,
 // fastest `min_ms`), and on S1 the rectangle tests too. The inputs are loaded once by the

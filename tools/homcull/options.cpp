@@ -116,4 +116,9 @@ long long now_ns() {
 
 double elapsed_ms(long long start_ns) { return double(now_ns() - start_ns) * 1e-6; }
 
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
 }  // namespace homcull::cli

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace homcull::cli {
 
@@ -50,5 +51,7 @@ nlohmann::json stats_json(const RasterStats& stats);
 // Milliseconds since `start` (std::chrono::steady_clock).
 double elapsed_ms(long long start_ns);
 long long now_ns();
+// The median of timings (the mean of the middle two for an even count; 0 for none).
+double median(std::vector<double> v);
 
 }  // namespace homcull::cli
