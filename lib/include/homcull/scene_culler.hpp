@@ -64,9 +64,8 @@ struct SceneCullerConfig {
     // (every edge shared by two triangles of the object, in opposite order) are drawn without
     // the triangles that face away from the eye. From any eye outside the solid they lie behind
     // the mesh's front faces, so the buffer loses nothing; leaving occluder triangles out can
-    // never hide what is visible. Clusters keep every triangle: culling the closed meshes'
-    // back faces there lost about half a point of efficiency on the castle
-    // (docs/scene-culling.md, "Closed occluders").
+    // never hide what is visible. Clusters keep every triangle (docs/scene-culling.md,
+    // "Closed occluders", says why).
     bool skip_closed_back_faces = true;
     // Occludee shape: the world box alone, or, where the box is found visible, the object's
     // triangles (much tighter for objects whose box reaches past what hides them, at the cost
