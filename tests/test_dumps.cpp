@@ -78,20 +78,22 @@ std::vector<std::pair<std::string, std::vector<float>>> expected_parts(const Occ
     // the maps make one, it is that one.
     OcclusionMapsConfig with_both = maps.config();
     with_both.depth_pyramids = DepthPyramids::both;
+    with_both.pyramid = PyramidBuild::always;  // the dump makes the pyramids that lazy maps leave out
     OcclusionMaps both(buffer, with_both);
     both.build(buffer);
+    const OcclusionMaps& pyramids = maps.pyramid_built() ? maps : both;
     for (int k = 0; k < maps.levels(); ++k) {
         const std::size_t n = std::size_t(maps.level_width(k)) * std::size_t(maps.level_height(k));
         std::vector<float> opacity;
         for (int y = 0; y < maps.level_height(k); ++y)
-            for (int x = 0; x < maps.level_width(k); ++x) opacity.push_back(maps.opacity(k, x, y));
+            for (int x = 0; x < maps.level_width(k); ++x) opacity.push_back(pyramids.opacity(k, x, y));
         out.emplace_back("opacity.L" + std::to_string(k), opacity);
         out.emplace_back("maxz.L" + std::to_string(k), std::vector<float>(both.farthest_depth(k), both.farthest_depth(k) + n));
         out.emplace_back("nbz.L" + std::to_string(k), std::vector<float>(both.nearest_depth(k), both.nearest_depth(k) + n));
-        if (maps.farthest_depth(k)) {
+        if (maps.pyramid_built() && maps.farthest_depth(k)) {
             EXPECT_TRUE(std::equal(maps.farthest_depth(k), maps.farthest_depth(k) + n, both.farthest_depth(k)));
         }
-        if (maps.nearest_depth(k)) {
+        if (maps.pyramid_built() && maps.nearest_depth(k)) {
             EXPECT_TRUE(std::equal(maps.nearest_depth(k), maps.nearest_depth(k) + n, both.nearest_depth(k)));
         }
     }

@@ -9,7 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <string>
 
 namespace homcull {
 namespace {
@@ -56,12 +58,16 @@ OcclusionBuffer buffer_of(int width, int height, int samples, const Occluders& o
     return buffer;
 }
 
-OcclusionMapsConfig maps_config(const OcclusionBuffer& b, DepthTest depth = DepthTest::masked, double hole = 0.0) {
+// The tests below study the pyramids and the overlap test: they make them whatever the mode
+// (PyramidBuild::always); LazyMaps... checks what lazy maps answer instead.
+OcclusionMapsConfig maps_config(const OcclusionBuffer& b, DepthTest depth = DepthTest::masked, double hole = 0.0,
+                                PyramidBuild pyramid = PyramidBuild::always) {
     OcclusionMapsConfig c;
     c.display_width = b.sample_width();
     c.display_height = b.sample_height();
     c.depth = depth;
     c.hole_pixels = hole;
+    c.pyramid = pyramid;
     return c;
 }
 
@@ -417,6 +423,86 @@ TEST(OcclusionMaps, ConservativeOverlapIsExactOnRandomInput) {
     }
 }
 
+// Lazy maps (conservative, masked depth) leave the pyramids out: the buffer's depth test gives
+// the same visibility as the overlap-then-depth test of maps that make them, and a visible
+// rectangle's level of visibility is its exact uncovered share (1 when all its samples are
+// covered). build_pyramid() then gives the full maps' answers, exits and estimates included.
+// On random triangles and rectangles, odd sizes and every sample count.
+TEST(OcclusionMaps, LazyMapsAnswerAsTheFullMapsWithoutThePyramids) {
+    std::mt19937 rng(5);
+    for (int s : {1, 2, 4}) {
+        const int width = 93, height = 67;
+        OcclusionBuffer buffer(test::buffer_config(width, height, s, 0.5f));
+        buffer.render(test::clip_space_input(test::random_clip_triangles(std::uint64_t(s) + 20, 500, 0.5f)));
+        OcclusionMaps full(buffer, maps_config(buffer));
+        OcclusionMaps lazy(buffer, maps_config(buffer, DepthTest::masked, 0.0, PyramidBuild::lazy));
+        full.build(buffer);
+        lazy.build(buffer);
+        ASSERT_TRUE(full.pyramid_built());
+        ASSERT_FALSE(lazy.pyramid_built());
+        EXPECT_THROW(lazy.opacity(0, 0, 0), Error);
+        EXPECT_THROW(lazy.covered_samples(0), Error);
+        std::vector<std::uint8_t> covered;
+        buffer.read_coverage(covered);
+        const int sw = buffer.sample_width(), sh = buffer.sample_height();
+        // Small rectangles (to be hidden) and large ones (partly covered), in front of the
+        // occluders (w 1 to 80) and behind them.
+        std::uniform_int_distribution<int> x_of(0, sw - 1), y_of(0, sh - 1), size_of(0, 150), small_size_of(0, 6);
+        std::uniform_real_distribution<float> w_of(0.6f, 400.0f);
+        int hidden = 0, partly_covered = 0;
+        std::vector<ScreenRect> rects;
+        for (int t = 0; t < 3000; ++t) {
+            const bool small = t % 2 == 0;
+            const int i0 = x_of(rng), j0 = y_of(rng);
+            const int i1 = std::min(sw - 1, i0 + (small ? small_size_of(rng) : size_of(rng)));
+            const int j1 = std::min(sh - 1, j0 + (small ? small_size_of(rng) : size_of(rng)));
+            int uncovered = 0;
+            for (int j = j0; j <= j1; ++j)
+                for (int i = i0; i <= i1; ++i) uncovered += covered[std::size_t(j) * std::size_t(sw) + std::size_t(i)] == 0;
+            const ScreenRect r = pixel_rect(sw, sh, i0 + 0.25, j0 + 0.25, i1 + 0.75, j1 + 0.75, w_of(rng));
+            rects.push_back(r);
+            const OccludeeAnswer a = lazy.test_rect(r), b = full.test_rect(r);
+            const std::string what = "S " + std::to_string(s) + " samples [" + std::to_string(i0) + ", " + std::to_string(i1) + "] x [" +
+                                     std::to_string(j0) + ", " + std::to_string(j1) + "]";
+            ASSERT_EQ(a.visibility, b.visibility) << what;
+            ASSERT_EQ(exit_of(a), OverlapExit::not_run) << what;
+            const double share = double(uncovered) / (double(i1 - i0 + 1) * double(j1 - j0 + 1));
+            if (a.visibility == Visibility::occluded) {
+                ASSERT_EQ(a.level_of_visibility, 0.0f) << what;
+                ++hidden;
+            } else {
+                ASSERT_EQ(a.level_of_visibility, uncovered == 0 ? 1.0f : float(share)) << what;
+                partly_covered += uncovered > 0 && share < 1.0;
+            }
+        }
+        EXPECT_GT(hidden, 100) << "too few hidden rectangles to mean anything";
+        EXPECT_GT(partly_covered, 100) << "too few partly covered rectangles to mean anything";
+        // With its pyramids, the lazy maps are the full maps.
+        lazy.build_pyramid();
+        ASSERT_TRUE(lazy.pyramid_built());
+        for (const ScreenRect& r : rects) {
+            const OccludeeAnswer a = lazy.test_rect(r), b = full.test_rect(r);
+            ASSERT_EQ(a.visibility, b.visibility);
+            ASSERT_EQ(a.level_of_visibility, b.level_of_visibility);
+            ASSERT_EQ(a.overlap_exit, b.overlap_exit);
+        }
+        for (int k = 0; k < full.levels(); ++k)
+            ASSERT_TRUE(std::equal(full.covered_samples(k), full.covered_samples(k) + full.level_width(k) * full.level_height(k),
+                                   lazy.covered_samples(k)));
+        // The next build leaves them out again.
+        lazy.build(buffer);
+        EXPECT_FALSE(lazy.pyramid_built());
+    }
+    // Lazy means always where the overlap test can hide what the buffer alone does not
+    // (approximate mode) or the depth test is not the buffer's.
+    OcclusionBuffer buffer(test::buffer_config(16, 16, 2, 0.5f));
+    for (auto [depth, hole] : {std::pair{DepthTest::masked, 1.0}, std::pair{DepthTest::hzb, 0.0}, std::pair{DepthTest::deb, 0.0}}) {
+        OcclusionMaps maps(buffer, maps_config(buffer, depth, hole, PyramidBuild::lazy));
+        maps.build(buffer);
+        EXPECT_TRUE(maps.pyramid_built()) << "depth " << int(depth) << ", hole " << hole;
+    }
+}
+
 TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
     const OcclusionBuffer buffer = buffer_of(32, 32, 1, Occluders{32, 32, {}, {}, {}});
     auto make = [&](auto change) {
@@ -433,11 +519,14 @@ TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.coarsest_level = 40; }), Error);
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.deb_width = 0; }), Error);
     EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.depth_pyramids = DepthPyramids(7); }), Error);
+    EXPECT_THROW(make([](OcclusionMapsConfig& c) { c.pyramid = PyramidBuild(7); }), Error);
     EXPECT_NO_THROW(make([](OcclusionMapsConfig&) {}));
     // Tests need a built map.
     {
-        const OcclusionMaps unbuilt(buffer, maps_config(buffer));
+        OcclusionMaps unbuilt(buffer, maps_config(buffer, DepthTest::masked, 0.0, PyramidBuild::lazy));
         EXPECT_THROW(unbuilt.test_rect({-1, -1, 1, 1, 5.0f}), Error);
+        EXPECT_THROW(unbuilt.build_pyramid(), Error);
+        EXPECT_THROW(unbuilt.opacity(0, 0, 0), Error);
     }
     // A 1 x 1 buffer is a one-level pyramid.
     const OcclusionBuffer tiny = buffer_of(1, 1, 4, Occluders{1, 1, {}, {}, {}});

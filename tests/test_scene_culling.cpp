@@ -316,6 +316,53 @@ TEST(SceneCulling, ClustersGiveTheSameAnswersWithAJobSystem) {
     }
 }
 
+// Lazy maps (the default): the buffer's depth test alone gives every object the visibility that
+// the overlap test followed by the depth test gives, for boxes and for occludee triangles, along
+// a castle walk with every strategy (progressive rebuilds the maps for each batch); the levels of
+// visibility are shares in [0, 1], 0 for what is hidden.
+TEST(SceneCulling, LazyMapsGiveTheSameVisibilityAsMapsWithTheirPyramids) {
+    const std::string path = test::shared_scene("intel_castle.glb");
+    if (path.empty()) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const Scene castle = load_scene(path);
+    const std::vector<std::uint32_t> candidates = occluder_candidates(castle, OccluderFilter::role);
+    const RayScene rays(castle);
+    WalkOptions walk;
+    walk.frames = 10;
+    const CameraPath frames = walk_path(rays, castle, walk);
+    for (const CullStrategy strategy : {CullStrategy::one_pass, CullStrategy::progressive, CullStrategy::temporal})
+        for (const OccludeeShape shape : {OccludeeShape::box, OccludeeShape::automatic}) {
+            SceneCullerConfig config;
+            config.display = {416, 234};
+            config.strategy = strategy;
+            config.occludees = shape;
+            config.maps.pyramid = PyramidBuild::always;
+            SceneCuller full(castle, candidates, config);
+            config.maps.pyramid = PyramidBuild::lazy;
+            SceneCuller lazy(castle, candidates, config);
+            std::vector<OccludeeAnswer> a, b;
+            std::size_t hidden = 0;
+            for (std::size_t f = 0; f < frames.frames.size(); ++f) {
+                lazy.cull(frames.frames[f], a);
+                full.cull(frames.frames[f], b);
+                ASSERT_EQ(a.size(), b.size());
+                for (std::size_t id = 0; id < a.size(); ++id) {
+                    ASSERT_EQ(a[id].visibility, b[id].visibility) << "strategy " << int(strategy) << ", frame " << f << ", object " << id;
+                    ASSERT_GE(a[id].level_of_visibility, 0.0f);
+                    ASSERT_LE(a[id].level_of_visibility, 1.0f);
+                    if (a[id].visibility == Visibility::occluded) {
+                        ASSERT_EQ(a[id].level_of_visibility, 0.0f);
+                        ++hidden;
+                    }
+                }
+                EXPECT_EQ(lazy.overlap_exits().count[std::size_t(OverlapExit::passed)], 0u);
+                EXPECT_GT(full.overlap_exits().count[std::size_t(OverlapExit::passed)], 0u);
+                // Dumps read the pyramids: maps() makes them.
+                EXPECT_TRUE(lazy.maps().pyramid_built());
+            }
+            EXPECT_GT(hidden, 1000u) << "strategy " << int(strategy);
+        }
+}
+
 // Temporal's second pass: an occluder hidden last frame that comes into view is drawn in the
 // same frame, so what it hides is culled at once, as one-pass culls it.
 TEST(SceneCulling, TemporalDrawsAnOccluderThatComesIntoViewAtOnce) {

@@ -12,6 +12,7 @@
 namespace homcull::detail {
 
 struct MapKernels;
+struct RectQuery;
 
 class MapsState {
 public:
@@ -28,19 +29,27 @@ public:
     int levels() const { return int(levels_.size()); }
     int level_width(int k) const { return levels_[std::size_t(k)].width; }
     int level_height(int k) const { return levels_[std::size_t(k)].height; }
-    const std::uint32_t* covered_samples(int k) const { return covered_.data() + levels_[std::size_t(k)].offset; }
+    const std::uint32_t* covered_samples(int k) const { return need_pyramid(), covered_.data() + levels_[std::size_t(k)].offset; }
     std::uint32_t cell_samples(int k, int x, int y) const;
     float opacity(int k, int x, int y) const;
     double opacity_threshold(int k) const { return opacity_threshold_[std::size_t(k)]; }
     double transparency_threshold(int k) const { return transparency_threshold_[std::size_t(k)]; }
-    const float* farthest_depth(int k) const { return hzb_.empty() ? nullptr : hzb_.data() + levels_[std::size_t(k)].offset; }
-    const float* nearest_depth(int k) const { return nbz_.empty() ? nullptr : nbz_.data() + levels_[std::size_t(k)].offset; }
+    const float* farthest_depth(int k) const { return need_pyramid(), hzb_.empty() ? nullptr : hzb_.data() + levels_[std::size_t(k)].offset; }
+    const float* nearest_depth(int k) const { return need_pyramid(), nbz_.empty() ? nullptr : nbz_.data() + levels_[std::size_t(k)].offset; }
     const std::vector<float>& depth_estimation() const { return deb_; }
-    float plane_depth() const { return plane_; }
+    float plane_depth() const { return need_pyramid(), plane_; }
+    void build_pyramid();
 
     using Level = detail::PyramidLevel;
     OcclusionMapsConfig config_;
     const OcclusionBuffer* built_ = nullptr;     // the buffer of the last build()
+    // PyramidBuild::lazy where the buffer's depth test decides alone (conservative, masked):
+    // build() then makes covered_sums_ instead of the pyramids, until build_pyramid().
+    bool buffer_decides_ = false;
+    bool pyramid_built_ = false;
+    // Covered samples summed over subtiles [0, tx) x [0, ty), at ty * (subtiles_x + 1) + tx.
+    std::vector<std::uint32_t> covered_sums_;
+    int sums_width_ = 0;
     const MapKernels* built_with_ = nullptr;     // the kernels it ran: its buffer's instruction set's
     int width_ = 0, height_ = 0, samples_ = 1;  // buffer pixels and samples per axis
     float near_w_ = 0.1f;
@@ -61,6 +70,11 @@ public:
     bool overlap_cell(OverlapQuery& q, int k, int x, int y) const;
     void overlap(int i0, int i1, int j0, int j1, double budget, OccludeeAnswer& answer, double& uncovered) const;
     bool depth_hidden(int i0, int i1, int j0, int j1, float d_near) const;
+    void make_pyramid();
+    void need_pyramid() const;  // throws unless pyramid_built_
+    void sum_covered_samples();
+    std::uint64_t uncovered_by_sums(int i0, int i1, int j0, int j1) const;  // from covered_sums_ and the border subtiles' masks
+    OccludeeAnswer buffer_answer(const RectQuery& q) const;
     const OcclusionBuffer& built() const;
 };
 

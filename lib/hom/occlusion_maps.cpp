@@ -73,6 +73,13 @@ detail::MapsState::MapsState(const OcclusionBuffer& buffer, const OcclusionMapsC
     if (both || config.depth == DepthTest::hzb || config.depth == DepthTest::plane) hzb_.assign(size, 0.0f);
     if (both || config.depth == DepthTest::nbz) nbz_.assign(size, 0.0f);
     deb_.assign(std::size_t(config.deb_width) * std::size_t(config.deb_height), INFINITY);
+    buffer_decides_ = config.pyramid == PyramidBuild::lazy && config.hole_pixels == 0.0 && config.depth == DepthTest::masked;
+    if (config.pyramid != PyramidBuild::lazy && config.pyramid != PyramidBuild::always)
+        throw Error("occlusion maps: pyramid must be PyramidBuild::lazy or ::always");
+    if (buffer_decides_) {
+        sums_width_ = buffer.subtiles_x() + 1;
+        covered_sums_.assign(std::size_t(sums_width_) * std::size_t(buffer.subtiles_y() + 1), 0u);
+    }
 
     // Display pixels per buffer pixel (m0 x m0) and samples per display pixel (area).
     const double m0x = double(config.display_width) / double(width_), m0y = double(config.display_height) / double(height_);
@@ -103,6 +110,7 @@ std::uint32_t detail::MapsState::cell_samples(int k, int x, int y) const {
 
 float detail::MapsState::opacity(int k, int x, int y) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
+    need_pyramid();
     const Level& l = levels_[std::size_t(k)];
     return float(covered_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)]) / float(cell_samples(k, x, y));
 }
@@ -111,6 +119,29 @@ void detail::MapsState::build(const OcclusionBuffer& buffer) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     if (buffer.config().width != width_ || buffer.config().height != height_ || buffer.config().samples != samples_)
         throw Error("occlusion maps: build() needs a buffer shaped like the one the maps were made for");
+    built_ = &buffer;
+    pyramid_built_ = false;
+    if (buffer_decides_) {
+        built_with_ = &detail::map_kernels(*buffer.state().isa_);
+        sum_covered_samples();
+        return;
+    }
+    make_pyramid();
+}
+
+void detail::MapsState::build_pyramid() {
+    if (!pyramid_built_) make_pyramid();  // built() throws before the first build()
+}
+
+void detail::MapsState::need_pyramid() const {
+    if (!pyramid_built_)
+        throw Error(built_ ? "occlusion maps: the pyramids were left out (PyramidBuild::lazy): call build_pyramid() first"
+                           : "occlusion maps: read before build()");
+}
+
+void detail::MapsState::make_pyramid() {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
+    const OcclusionBuffer& buffer = built();
     // Level 0: per buffer pixel, its covered samples, and the farthest and nearest bound of
     // those samples (a sample in a subtile's working mask is bounded by max(d0, d1), any
     // other by d0; see OcclusionBuffer). Pixels without covered samples get +inf ("no
@@ -150,7 +181,7 @@ void detail::MapsState::build(const OcclusionBuffer& buffer) {
     }
     const Level& top = levels_.back();
     plane_ = hzb ? *std::min_element(hzb_.begin() + std::ptrdiff_t(top.offset), hzb_.end()) : INFINITY;
-    built_ = &buffer;
+    pyramid_built_ = true;
 }
 
 const OcclusionBuffer& detail::MapsState::built() const {
@@ -306,6 +337,7 @@ OccludeeAnswer detail::MapsState::test_rect_within(const ScreenRect& rect, doubl
     Visibility decided;
     if (!built().state().prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
         return decided_answer(decided);
+    if (!pyramid_built_) return buffer_answer(q);  // PyramidBuild::lazy: the buffer decides alone
     OccludeeAnswer answer;
     double uncovered = 0.0;
     overlap(q.i0, q.i1, q.j0, q.j1, budget, answer, uncovered);

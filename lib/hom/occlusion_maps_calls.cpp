@@ -13,6 +13,8 @@ OcclusionMaps& OcclusionMaps::operator=(OcclusionMaps&&) noexcept = default;
 void OcclusionMaps::clear() { state_->clear(); }
 void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16>& model_to_clip) { state_->add_occluder_box(box, model_to_clip); }
 void OcclusionMaps::build(const OcclusionBuffer& buffer) { state_->build(buffer); }
+void OcclusionMaps::build_pyramid() { state_->build_pyramid(); }
+bool OcclusionMaps::pyramid_built() const { return state_->pyramid_built_; }
 OccludeeAnswer OcclusionMaps::test_rect(const ScreenRect& rect) const { return state_->test_rect(rect); }
 OccludeeAnswer OcclusionMaps::test_aabb(const Aabb& box, const std::array<float, 16>& model_to_clip) const { return state_->test_aabb(box, model_to_clip); }
 double OcclusionMaps::hole_budget() const { return state_->hole_budget(); }

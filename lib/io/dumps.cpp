@@ -74,14 +74,16 @@ std::string number(double v) {
 std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionMaps& maps) {
     if (maps.levels() < 1 || maps.level_width(0) != buffer.config().width || maps.level_height(0) != buffer.config().height)
         throw Error("dumps: the occlusion maps were not made for this buffer");
-    // Maps that make only the depth pyramid their test reads (OcclusionMapsConfig::
-    // depth_pyramids): both are built here from the same buffer, for the dump alone.
+    // Maps that left out their pyramids (PyramidBuild::lazy) or make only the depth pyramid
+    // their test reads (OcclusionMapsConfig::depth_pyramids): every pyramid is built here from
+    // the same buffer, for the dump alone.
     std::optional<OcclusionMaps> with_both;
-    const OcclusionMaps* depth_maps = &maps;
-    if (!maps.farthest_depth(0) || !maps.nearest_depth(0)) {
+    const OcclusionMaps* pyramids = &maps;
+    if (!maps.pyramid_built() || !maps.farthest_depth(0) || !maps.nearest_depth(0)) {
         OcclusionMapsConfig config = maps.config();
         config.depth_pyramids = DepthPyramids::both;
-        depth_maps = &with_both.emplace(buffer, config);
+        config.pyramid = PyramidBuild::always;
+        pyramids = &with_both.emplace(buffer, config);
         with_both->build(buffer);
     }
     std::vector<DumpPart> parts;
@@ -106,7 +108,7 @@ std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionM
                                      "opacity pyramid level " + std::to_string(k) + ": covered samples / samples per cell", w, h,
                                      DumpColormap::viridis, false);
         for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) opacity.values.push_back(maps.opacity(k, x, y));
+            for (int x = 0; x < w; ++x) opacity.values.push_back(pyramids->opacity(k, x, y));
         parts.push_back(std::move(opacity));
         // The two depth pyramids: 1/w per cell, one level's cells contiguous.
         const std::size_t n = std::size_t(w) * std::size_t(h);
@@ -118,8 +120,8 @@ std::vector<DumpPart> dump_parts(const OcclusionBuffer& buffer, const OcclusionM
             part.values.assign(cells, cells + n);
             parts.push_back(std::move(part));
         };
-        depth_part("maxz", "max-Z (hzb), the farthest depth of the covered samples:", depth_maps->farthest_depth(k));
-        depth_part("nbz", "no-background Z-buffer, the nearest depth of the covered samples:", depth_maps->nearest_depth(k));
+        depth_part("maxz", "max-Z (hzb), the farthest depth of the covered samples:", pyramids->farthest_depth(k));
+        depth_part("nbz", "no-background Z-buffer, the nearest depth of the covered samples:", pyramids->nearest_depth(k));
     }
     // Only filled (add_occluder_box) when the maps answer with it: otherwise all +inf, noise.
     if (maps.config().depth == DepthTest::deb) {

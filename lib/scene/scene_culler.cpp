@@ -140,6 +140,7 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     if (buffer_.config().near_w != float(camera.near_plane)) {
         buffer_ = OcclusionBuffer(scene_buffer_config(config_, float(camera.near_plane)));
         maps_ = OcclusionMaps(buffer_, maps_config(config_));
+        maps_built_ = false;
     }
     const double aspect = config_.display.aspect();
     // The buffer's matrix takes positions relative to the anchor: composed in double, so that the
@@ -439,6 +440,7 @@ void detail::SceneCullerState::build_maps(const Frame& frame) {
     if (config_.maps.depth == DepthTest::deb)
         for (std::uint32_t id : frame_occluders_) maps_.add_occluder_box(object_boxes_[id], frame.clip);
     maps_.build(buffer_);
+    maps_built_ = true;
     timings_.maps_ms += ms_since(start);
 }
 

@@ -19,7 +19,12 @@ public:
     const SceneCullerConfig& config() const { return config_; }
     const Scene& scene() const { return *scene_; }
     const OcclusionBuffer& buffer() const { return buffer_; }
-    const OcclusionMaps& maps() const { return maps_; }
+    // The maps with their pyramids (made now when the frame's build left them out,
+    // PyramidBuild::lazy), for dumps.
+    const OcclusionMaps& maps() {
+        if (maps_built_) maps_.build_pyramid();
+        return maps_;
+    }
     const SceneCullTimings& timings() const { return timings_; }
     const SceneCullWork& work() const { return work_; }
     const OverlapExitCounts& overlap_exits() const { return exits_; }
@@ -63,6 +68,7 @@ public:
     ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
+    bool maps_built_ = false;  // since the buffer was made (maps() may then make their pyramids)
     SceneCullTimings timings_;
     SceneCullWork work_;
     OverlapExitCounts exits_;

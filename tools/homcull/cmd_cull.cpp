@@ -84,7 +84,7 @@ void run_cull(const CullCommandOptions& o) {
     const SceneCullTimings& ms = best;
     if (o.json) {
         nlohmann::json exits;
-        for (int e = 1; e < 7; ++e) exits[overlap_exit_name(OverlapExit(e))] = culler.overlap_exits().count[e];
+        for (int e = 0; e < 7; ++e) exits[overlap_exit_name(OverlapExit(e))] = culler.overlap_exits().count[e];  // not_run: --pyramid lazy
         nlohmann::json out = {
             {"scene", scene.source},
             {"camera", camera_json(camera)},

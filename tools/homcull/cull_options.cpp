@@ -40,6 +40,11 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--depth", o.depth, "Depth test: masked, hzb, deb, nbz (not conservative) or plane")
         ->capture_default_str()->check(CLI::IsMember({"masked", "hzb", "deb", "nbz", "plane"}));
     app.add_option("--deb", o.deb, "Depth estimation buffer cells WxH")->capture_default_str();
+    app.add_option("--pyramid", o.pyramid,
+                   "lazy: with --mode conservative and --depth masked, build no opacity pyramid (the buffer's depth test "
+                   "decides alone, the overlap test does not run); always: build it every frame and run the overlap test "
+                   "(the same answers; its exits and estimates reported)")
+        ->capture_default_str()->check(CLI::IsMember({"lazy", "always"}));
     app.add_option("--finest-level", o.finest_level, "Finest active level of the opacity pyramid")->capture_default_str();
     app.add_option("--coarsest-level", o.coarsest_level, "Coarsest active level (-1: the pyramid's last)")->capture_default_str();
     app.add_option("--occludees", o.occludees,
@@ -103,6 +108,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.maps.deb_height = deb.height;
     c.maps.depth = o.depth == "hzb" ? DepthTest::hzb : o.depth == "deb" ? DepthTest::deb : o.depth == "nbz" ? DepthTest::nbz
                  : o.depth == "plane" ? DepthTest::plane : DepthTest::masked;
+    c.maps.pyramid = o.pyramid == "always" ? PyramidBuild::always : PyramidBuild::lazy;
     c.occludees = o.occludees == "box" ? OccludeeShape::box : o.occludees == "rects" ? OccludeeShape::rectangles
                 : o.occludees == "samples" ? OccludeeShape::samples : OccludeeShape::automatic;
     c.sample_depth = o.sample_depth == "on";

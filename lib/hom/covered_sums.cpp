@@ -1,0 +1,77 @@
+// The maps without their pyramids (PyramidBuild::lazy, conservative mode, masked depth): the
+// buffer's own depth test answers, and the covered samples summed over subtiles give a visible
+// occludee's uncovered share. A summed-area table (Crow, "Summed-area tables for texture
+// mapping", SIGGRAPH 1984) makes the share of any rectangle cost its border subtiles alone.
+#include "hom/maps_state.hpp"
+
+#include "buffer/buffer_state.hpp"
+#include "buffer/rect_queries.hpp"
+#include "raster/rasterize.hpp"
+
+namespace homcull {
+namespace {
+
+constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+
+}  // namespace
+
+// One pass over the subtiles' coverage masks: a fortieth of the pyramids' work at one sample
+// per pixel (one 32-bit mask a subtile against a count, and depths, per pixel).
+void detail::MapsState::sum_covered_samples() {
+    const detail::BufferState& state = built_->state();
+    const int tiles_x = sums_width_ - 1, tiles_y = int(covered_sums_.size() / std::size_t(sums_width_)) - 1;
+    std::uint32_t* sums = covered_sums_.data();
+    for (int ty = 0; ty < tiles_y; ++ty) {
+        const std::uint32_t* above = sums + std::size_t(ty) * std::size_t(sums_width_);
+        std::uint32_t* row = sums + std::size_t(ty + 1) * std::size_t(sums_width_);
+        const std::uint32_t* covered = state.covered_.data() + state.at(0, ty);
+        std::uint32_t run = 0;  // this row's covered samples left of tx + 1
+        for (int tx = 0; tx < tiles_x; ++tx) {
+            run += detail::bit_count(covered[tx]);
+            row[tx + 1] = above[tx + 1] + run;
+        }
+    }
+}
+
+// Uncovered samples of [i0, i1] x [j0, j1] (inside the buffer): the subtiles wholly inside from
+// the table, the border ones from their masks.
+std::uint64_t detail::MapsState::uncovered_by_sums(int i0, int i1, int j0, int j1) const {
+    const detail::BufferState& state = built_->state();
+    const detail::RectQuery q{i0, i1, j0, j1, 0.0f};
+    const auto [ix0, ix1, iy0, iy1] = detail::interior_subtiles(q);
+    std::uint64_t covered = 0;
+    const bool interior = ix0 <= ix1 && iy0 <= iy1;
+    if (interior) {
+        const auto sum = [&](int tx, int ty) { return std::uint64_t(covered_sums_[std::size_t(ty) * std::size_t(sums_width_) + std::size_t(tx)]); };
+        covered = sum(ix1 + 1, iy1 + 1) + sum(ix0, iy0) - sum(ix0, iy1 + 1) - sum(ix1 + 1, iy0);
+    }
+    for (int ty = j0 / kH; ty <= j1 / kH; ++ty)
+        for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {
+            if (interior && ty >= iy0 && ty <= iy1 && tx >= ix0 && tx <= ix1) {  // counted above
+                tx = ix1;
+                continue;
+            }
+            covered += detail::bit_count(detail::subtile_rect_bits(tx, ty, i0, i1, j0, j1) & state.covered_[state.at(tx, ty)]);
+        }
+    return std::uint64_t(i1 - i0 + 1) * std::uint64_t(j1 - j0 + 1) - covered;
+}
+
+// The buffer's depth test decides (it finds a rectangle hidden only where every sample is
+// covered, so an overlap test could add nothing); a visible rectangle's level of visibility is
+// its uncovered share, or 1 when it is covered everywhere (then in front of an occluder
+// somewhere, as the overlap-then-depth answer has it).
+OccludeeAnswer detail::MapsState::buffer_answer(const RectQuery& q) const {
+    OccludeeAnswer answer;
+    answer.overlap_exit = std::uint8_t(OverlapExit::not_run);
+    if (built_->state().test_prepared_rect(q) == Visibility::occluded) {
+        answer.visibility = Visibility::occluded;
+        answer.level_of_visibility = 0.0f;
+        return answer;
+    }
+    const std::uint64_t uncovered = uncovered_by_sums(q.i0, q.i1, q.j0, q.j1);
+    answer.level_of_visibility =
+        uncovered == 0 ? 1.0f : float(double(uncovered) / (double(q.i1 - q.i0 + 1) * double(q.j1 - q.j0 + 1)));
+    return answer;
+}
+
+}  // namespace homcull
