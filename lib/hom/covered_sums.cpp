@@ -8,6 +8,8 @@
 #include "buffer/rect_queries.hpp"
 #include "raster/rasterize.hpp"
 
+#include <algorithm>
+
 namespace homcull {
 namespace {
 
@@ -45,14 +47,29 @@ std::uint64_t detail::MapsState::uncovered_by_sums(int i0, int i1, int j0, int j
         const auto sum = [&](int tx, int ty) { return std::uint64_t(covered_sums_[std::size_t(ty) * std::size_t(sums_width_) + std::size_t(tx)]); };
         covered = sum(ix1 + 1, iy1 + 1) + sum(ix0, iy0) - sum(ix0, iy1 + 1) - sum(ix1 + 1, iy0);
     }
-    for (int ty = j0 / kH; ty <= j1 / kH; ++ty)
-        for (int tx = i0 / kW; tx <= i1 / kW; ++tx) {
+    // A subtile's samples in the rectangle: its columns in the rectangle (repeated on each of its
+    // kH rows of kW bits) and its rows in it (kW bits each), as subtile_rect_bits gives them.
+    static_assert(kW == 8 && kH == 4, "one byte per subtile row");
+    const auto column_bits = [&](int tx) {
+        const int c0 = std::max(0, i0 - tx * kW), c1 = std::min(kW - 1, i1 - tx * kW);
+        return ((0xFFu >> (kW - 1 - c1)) & (0xFFu << c0)) * 0x01010101u;
+    };
+    const auto row_bits = [&](int ty) {
+        const int r0 = std::max(0, j0 - ty * kH), r1 = std::min(kH - 1, j1 - ty * kH);
+        return std::uint32_t(((std::uint64_t(1) << (8 * (r1 - r0 + 1))) - 1u) << (8 * r0));
+    };
+    const int tx0 = i0 / kW, tx1 = i1 / kW;
+    for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
+        const std::uint32_t rows = row_bits(ty);
+        const std::uint32_t* masks = state.covered_.data() + state.at(0, ty);
+        for (int tx = tx0; tx <= tx1; ++tx) {
             if (interior && ty >= iy0 && ty <= iy1 && tx >= ix0 && tx <= ix1) {  // counted above
                 tx = ix1;
                 continue;
             }
-            covered += detail::bit_count(detail::subtile_rect_bits(tx, ty, i0, i1, j0, j1) & state.covered_[state.at(tx, ty)]);
+            covered += detail::bit_count(column_bits(tx) & rows & masks[tx]);
         }
+    }
     return std::uint64_t(i1 - i0 + 1) * std::uint64_t(j1 - j0 + 1) - covered;
 }
 

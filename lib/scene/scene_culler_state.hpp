@@ -112,6 +112,7 @@ public:
     void build_maps(const Frame& frame);
     void draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
+    OccludeeAnswer node_answer(const Frame& frame, std::uint32_t node_index) const;
     OccludeeAnswer test_object(const Frame& frame, std::uint32_t id);
     // Occludee triangles in world space (transformed as ground truth transforms them) for the
     // samples test: object id -> its first vertex in occludee_positions_, or kNotGathered.

@@ -61,7 +61,7 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
             waiting_nearest_far = std::numeric_limits<float>::infinity();
         }
         if (config_.hierarchy && node.end - node.begin > 1) {
-            const OccludeeAnswer a = maps_.test_aabb(node_boxes_[node_index], frame.clip);
+            const OccludeeAnswer a = node_answer(frame, node_index);
             ++work_.nodes_tested;
             if (a.visibility != Visibility::visible) {
                 for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
@@ -88,6 +88,18 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
         }
     }
     timings_.test_ms = ms_since(start) - (timings_.render_ms + timings_.maps_ms - flushes_before);
+}
+
+// A node's box: only whether it is hidden counts (a visible node's objects are tested one by
+// one), so where the maps leave the buffer to decide (PyramidBuild::lazy) the buffer answers
+// without the uncovered share the maps would work out for a visible box.
+OccludeeAnswer detail::SceneCullerState::node_answer(const Frame& frame, std::uint32_t node_index) const {
+    const Aabb& box = node_boxes_[node_index];
+    if (maps_.pyramid_built()) return maps_.test_aabb(box, frame.clip);
+    OccludeeAnswer a;
+    a.visibility = buffer_.test_aabb(&box.min.x, &box.max.x, frame.clip);
+    a.level_of_visibility = a.visibility == Visibility::visible ? 1.0f : 0.0f;
+    return a;
 }
 
 // The object's box, then, where the box is visible and the object small enough, its triangles.

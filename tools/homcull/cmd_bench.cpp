@@ -34,7 +34,7 @@ struct BenchOptions {
     bool json = false, sample_depth = false, vs_scalar = false;
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
-    std::string occludees = "auto", closed_back_faces = "skip";
+    std::string occludees = "auto", closed_back_faces = "skip", pyramid = "lazy";
 };
 
 constexpr const char* kCastleViews = "data/views/castle.json";
@@ -56,6 +56,7 @@ void run_frame_workload(const BenchOptions& o) {
     f.cull.occludees = o.occludees;
     f.cull.clusters = o.clusters > 0 ? "on" : "off";
     f.cull.closed_back_faces = o.closed_back_faces;
+    f.cull.pyramid = o.pyramid;
     run_frame_bench(f);
 }
 
@@ -274,6 +275,8 @@ void register_bench(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--closed-back-faces", o->closed_back_faces, "frame: skip or draw the back faces of closed occluder meshes (cull --closed-back-faces)")
         ->capture_default_str()->check(CLI::IsMember({"skip", "draw"}));
+    cmd->add_option("--pyramid", o->pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")
+        ->capture_default_str()->check(CLI::IsMember({"lazy", "always"}));
     cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");
     cmd->add_flag("--vs-scalar", o->vs_scalar,
                   "Also time the scalar reference path (same threads and runs): \"scalar\" and \"speedup_vs_scalar\" (its median "
