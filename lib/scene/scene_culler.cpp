@@ -85,6 +85,8 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
         throw Error("progressive culling needs a batch of at least one triangle");
     if (config.occluder_budget.ranking == OccluderRanking::baked && !config.occluder_budget.grid)
         throw Error("baked occluder ranking needs a visibility grid");
+    if (config.occludee_parts < 0 || config.occludee_parts > 64)
+        throw Error("occludee parts must be 0 to 64 per object, got " + std::to_string(config.occludee_parts));
     temporal_pool_.reserve(occluders.size());
     ranked_.reserve(occluders.size());
     rank_scratch_.reserve(occluders.size());
@@ -119,6 +121,9 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     frame_apexes_.reserve(3 * occluders_.triangle_count());
     last_visibility_.assign(scene.objects.size(), Visibility::visible);
 
+    // Approximate mode: each part would tolerate the holes again, so no parts.
+    parts_.build(scene, config.maps.hole_pixels == 0.0 ? config.occludee_parts : 0, config.triangle_test_limit, anchor_);
+    first_visible_part_.assign(scene.objects.size(), 0);
     if (resolved_occludee_shape(config) != OccludeeShape::samples) return;
     occludee_first_vertex_.assign(scene.objects.size(), kNotGathered);
     first_visible_triangle_.assign(scene.objects.size(), 0);

@@ -4,6 +4,8 @@
 // Private to the library.
 #include <homcull/scene_culler.hpp>
 
+#include "scene/occludee_parts.hpp"
+
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -120,8 +122,13 @@ public:
     std::vector<float> occludee_positions_;
     std::vector<std::size_t> occludee_first_vertex_;
     bool triangle_rectangles_hidden(const Object& object, const glm::dmat4& clip_from_world) const;
-    // Per object, the triangle that found it visible last time: the next test starts there.
+    // Per object, the triangle that found it visible last time: the next test starts there
+    // (with parts: numbered in the parts' order, OccludeeParts::indices).
     std::vector<std::uint32_t> first_visible_triangle_;
+    OccludeeParts parts_;  // config_.occludee_parts
+    std::vector<std::uint8_t> first_visible_part_;  // per object, the part found visible last time: tested first
+    bool parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles);
+    bool part_triangles_hidden(std::uint32_t id, std::uint32_t part, const std::array<float, 16>& clip_from_world);
     bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
 };
 

@@ -110,6 +110,17 @@ OccludeeAnswer detail::SceneCullerState::test_object(const Frame& frame, std::ui
     ++exits_.count[answer.overlap_exit];
     if (answer.visibility != Visibility::visible || scene_->triangle_count(object) > config_.triangle_test_limit) return answer;
     const OccludeeShape shape = resolved_occludee_shape(config_);
+    if (parts_.count(id) > 0) {
+        // The parts answer for the object (their triangles with the samples shape); the
+        // rectangles shape still tries the whole object's triangles where a part is visible.
+        const bool samples = shape == OccludeeShape::samples && occludee_first_vertex_[id] != kNotGathered;
+        if (parts_hidden(frame, id, samples)) {
+            answer.visibility = Visibility::occluded;
+            answer.level_of_visibility = 0.0f;
+            return answer;
+        }
+        if (shape != OccludeeShape::rectangles) return answer;
+    }
     if (shape == OccludeeShape::rectangles && triangle_rectangles_hidden(object, frame.clip_double)) {
         answer.visibility = Visibility::occluded;
         answer.level_of_visibility = 0.0f;  // the holes its triangles tolerated are not estimated
@@ -159,6 +170,43 @@ bool detail::SceneCullerState::triangle_rectangles_hidden(const Object& object, 
         if (!triangle_hidden(maps_, buffer_.config().near_w, c, 3, budget)) return false;
     }
     return true;
+}
+
+// Whether every part of the object is hidden: its box, and where the box is visible and
+// `test_triangles`, its triangles sample by sample (conservative mode: no holes tolerated). The
+// part found visible last time goes first, so that a visible object ends at once.
+bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles) {
+    const std::uint32_t first = parts_.first(id), count = parts_.count(id);
+    const std::uint32_t start = first_visible_part_[id] < count ? first_visible_part_[id] : 0;
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const std::uint32_t p = (start + k) % count;
+        ++work_.occludee_parts_tested;
+        if (maps_.test_aabb(parts_.box(first + p), frame.clip).visibility != Visibility::visible) continue;
+        if (test_triangles && part_triangles_hidden(id, first + p, frame.clip)) continue;
+        first_visible_part_[id] = std::uint8_t(p);
+        return false;
+    }
+    return true;
+}
+
+// The triangles of one part of an object, sample by sample; the triangle that found the object
+// visible last time goes first when it is in this part.
+bool detail::SceneCullerState::part_triangles_hidden(std::uint32_t id, std::uint32_t part, const std::array<float, 16>& clip_from_world) {
+    const Mesh& mesh = scene_->meshes[scene_->objects[id].mesh];
+    const std::uint32_t begin = parts_.first_triangle(part), count = parts_.triangle_count(part);
+    TriangleInput in;
+    in.positions = occludee_positions_.data() + 3 * occludee_first_vertex_[id];
+    in.vertex_count = mesh.positions.size();
+    in.indices = parts_.indices(scene_->objects[id].mesh) + 3 * std::size_t(begin);
+    in.triangle_count = count;
+    in.model_to_clip = clip_from_world;
+    in.backface = Backface::none;
+    const std::uint32_t last = first_visible_triangle_[id];
+    const std::uint32_t start = last >= begin && last < begin + count ? last - begin : 0;
+    const OcclusionBuffer::TriangleTest r = buffer_.test_triangles(in, 0, start);
+    if (r.visibility != Visibility::visible) return true;
+    first_visible_triangle_[id] = begin + std::uint32_t(r.deciding_triangle);
+    return false;
 }
 
 // The object's triangles sample by sample (OcclusionBuffer::test_triangles), tolerating the

@@ -35,6 +35,7 @@ struct BenchOptions {
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
     std::string occludees = "auto", closed_back_faces = "skip", pyramid = "lazy";
+    int occludee_parts = 16;
 };
 
 constexpr const char* kCastleViews = "data/views/castle.json";
@@ -57,6 +58,7 @@ void run_frame_workload(const BenchOptions& o) {
     f.cull.clusters = o.clusters > 0 ? "on" : "off";
     f.cull.closed_back_faces = o.closed_back_faces;
     f.cull.pyramid = o.pyramid;
+    f.cull.occludee_parts = o.occludee_parts;
     run_frame_bench(f);
 }
 
@@ -275,6 +277,8 @@ void register_bench(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--closed-back-faces", o->closed_back_faces, "frame: skip or draw the back faces of closed occluder meshes (cull --closed-back-faces)")
         ->capture_default_str()->check(CLI::IsMember({"skip", "draw"}));
+    cmd->add_option("--occludee-parts", o->occludee_parts, "frame: parts per object with a box each (cull --occludee-parts)")
+        ->capture_default_str()->check(CLI::Range(0, 64));
     cmd->add_option("--pyramid", o->pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")
         ->capture_default_str()->check(CLI::IsMember({"lazy", "always"}));
     cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");

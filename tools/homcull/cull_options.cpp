@@ -52,6 +52,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "through the maps' depth test) or samples (sample by sample against the masked depth); auto: samples with "
                    "--depth masked, else rects")
         ->capture_default_str()->check(CLI::IsMember({"box", "rects", "samples", "auto"}));
+    app.add_option("--occludee-parts", o.occludee_parts,
+                   "Split each object's triangles into up to N parts with a box each: an object is hidden when every part's "
+                   "box is (or, with samples occludees, every visible part's triangles); 0 or 1: the object's box alone")
+        ->capture_default_str()->check(CLI::Range(0, 64));
     app.add_option("--sample-depth", o.sample_depth,
                    "on: with samples occludees, keep the occluders' depth per sample (precise at silhouettes); off: the "
                    "subtile layers alone (faster render)")
@@ -109,6 +113,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.maps.depth = o.depth == "hzb" ? DepthTest::hzb : o.depth == "deb" ? DepthTest::deb : o.depth == "nbz" ? DepthTest::nbz
                  : o.depth == "plane" ? DepthTest::plane : DepthTest::masked;
     c.maps.pyramid = o.pyramid == "always" ? PyramidBuild::always : PyramidBuild::lazy;
+    c.occludee_parts = o.occludee_parts;
     c.occludees = o.occludees == "box" ? OccludeeShape::box : o.occludees == "rects" ? OccludeeShape::rectangles
                 : o.occludees == "samples" ? OccludeeShape::samples : OccludeeShape::automatic;
     c.sample_depth = o.sample_depth == "on";

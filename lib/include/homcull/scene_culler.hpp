@@ -73,6 +73,14 @@ struct SceneCullerConfig {
     // keep the box's answer.
     OccludeeShape occludees = OccludeeShape::automatic;
     std::size_t triangle_test_limit = 20000;
+    // Each object's triangles split, when the culler is made, into up to this many parts by
+    // their centres, each with its box (objects with at most triangle_test_limit triangles):
+    // an object whose own box is visible is hidden when every part's box is, and the samples
+    // shape then tests only the triangles of the parts whose box is visible. Tighter than the
+    // object's box for L-shaped, hollow or sprawling objects, and far cheaper than its
+    // triangles. Conservative mode only (approximate mode would tolerate holes once per part).
+    // Below 2: the object's box alone.
+    int occludee_parts = 16;
     // With the samples shape: give the buffer a per-sample depth (BufferConfig::sample_depth),
     // the occluders' depth without the layers' loss at silhouettes. Off: the layers alone,
     // rendering faster.
@@ -119,6 +127,7 @@ struct SceneCullWork {
     std::size_t renders = 0;             // render calls (progressive: batches)
     std::size_t nodes_tested = 0;        // inner hierarchy nodes tested
     std::size_t objects_tested = 0;      // objects tested on their own (the rest answered by a node)
+    std::size_t occludee_parts_tested = 0;  // part boxes tested (SceneCullerConfig::occludee_parts)
 };
 
 // How many objects each overlap-test exit decided (indexed by OverlapExit).
