@@ -44,6 +44,7 @@ const RasterKernels& raster_kernels(const IsaChoice& choice);
 // Each SIMD translation unit's part of the table (they hold the HWY_EXPORTs).
 void resolve_rasterize_kernels(const IsaChoice& choice, RasterKernels& kernels);
 void resolve_front_end_kernels(const IsaChoice& choice, RasterKernels& kernels);
+MarginFreeKernel margin_free_kernel_for(const IsaChoice& choice);  // shared_edge_rule_simd.cpp; null for the scalar choice
 void resolve_reference_cells_kernels(const IsaChoice& choice, RasterKernels& kernels);
 void resolve_draw_order_kernels(const IsaChoice& choice, RasterKernels& kernels);
 

@@ -124,4 +124,19 @@ inline std::uint8_t margin_free_edges(const glm::dvec4 own[3], const glm::dvec4 
     return kept;
 }
 
+// margin_free_edges for up to kMarginFreeLanes triangles at once, in structure-of-arrays form:
+// lane t's own vertices (clip x, y, w), the apexes of its edges, and its flags already
+// restricted to the edges with an apex (flags & apex_valid; 0: the lane is not asked, and gets
+// 0). The SIMD kernel (shared_edge_rule_simd.cpp) does in each lane exactly the operations of
+// margin_free_edges, in its order: the same bits on every instruction set.
+constexpr int kMarginFreeLanes = 16;
+struct MarginFreeLanes {
+    alignas(64) double ox[3][kMarginFreeLanes], oy[3][kMarginFreeLanes], ow[3][kMarginFreeLanes];  // own vertex k
+    alignas(64) double ax[3][kMarginFreeLanes], ay[3][kMarginFreeLanes], aw[3][kMarginFreeLanes];  // apex across edge k
+    std::uint8_t flags[kMarginFreeLanes];
+    int count;  // lanes [0, count) are read; whole vectors past it may be too (their flags must be 0)
+};
+using MarginFreeKernel = void (*)(const MarginFreeLanes& lanes, double near_w, double edge_margin, int sample_width, int sample_height,
+                                  std::uint8_t* kept);
+
 }  // namespace homcull::detail

@@ -149,6 +149,9 @@ struct FrontEndKernels {
     std::uint32_t (*beyond_side_plane)(const TriangleBatch& batch, int count);
     // transform_batch with transform_to_clip_plain: the occludee tests' (they bound its error).
     TransformBatchKernel transform_batch_plain;
+    // margin_free_edges for a batch's lanes at once (shared_edge_rule.hpp); null for the scalar
+    // reference, which decides lane by lane.
+    MarginFreeKernel margin_free;
 };
 void transform_batch_plain_reference(const TriangleInput& in, TriangleBatch& batch);
 std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count);
@@ -221,6 +224,33 @@ inline std::uint8_t edges_across(const TriangleInput& in, const VertexClip* cach
     return margin_free_edges(own, apex, apex_valid, flags, near_w, edge_margin, sample_width, sample_height);
 }
 
+// edges_across for the drawn lanes of a batch, gathered for FrontEndKernels::margin_free: each
+// lane's own vertices and, for each flagged edge, its apex (also kept in apex, as edges_across
+// keeps it); lanes not drawn, without flags or apexes, get flags 0.
+inline void lanes_across(const TriangleInput& in, const VertexClip* cache, const TriangleBatch& batch, std::uint32_t drawn,
+                         glm::dvec4 (&apex)[TriangleBatch::kSize][3], MarginFreeLanes& lanes) {
+    static_assert(kMarginFreeLanes == TriangleBatch::kSize, "a batch's lanes at once");
+    lanes.count = batch.count;
+    for (int t = 0; t < TriangleBatch::kSize; ++t) lanes.flags[t] = 0;
+    for (std::uint32_t bits = drawn; bits != 0; bits &= bits - 1) {
+        const int t = __builtin_ctz(bits);
+        const std::uint8_t flags = in.shared_edges[batch.triangle[t]];
+        if (flags == 0) continue;
+        const std::uint32_t* apexes = in.edge_apexes + 3 * batch.triangle[t];
+        std::uint8_t valid = 0;
+        for (int k = 0; k < 3; ++k) {
+            lanes.ox[k][t] = batch.cx[k][t], lanes.oy[k][t] = batch.cy[k][t], lanes.ow[k][t] = batch.cw[k][t];
+            if (((flags >> k) & 1u) && vertex_clip(in, cache, apexes[k], apex[t][k])) {
+                valid |= std::uint8_t(1u << k);
+                lanes.ax[k][t] = apex[t][k].x, lanes.ay[k][t] = apex[t][k].y, lanes.aw[k][t] = apex[t][k].w;
+            } else {
+                lanes.ax[k][t] = 0.0, lanes.ay[k][t] = 0.0, lanes.aw[k][t] = 0.0;
+            }
+        }
+        lanes.flags[t] = flags & valid;
+    }
+}
+
 // Sets up triangles [begin, end) of the input in batches and hands every triangle of their
 // clipped fans that covers a sample's bounding box to emit(const RasterTriangle&), in input
 // order; the statistics are those of fetch_clip_triangle and setup_clip_triangle, triangle
@@ -237,6 +267,7 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
     const HiddenTestKernel hidden_test = drawn_into && drawn_into->skip_hidden ? drawn_into->hidden_test : nullptr;
     TriangleBatch batch{};  // zeroed: the last vector of a batch may read lanes past count
     BatchSetup simple;
+    MarginFreeLanes margin_lanes{};  // zeroed, as the batch
     for (std::size_t first = begin; first < end;) {
         if (cache) {
             first = gather_cached_batch(in, *cache, first, end, batch, stats);
@@ -284,7 +315,14 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
         std::uint8_t lane_shared[TriangleBatch::kSize] = {};
         glm::dvec4 lane_apexes[TriangleBatch::kSize][3];  // read where a lane keeps a flag
         std::uint32_t silhouette_only = drawn;
-        if (in.shared_edges)
+        if (in.shared_edges && kernels.margin_free) {
+            lanes_across(in, cache, batch, drawn, lane_apexes, margin_lanes);
+            kernels.margin_free(margin_lanes, near_w, edge_margin, sample_width, sample_height, lane_shared);
+            for (std::uint32_t bits = drawn; bits != 0; bits &= bits - 1) {
+                const int t = __builtin_ctz(bits);
+                if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
+            }
+        } else if (in.shared_edges) {
             for (std::uint32_t bits = drawn; bits != 0; bits &= bits - 1) {
                 const int t = __builtin_ctz(bits);
                 const std::uint8_t flags = in.shared_edges[batch.triangle[t]];
@@ -292,6 +330,7 @@ void setup_triangle_range(const TriangleInput& in, const VertexClip* cache, std:
                 lane_shared[t] = edges_across(in, cache, batch, t, flags, near_w, edge_margin, sample_width, sample_height, lane_apexes[t]);
                 if (lane_shared[t] != 0) silhouette_only &= ~(1u << t);
             }
+        }
         if (emitted) kernels.setup_edges(batch.count, edge_margin, silhouette_only & emitted, emitted, simple);
         // Every simple lane counts as rasterized (what setup_clip_triangle counts for it); the
         // loop visits those emitted and the lanes left to the one-triangle setup, in order.

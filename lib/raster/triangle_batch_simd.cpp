@@ -426,12 +426,13 @@ HWY_EXPORT(BeyondSidePlane);
 void resolve_front_end_kernels(const IsaChoice& choice, RasterKernels& k) {
     if (choice.scalar) {
         k.front_end = {&transform_vertices_reference, &transform_batch_reference, &classify_batch_reference, nullptr, nullptr, nullptr,
-                       &beyond_side_plane_reference, &transform_batch_plain_reference};
+                       &beyond_side_plane_reference, &transform_batch_plain_reference, nullptr};
         return;
     }
     k.front_end = {HOMCULL_KERNEL_FOR(choice, TransformVertices), HOMCULL_KERNEL_FOR(choice, TransformBatch), HOMCULL_KERNEL_FOR(choice, ClassifyBatch),
                    HOMCULL_KERNEL_FOR(choice, SetupPlanes),       HOMCULL_KERNEL_FOR(choice, SetupEdges),     HOMCULL_KERNEL_FOR(choice, GatherDirectBatch),
-                   HOMCULL_KERNEL_FOR(choice, BeyondSidePlane),   HOMCULL_KERNEL_FOR(choice, TransformBatchPlain)};
+                   HOMCULL_KERNEL_FOR(choice, BeyondSidePlane),   HOMCULL_KERNEL_FOR(choice, TransformBatchPlain),
+                   margin_free_kernel_for(choice)};
 }
 
 }  // namespace homcull::detail

@@ -121,7 +121,7 @@ struct SceneCullWork {
     std::size_t occluder_objects = 0;    // objects rendered into the buffer
     std::size_t occluder_triangles = 0;  // their triangles (as drawn: LODs' where used)
     // Of those, the closed meshes' triangles facing away from the eye, left out
-    // (skip_closed_back_faces; with clusters the rasterizer culls them instead, RasterStats::backface_culled).
+    // (skip_closed_back_faces; clusters keep every triangle).
     std::size_t back_faces_skipped = 0;
     std::size_t occluder_lods = 0;       // occluders drawn with their LOD
     std::size_t renders = 0;             // render calls (progressive: batches)
