@@ -5,6 +5,8 @@
 #include <homcull/error.hpp>
 #include <homcull/generate.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/occluder_selection.hpp>
+#include <homcull/scene_culler.hpp>
 #include <homcull/tbb_parallel_for.hpp>
 #include <homcull/world_triangles.hpp>
 
@@ -675,6 +677,50 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
             EXPECT_TRUE(test::same_subtiles(reference, b)) << isa << (threads ? ", TBB" : ", serial");
         }
     }
+}
+
+// The scene culler tests the objects left by its traversal in tasks of the job system (one-pass
+// and temporal, whose buffer no longer changes): the same answers, levels and counts as on one
+// thread, for boxes, parts and occludee triangles, with threads and in a shuffled task order.
+TEST(RenderThreads, SceneCullerObjectTestsInTasksAnswerAsOneThread) {
+    CityOptions city;
+    city.blocks = 5;
+    const Scene scene = generate_city(city);
+    const std::vector<std::uint32_t> occluders = occluder_candidates(scene, OccluderFilter::role);
+    std::vector<Camera> cameras;
+    for (int k = 0; k < 6; ++k) {
+        Camera c;
+        c.eye = {-60.0 + 24.0 * k, 1.7 + 3.0 * (k % 2), -50.0 + 15.0 * k};
+        c.target = {10.0 * (k % 3), 2.0, 20.0 - 8.0 * k};
+        cameras.push_back(c);
+    }
+    std::mt19937_64 order(9);
+    const ParallelFor shuffled{&test::run_shuffled, &order, 2};
+    for (const CullStrategy strategy : {CullStrategy::one_pass, CullStrategy::temporal})
+        for (const OccludeeShape shape : {OccludeeShape::box, OccludeeShape::automatic}) {
+            SceneCullerConfig config;
+            config.display = {320, 180};
+            config.strategy = strategy;
+            config.occludees = shape;
+            SceneCuller serial(scene, occluders, config), threaded(scene, occluders, config), reordered(scene, occluders, config);
+            std::vector<OccludeeAnswer> a, b, c;
+            std::size_t hidden = 0;
+            for (const Camera& camera : cameras) {
+                serial.cull(camera, a);
+                threaded.cull(camera, b, test::thread_jobs(2));
+                reordered.cull(camera, c, shuffled);
+                for (std::size_t id = 0; id < a.size(); ++id) {
+                    ASSERT_EQ(a[id].visibility, b[id].visibility) << "object " << id;
+                    ASSERT_EQ(a[id].level_of_visibility, b[id].level_of_visibility) << "object " << id;
+                    ASSERT_EQ(a[id].visibility, c[id].visibility) << "object " << id;
+                    hidden += a[id].visibility == Visibility::occluded;
+                }
+                EXPECT_EQ(serial.work().objects_tested, threaded.work().objects_tested);
+                EXPECT_EQ(serial.work().occludee_parts_tested, threaded.work().occludee_parts_tested);
+                EXPECT_EQ(serial.work().occludee_parts_tested, reordered.work().occludee_parts_tested);
+            }
+            EXPECT_GT(hidden, 0u) << "no object hidden: the views test nothing";
+        }
 }
 
 }  // namespace

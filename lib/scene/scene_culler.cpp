@@ -120,6 +120,8 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     frame_shared_.reserve(occluders_.triangle_count());
     frame_apexes_.reserve(3 * occluders_.triangle_count());
     last_visibility_.assign(scene.objects.size(), Visibility::visible);
+    objects_to_test_.reserve(scene.objects.size());
+    task_tallies_.resize(64);
 
     // Approximate mode: each part would tolerate the holes again, so no parts.
     parts_.build(scene, config.maps.hole_pixels == 0.0 ? config.occludee_parts : 0, config.triangle_test_limit, anchor_);
@@ -399,7 +401,11 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
     build_maps(frame);
     start = Clock::now();
     for (std::size_t id = 0; id < answers.size(); ++id)
-        if (answers[id].visibility == Visibility::visible) answers[id] = test_object(frame, std::uint32_t(id));
+        if (answers[id].visibility == Visibility::visible) {
+            TestTally tally;
+            answers[id] = test_object(frame, std::uint32_t(id), tally);
+            add_tally(tally);
+        }
     timings_.test_ms += ms_since(start);
 }
 

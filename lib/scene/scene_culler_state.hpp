@@ -115,7 +115,19 @@ public:
     void draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     OccludeeAnswer node_answer(const Frame& frame, std::uint32_t node_index) const;
-    OccludeeAnswer test_object(const Frame& frame, std::uint32_t id);
+    // What object tests count, per task when they run in parallel (then added to work_ and exits_).
+    struct TestTally {
+        std::size_t objects = 0, parts = 0;
+        std::uint64_t exits[7] = {};
+    };
+    void add_tally(const TestTally& tally);
+    // Thread-safe for distinct objects: it writes only their answers and caches.
+    OccludeeAnswer test_object(const Frame& frame, std::uint32_t id, TestTally& tally);
+    // one_pass and temporal: the objects traversal left to test one by one, tested after it, in
+    // tasks of the caller's job system (the buffer does not change meanwhile).
+    std::vector<std::uint32_t> objects_to_test_;
+    std::vector<TestTally> task_tallies_;
+    void test_objects_in_tasks(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     // Occludee triangles in world space (transformed as ground truth transforms them) for the
     // samples test: object id -> its first vertex in occludee_positions_, or kNotGathered.
     static constexpr std::size_t kNotGathered = ~std::size_t(0);
@@ -127,7 +139,7 @@ public:
     std::vector<std::uint32_t> first_visible_triangle_;
     OccludeeParts parts_;  // config_.occludee_parts
     std::vector<std::uint8_t> first_visible_part_;  // per object, the part found visible last time: tested first
-    bool parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles);
+    bool parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles, TestTally& tally);
     bool part_triangles_hidden(std::uint32_t id, std::uint32_t part, const std::array<float, 16>& clip_from_world);
     bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
 };

@@ -5,6 +5,7 @@
 #include "scene/scene_culler_state.hpp"
 
 #include "common/float_round.hpp"
+#include "common/run_tasks.hpp"
 #include "scene/scene_culler_frame.hpp"
 
 #include <algorithm>
@@ -48,6 +49,10 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
     float waiting_nearest_far = std::numeric_limits<float>::infinity();  // squared, of the waiting occluders
     node_heap_.clear();
     if (!hierarchy_.nodes.empty()) node_heap_.emplace_back(0.0f, 0u);
+    // Without progressive's draws the buffer is final: the objects are tested after the
+    // traversal, in tasks, when there is a job system.
+    const bool in_tasks = !progressive && parallel.run != nullptr;
+    objects_to_test_.clear();
     while (!node_heap_.empty()) {
         std::pop_heap(node_heap_.begin(), node_heap_.end(), nearest_first);
         const std::uint32_t node_index = node_heap_.back().second;
@@ -78,7 +83,13 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
         }
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
             const std::uint32_t id = hierarchy_.object_ids[i];
-            answers[id] = test_object(frame, id);
+            if (in_tasks) {
+                objects_to_test_.push_back(id);
+                continue;
+            }
+            TestTally tally;
+            answers[id] = test_object(frame, id, tally);
+            add_tally(tally);
             // progressive: a visible candidate is drawn with the next batch, within the budget.
             if (progressive && answers[id].visibility == Visibility::visible && candidate_of_[id] != kNone &&
                 work_.occluder_triangles + occluder_triangles_drawn(*scene_, id, *frame.camera, config_.lods) <= budget) {
@@ -87,7 +98,38 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
             }
         }
     }
+    if (in_tasks) test_objects_in_tasks(frame, answers, parallel);
     timings_.test_ms = ms_since(start) - (timings_.render_ms + timings_.maps_ms - flushes_before);
+}
+
+void detail::SceneCullerState::add_tally(const TestTally& tally) {
+    work_.objects_tested += tally.objects;
+    work_.occludee_parts_tested += tally.parts;
+    for (int e = 0; e < 7; ++e) exits_.count[e] += tally.exits[e];
+}
+
+// The objects in objects_to_test_, in as many tasks as task_tallies_ holds (a few per thread,
+// since objects differ widely in cost), each a contiguous run with its own tally.
+void detail::SceneCullerState::test_objects_in_tasks(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+    const std::size_t n = objects_to_test_.size();
+    const std::size_t threads = parallel.threads == 0 ? 2 : parallel.threads;
+    const std::size_t tasks = std::min({task_tallies_.size(), 8 * threads, (n + 15) / 16});
+    for (std::size_t k = 0; k < tasks; ++k) task_tallies_[k] = TestTally{};
+    struct Job {
+        SceneCullerState* self;
+        const Frame* frame;
+        std::vector<OccludeeAnswer>* answers;
+        std::size_t n, tasks;
+    } job{this, &frame, &answers, n, tasks};
+    run_tasks(parallel, tasks, [](void* data, std::size_t k) {
+        const Job& j = *static_cast<const Job*>(data);
+        TestTally& tally = j.self->task_tallies_[k];
+        for (std::size_t i = j.n * k / j.tasks; i < j.n * (k + 1) / j.tasks; ++i) {
+            const std::uint32_t id = j.self->objects_to_test_[i];
+            (*j.answers)[id] = j.self->test_object(*j.frame, id, tally);
+        }
+    }, &job);
+    for (std::size_t k = 0; k < tasks; ++k) add_tally(task_tallies_[k]);
 }
 
 // A node's box: only whether it is hidden counts (a visible node's objects are tested one by
@@ -103,18 +145,18 @@ OccludeeAnswer detail::SceneCullerState::node_answer(const Frame& frame, std::ui
 }
 
 // The object's box, then, where the box is visible and the object small enough, its triangles.
-OccludeeAnswer detail::SceneCullerState::test_object(const Frame& frame, std::uint32_t id) {
+OccludeeAnswer detail::SceneCullerState::test_object(const Frame& frame, std::uint32_t id, TestTally& tally) {
     const Object& object = scene_->objects[id];
     OccludeeAnswer answer = maps_.test_aabb(object_boxes_[id], frame.clip);
-    ++work_.objects_tested;
-    ++exits_.count[answer.overlap_exit];
+    ++tally.objects;
+    ++tally.exits[answer.overlap_exit];
     if (answer.visibility != Visibility::visible || scene_->triangle_count(object) > config_.triangle_test_limit) return answer;
     const OccludeeShape shape = resolved_occludee_shape(config_);
     if (parts_.count(id) > 0) {
         // The parts answer for the object (their triangles with the samples shape); the
         // rectangles shape still tries the whole object's triangles where a part is visible.
         const bool samples = shape == OccludeeShape::samples && occludee_first_vertex_[id] != kNotGathered;
-        if (parts_hidden(frame, id, samples)) {
+        if (parts_hidden(frame, id, samples, tally)) {
             answer.visibility = Visibility::occluded;
             answer.level_of_visibility = 0.0f;
             return answer;
@@ -175,12 +217,12 @@ bool detail::SceneCullerState::triangle_rectangles_hidden(const Object& object, 
 // Whether every part of the object is hidden: its box, and where the box is visible and
 // `test_triangles`, its triangles sample by sample (conservative mode: no holes tolerated). The
 // part found visible last time goes first, so that a visible object ends at once.
-bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles) {
+bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles, TestTally& tally) {
     const std::uint32_t first = parts_.first(id), count = parts_.count(id);
     const std::uint32_t start = first_visible_part_[id] < count ? first_visible_part_[id] : 0;
     for (std::uint32_t k = 0; k < count; ++k) {
         const std::uint32_t p = (start + k) % count;
-        ++work_.occludee_parts_tested;
+        ++tally.parts;
         if (maps_.test_aabb(parts_.box(first + p), frame.clip).visibility != Visibility::visible) continue;
         if (test_triangles && part_triangles_hidden(id, first + p, frame.clip)) continue;
         first_visible_part_[id] = std::uint8_t(p);
