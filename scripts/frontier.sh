@@ -28,6 +28,7 @@ mkdir -p "$OUT"
 # name|bench arguments: the scene culler's configurations, cheapest first.
 configs=(
   "boxes, clusters|--occludees box --clusters 124"
+  "boxes, clusters, 32 parts|--occludees box --clusters 124 --occludee-parts 32"
   "boxes|--occludees box"
   "triangles, clusters|--clusters 124"
   "triangles (default)|"

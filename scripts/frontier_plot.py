@@ -43,6 +43,9 @@ def load_homcull(out):
             doc = json.load(f)
         c = doc['config']
         label = ('boxes' if c['occludees'] == 'box' else 'triangles') + (', clusters' if c['clusters'] == 'on' else '')
+        parts = c.get('occludee_parts', 16)
+        if parts != 16:  # the default; others are named
+            label += ', ' + (f'{parts} parts' if parts > 1 else 'no parts')
         points.setdefault(label, {})[kind] = doc
     return points
 

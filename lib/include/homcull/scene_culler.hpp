@@ -155,6 +155,9 @@ public:
     const SceneCullerConfig& config() const;
     const Scene& scene() const;
     const OcclusionBuffer& buffer() const;
+    // The maps of the last cull() with their pyramids: with lazy maps (the default, see
+    // PyramidBuild) the first call after a cull makes them, for dumps. Not thread-safe with
+    // cull() or with itself.
     const OcclusionMaps& maps() const;
     const SceneCullTimings& timings() const;
     const SceneCullWork& work() const;
