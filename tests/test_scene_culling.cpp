@@ -284,17 +284,33 @@ TEST(SceneCulling, EveryStrategyOnSharedScenesHasNoFalseCulls) {
     if (found == 0) GTEST_SKIP() << "no shared scene in " << test::shared_scenes_dir();
 }
 
+// The castle, its role occluders and a walk of `frames` frames through it; false when the
+// shared scene is missing.
+struct CastleWalk {
+    Scene castle;
+    std::vector<std::uint32_t> candidates;
+    CameraPath frames;
+};
+bool load_castle_walk(int frames, CastleWalk& out) {
+    const std::string path = test::shared_scene("intel_castle.glb");
+    if (path.empty()) return false;
+    out.castle = load_scene(path);
+    out.candidates = occluder_candidates(out.castle, OccluderFilter::role);
+    const RayScene rays(out.castle);
+    WalkOptions walk;
+    walk.frames = frames;
+    out.frames = walk_path(rays, out.castle, walk);
+    return true;
+}
+
 // Occluders as clusters with a job system: the same answers and statistics as on one thread,
 // frame after frame (progressive renders several batches a frame into the same buffer).
 TEST(SceneCulling, ClustersGiveTheSameAnswersWithAJobSystem) {
-    const std::string path = test::shared_scene("intel_castle.glb");
-    if (path.empty()) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
-    const Scene castle = load_scene(path);
-    const std::vector<std::uint32_t> candidates = occluder_candidates(castle, OccluderFilter::role);
-    const RayScene rays(castle);
-    WalkOptions walk;
-    walk.frames = 12;
-    const CameraPath frames = walk_path(rays, castle, walk);
+    CastleWalk walk;
+    if (!load_castle_walk(12, walk)) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const Scene& castle = walk.castle;
+    const std::vector<std::uint32_t>& candidates = walk.candidates;
+    const CameraPath& frames = walk.frames;
     for (const CullStrategy strategy : {CullStrategy::one_pass, CullStrategy::progressive}) {
         SceneCullerConfig config;
         config.display = {480, 270};
@@ -321,14 +337,11 @@ TEST(SceneCulling, ClustersGiveTheSameAnswersWithAJobSystem) {
 // a castle walk with every strategy (progressive rebuilds the maps for each batch); the levels of
 // visibility are shares in [0, 1], 0 for what is hidden.
 TEST(SceneCulling, LazyMapsGiveTheSameVisibilityAsMapsWithTheirPyramids) {
-    const std::string path = test::shared_scene("intel_castle.glb");
-    if (path.empty()) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
-    const Scene castle = load_scene(path);
-    const std::vector<std::uint32_t> candidates = occluder_candidates(castle, OccluderFilter::role);
-    const RayScene rays(castle);
-    WalkOptions walk;
-    walk.frames = 10;
-    const CameraPath frames = walk_path(rays, castle, walk);
+    CastleWalk walk;
+    if (!load_castle_walk(10, walk)) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const Scene& castle = walk.castle;
+    const std::vector<std::uint32_t>& candidates = walk.candidates;
+    const CameraPath& frames = walk.frames;
     for (const CullStrategy strategy : {CullStrategy::one_pass, CullStrategy::progressive, CullStrategy::temporal})
         for (const OccludeeShape shape : {OccludeeShape::box, OccludeeShape::automatic}) {
             SceneCullerConfig config;
