@@ -34,6 +34,21 @@ std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::
     return add_object_with_own_mesh(scene, std::move(mesh));
 }
 
+std::uint32_t add_interlocked_pair(Scene& scene, float split) {
+    Mesh interlocked;
+    interlocked.name = "interlocked";
+    const auto quad = [&](float x0, float x1, float z) {
+        const auto base = std::uint32_t(interlocked.positions.size());
+        interlocked.positions.insert(interlocked.positions.end(), {{x0, -50, z}, {x1, -50, z}, {x1, 50, z}, {x0, 50, z}});
+        interlocked.indices.insert(interlocked.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    };
+    quad(-50.0f, split, -2.0f);
+    quad(split, 50.0f, -6.0f);
+    const std::uint32_t first = add_object_with_own_mesh(scene, interlocked);
+    add_quad(scene, "between", {-50, -50, -4}, {50, -50, -4}, {50, 50, -4}, {-50, 50, -4});
+    return first;
+}
+
 std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::vec3 hi) {
     Mesh mesh;
     mesh.name = name;

@@ -27,6 +27,11 @@ std::uint32_t add_object_with_own_mesh(Scene& scene, Mesh mesh);
 std::uint32_t add_quad(Scene& scene, const std::string& name, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d);
 // Appends an axis-aligned box object (12 triangles, CCW outward).
 std::uint32_t add_box(Scene& scene, const std::string& name, glm::vec3 lo, glm::vec3 hi);
+// Two interlocked objects, across the view of camera_down_minus_z: object `first` is a near quad
+// (z = -2) left of x = split and a far one (z = -6) right of it, the next object one quad between
+// them (z = -4): rays on the left meet the first then the second, on the right the second then
+// the first. Returns the first's id.
+std::uint32_t add_interlocked_pair(Scene& scene, float split = 0.0f);
 // A camera at the origin looking down -z with the given vertical field of view.
 Camera camera_down_minus_z(double fov_y_degrees = 90.0, double near_plane = 0.1, double far_plane = 1000.0);
 

@@ -58,16 +58,7 @@ TEST(SortTruth, StackedQuadsGiveTheEdgesBetweenNeighboursAlongTheRays) {
 // only one layer holding both sorts them, and that grouping is needed.
 TEST(SortTruth, InterlockedObjectsGiveATrueCycle) {
     Scene scene;
-    Mesh interlocked;
-    const auto quad = [&](float x0, float x1, float z) {
-        const auto base = std::uint32_t(interlocked.positions.size());
-        interlocked.positions.insert(interlocked.positions.end(), {{x0, -50, z}, {x1, -50, z}, {x1, 50, z}, {x0, 50, z}});
-        interlocked.indices.insert(interlocked.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    };
-    quad(-50.0f, 0.0f, -2.0f);
-    quad(0.0f, 50.0f, -6.0f);
-    test::add_object_with_own_mesh(scene, interlocked);
-    test::add_quad(scene, "between", {-50, -50, -4}, {50, -50, -4}, {50, 50, -4}, {-50, 50, -4});
+    test::add_interlocked_pair(scene);
     const RayScene rays(scene);
     const SortTruth truth = occlusion_edges(rays, scene.objects.size(), test::camera_down_minus_z(), {40, 20});
     EXPECT_TRUE(has_edge(truth, 0, 1));
