@@ -5,8 +5,11 @@
 #include <homcull/error.hpp>
 #include <homcull/generate.hpp>
 #include <homcull/io/scene_io.hpp>
+#include <homcull/world_triangles.hpp>
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 namespace homcull {
 namespace {
@@ -75,6 +78,57 @@ TEST(Generate, ForestTreesAreDisjointSmallOccluders) {
         for (std::size_t j = i + 1; j < trees.size(); ++j) EXPECT_FALSE(overlap_xz(trees[i], trees[j])) << i << " " << j;
     }
     expect_same_scene(forest, generate_forest(options));
+}
+
+// Toothpicks: 328 polygons (574 triangles) each, closed and wound outward; deterministic; inside
+// their cube at every frame; moving and tumbling from frame to frame; the cube twice as wide
+// for 1,600 as for 200 with uniform density.
+TEST(Generate, ToothpicksTumbleInsideTheirCube) {
+    expect_same_scene(generate_scene("toothpicks:seed=3,count=50,frame=7"), generate_scene("toothpicks:seed=3,count=50,frame=7"));
+    ToothpickOptions o;
+    o.count = 200;
+    const Scene first = generate_toothpicks(o, 0), later = generate_toothpicks(o, 40);
+    ASSERT_EQ(first.objects.size(), 200u);
+    ASSERT_EQ(first.meshes.size(), 1u);
+    const Mesh& mesh = first.meshes[0];
+    EXPECT_EQ(mesh.triangle_count(), 574u);
+    // Closed, with a positive volume (the divergence theorem over its triangles).
+    double volume = 0.0;
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const glm::dvec3 a(mesh.positions[mesh.indices[3 * t]]), b(mesh.positions[mesh.indices[3 * t + 1]]),
+            c(mesh.positions[mesh.indices[3 * t + 2]]);
+        volume += glm::dot(a, glm::cross(b, c)) / 6.0;
+    }
+    EXPECT_NEAR(volume, 4.0, 0.2);  // the unit sphere holds 4.19; 8 stacks of facets cut off a little
+    std::vector<std::uint8_t> shared(mesh.triangle_count());
+    std::vector<std::uint32_t> apexes(mesh.indices.size());
+    compute_shared_edges(&mesh.positions[0].x, sizeof(glm::vec3), mesh.positions.size(), mesh.indices.data(), mesh.triangle_count(),
+                         shared.data(), apexes.data());
+    EXPECT_TRUE(std::all_of(shared.begin(), shared.end(), [](std::uint8_t s) { return s == 7; }));
+    for (int frame : {0, 13, 250, 999}) {
+        const Scene s = generate_toothpicks(o, frame);
+        for (const Object& t : s.objects)
+            for (int k = 0; k < 3; ++k) {
+                ASSERT_GE(t.world_bounds.min[k], -0.5f * float(o.cube) - 1e-4f) << "frame " << frame;
+                ASSERT_LE(t.world_bounds.max[k], 0.5f * float(o.cube) + 1e-4f) << "frame " << frame;
+            }
+    }
+    int moved = 0;
+    for (std::size_t i = 0; i < first.objects.size(); ++i) moved += first.objects[i].world != later.objects[i].world;
+    EXPECT_EQ(moved, 200);
+    // Uniform density: 1,600 fill a cube twice as wide.
+    ToothpickOptions dense = o;
+    dense.count = 1600;
+    dense.uniform_density = true;
+    const Scene many = generate_toothpicks(dense, 0);
+    Aabb all;
+    for (const Object& t : many.objects) all.extend(t.world_bounds);
+    EXPECT_GT(all.max.x - all.min.x, 1.8f * float(o.cube));
+    EXPECT_LT(all.max.x - all.min.x, 2.0f * float(o.cube) + 1e-3f);
+    EXPECT_THROW(generate_scene("toothpicks:count=0"), Error);
+    EXPECT_THROW(generate_scene("toothpicks:density=sparse"), Error);
+    EXPECT_THROW(generate_scene("toothpicks:length=20"), Error);
+    EXPECT_THROW(generate_toothpicks(o, -1), Error);
 }
 
 TEST(Generate, SpecsAreParsedAndCheckedWithClearMessages) {

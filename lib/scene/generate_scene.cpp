@@ -85,8 +85,29 @@ Scene generate_scene(std::string_view spec) {
             throw Error("generated scene '" + std::string(spec) + "': unknown option '" + options.begin()->first +
                         "' (forest takes seed, radius, spacing, rocks)");
         scene = generate_forest(o);
+    } else if (name == "toothpicks") {
+        ToothpickOptions o;
+        int frame = 0;
+        if (auto v = take("seed")) o.seed = to_seed(*v, spec);
+        if (auto v = take("count")) o.count = to_int("count", *v, spec);
+        if (auto v = take("frame")) frame = to_int("frame", *v, spec);
+        if (auto v = take("cube")) o.cube = to_number("cube", *v, spec);
+        if (auto v = take("length")) o.length = to_number("length", *v, spec);
+        if (auto v = take("thickness")) o.thickness = to_number("thickness", *v, spec);
+        if (auto v = take("speed")) o.speed = to_number("speed", *v, spec);
+        if (auto v = take("tumble")) o.tumble = to_number("tumble", *v, spec);
+        if (auto v = take("density")) {
+            if (*v != "uniform" && *v != "scale")
+                throw Error("generated scene '" + std::string(spec) + "': density must be uniform or scale, got '" + *v + "'");
+            o.uniform_density = *v == "uniform";
+        }
+        for (const char* k : {"seed", "count", "frame", "cube", "length", "thickness", "speed", "tumble", "density"}) options.erase(k);
+        if (!options.empty())
+            throw Error("generated scene '" + std::string(spec) + "': unknown option '" + options.begin()->first +
+                        "' (toothpicks takes seed, count, density, frame, cube, length, thickness, speed, tumble)");
+        scene = generate_toothpicks(o, frame);
     } else {
-        throw Error("unknown generated scene '" + name + "' (known: city, forest)");
+        throw Error("unknown generated scene '" + name + "' (known: city, forest, toothpicks)");
     }
     scene.source = "gen:" + std::string(spec);
     return scene;

@@ -32,8 +32,34 @@ struct ForestOptions {
 };
 Scene generate_forest(const ForestOptions& options);
 
-// "city", "forest", or either with options: "city:seed=3,blocks=10",
-// "forest:seed=2,radius=80,spacing=5,rocks=100". Throws homcull::Error on an unknown name or
+// Snyder and Lengyel's "toothpicks" (Visibility Sorting and Compositing for Image-Based
+// Rendering, 1997), the test of visibility sorting: eccentric ellipsoids of 328 polygons each
+// (41 slices by 8 stacks: 574 triangles), tumbling and moving through each other inside a
+// cube, frame after frame. Each toothpick keeps a random start (position, orientation), a
+// velocity that reflects off the cube's walls, and a tumble (a fixed rotation per frame about
+// a random axis), all from the seed. Uniform scale keeps the cube's side at `cube` whatever the
+// count; uniform density grows it as the cube root of count / 200, so that 1,600 toothpicks
+// fill a cube twice as wide as 200 do (the paper's two runs). Role "occludee", centred on the
+// origin, metres. No trigonometry: the mesh and the rotations come from rational
+// parametrizations and quaternion products, the same bits with every compiler.
+struct ToothpickOptions {
+    std::uint64_t seed = 1;
+    int count = 200;
+    bool uniform_density = false;
+    double cube = 10.0;          // side of the cube (uniform density: at 200 toothpicks)
+    double length = 2.0;         // the long axis of each ellipsoid
+    double thickness = 0.25;     // its two short axes
+    double speed = 0.04;         // distance moved per frame, times the cube's side
+    double tumble = 0.05;        // rotation per frame, in radians (approximately)
+};
+Scene generate_toothpicks(const ToothpickOptions& options, int frame = 0);
+// Toothpick `index`'s model-to-world transform at `frame` (what generate_toothpicks places
+// it with), for moving an already generated scene along frames.
+glm::dmat4 toothpick_transform(const ToothpickOptions& options, int index, int frame);
+
+// "city", "forest", "toothpicks", or one with options: "city:seed=3,blocks=10",
+// "forest:seed=2,radius=80,spacing=5,rocks=100", "toothpicks:seed=1,count=1600,density=uniform,frame=10"
+// (density: uniform or scale, the default). Throws homcull::Error on an unknown name or
 // option, or an out-of-range value.
 Scene generate_scene(std::string_view spec);
 
