@@ -114,7 +114,7 @@ public:
     void build_maps(const Frame& frame);
     void draw_newly_visible(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
-    OccludeeAnswer node_answer(const Frame& frame, std::uint32_t node_index) const;
+    OccludeeAnswer box_answer(const Frame& frame, const Aabb& box) const;
     // What object tests count, per task when they run in parallel (then added to work_ and exits_).
     struct TestTally {
         std::size_t objects = 0, parts = 0;

@@ -66,7 +66,7 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
             waiting_nearest_far = std::numeric_limits<float>::infinity();
         }
         if (config_.hierarchy && node.end - node.begin > 1) {
-            const OccludeeAnswer a = node_answer(frame, node_index);
+            const OccludeeAnswer a = box_answer(frame, node_boxes_[node_index]);
             ++work_.nodes_tested;
             if (a.visibility != Visibility::visible) {
                 for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
@@ -132,11 +132,11 @@ void detail::SceneCullerState::test_objects_in_tasks(const Frame& frame, std::ve
     for (std::size_t k = 0; k < tasks; ++k) add_tally(task_tallies_[k]);
 }
 
-// A node's box: only whether it is hidden counts (a visible node's objects are tested one by
-// one), so where the maps leave the buffer to decide (PyramidBuild::lazy) the buffer answers
-// without the uncovered share the maps would work out for a visible box.
-OccludeeAnswer detail::SceneCullerState::node_answer(const Frame& frame, std::uint32_t node_index) const {
-    const Aabb& box = node_boxes_[node_index];
+// A box whose answer only counts as hidden or not (a hierarchy node's, whose visible objects are
+// tested one by one, or an object part's): where the maps leave the buffer to decide
+// (PyramidBuild::lazy) the buffer answers, without the uncovered share the maps would work out
+// for a visible box.
+OccludeeAnswer detail::SceneCullerState::box_answer(const Frame& frame, const Aabb& box) const {
     if (maps_.pyramid_built()) return maps_.test_aabb(box, frame.clip);
     OccludeeAnswer a;
     a.visibility = buffer_.test_aabb(&box.min.x, &box.max.x, frame.clip);
@@ -223,7 +223,7 @@ bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id
     for (std::uint32_t k = 0; k < count; ++k) {
         const std::uint32_t p = (start + k) % count;
         ++tally.parts;
-        if (maps_.test_aabb(parts_.box(first + p), frame.clip).visibility != Visibility::visible) continue;
+        if (box_answer(frame, parts_.box(first + p)).visibility != Visibility::visible) continue;
         if (test_triangles && part_triangles_hidden(id, first + p, frame.clip)) continue;
         first_visible_part_[id] = std::uint8_t(p);
         return false;
