@@ -33,7 +33,7 @@ echo "== frame 60 in detail"
   | head -16
 
 echo
-echo "== occlusion culling along the walk: hierarchical occlusion maps' answers for every object"
+echo "== occlusion culling along the walk: the scene culler's answers for every object"
 echo "   against the exact visibility above (1280x720 display, 320x180 buffer with 4x4 samples)"
 "$homcull" accuracy --scene "$out/city.glb" --path "$out/city_walk.json" --resolution 1280x720 --samples 4 2>/dev/null
 "$homcull" accuracy --scene "$out/city.glb" --path "$out/city_walk.json" --resolution 1280x720 --samples 4 --json \
