@@ -18,10 +18,11 @@ USES = {
     "buffer": {"common", "raster"},
     "hom": {"common", "raster", "buffer"},
     "capi": {"common", "raster", "buffer"},
-    "scene": {"common", "raster", "buffer", "hom"},
+    "sort": {"common"},
+    "scene": {"common", "raster", "buffer", "hom", "sort"},
     "tbb": {"common"},
-    "truth": {"common", "raster", "buffer", "hom", "scene"},
-    "io": {"common", "raster", "buffer", "hom", "scene", "truth"},
+    "truth": {"common", "raster", "buffer", "hom", "sort", "scene"},
+    "io": {"common", "raster", "buffer", "hom", "sort", "scene", "truth"},
 }
 # The layers whose private headers a layer may include besides its own: common's helpers are
 # everyone's; the buffer is built on the rasterizer's internals, and the occlusion maps and the
@@ -38,8 +39,9 @@ PUBLIC = {
     "buffer": ["occlusion_buffer.hpp", "occluder_clusters.hpp"],
     "hom": ["occlusion_maps.hpp"],
     "capi": ["homcull.h", "homcull.hpp"],
+    "sort": ["visibility_sort.hpp"],
     "scene": ["scene.hpp", "generate.hpp", "object_hierarchy.hpp", "occluder_lod.hpp", "occluder_selection.hpp",
-              "scene_culler.hpp", "soup_subdivision.hpp", "visibility_grid.hpp", "world_triangles.hpp"],
+              "scene_culler.hpp", "scene_sort.hpp", "soup_subdivision.hpp", "visibility_grid.hpp", "world_triangles.hpp"],
     "tbb": ["tbb_parallel_for.hpp"],
 }
 PUBLIC_LAYER = {header: layer for layer, headers in PUBLIC.items() for header in headers}

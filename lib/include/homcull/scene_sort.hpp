@@ -1,0 +1,20 @@
+#pragma once
+// A scene's objects as a visibility sort sees them (visibility_sort.hpp): one convex hull per
+// mesh, made at load time, and each object's transform per frame relative to an origin.
+#include <homcull/scene.hpp>
+#include <homcull/visibility_sort.hpp>
+
+#include <vector>
+
+namespace homcull {
+
+// A sorter over the scene's objects: each mesh's hull (of the vertices its triangles use; a
+// mesh with none gets its one vertex at the model origin, a point never in front of anything
+// but the eye), object i's shape being its mesh. Throws homcull::Error on a non-finite vertex.
+VisibilitySorter make_visibility_sorter(const Scene& scene);
+
+// Object i's model-to-world transform relative to `origin` (translate(-origin) * world, in
+// double, then rounded to float), into `out` (resized to the object count).
+void sort_transforms(const Scene& scene, const glm::dvec3& origin, std::vector<glm::mat4>& out);
+
+}  // namespace homcull

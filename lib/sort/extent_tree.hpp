@@ -1,0 +1,46 @@
+#pragma once
+// The pruning of pairs: a kd-tree over the objects' angular and spatial extents about the eye
+// (Snyder and Lengyel, section 4: pairs whose extents are apart cannot occlude each other).
+//
+// An object's angular extent is the range, along each of the three fixed world axes, of the
+// unit directions from the eye to its bounding sphere: a box in direction space holding the
+// sphere's cone. Two objects can overlap on screen only if those boxes overlap. Its spatial
+// extent is its range of distances from the eye: A can hide part of B only if A's nearest
+// point is nearer than B's farthest. The tree is rebuilt every frame, without allocation once
+// it has held its largest frame: median splits on the widest axis of the boxes' centres.
+#include <cstdint>
+#include <vector>
+
+namespace homcull::sort_detail {
+
+struct Extent {
+    float lo[3], hi[3];  // the direction box: components of the unit directions to the object
+    float nearest = 0;   // distance from the eye to the bounding sphere (0 when it holds the eye)
+};
+
+class ExtentTree {
+public:
+    // A tree over extents[ids[k]] (ids: the objects to hold; extents indexed by object).
+    void build(const std::vector<Extent>& extents, const std::vector<std::uint32_t>& ids);
+    // Appends to `out` every object held whose direction box overlaps `box` and whose nearest
+    // distance is below `farthest`.
+    void query(const Extent& box, float farthest, std::vector<std::uint32_t>& out) const;
+
+private:
+    struct Node {
+        Extent bounds;           // the union of its objects' boxes, nearest: their least
+        std::uint32_t first = 0; // leaf: objects_[first, first + count); inner: first = right child
+        std::uint32_t count = 0; // 0 for an inner node (its left child follows it)
+    };
+    const std::vector<Extent>* extents_ = nullptr;
+    std::vector<Node> nodes_;
+    std::vector<std::uint32_t> objects_;
+    std::vector<float> keys_;  // build scratch: the split axis' centres
+    struct Range {
+        std::uint32_t node, first, count;
+    };
+    std::vector<Range> work_;           // build scratch
+    mutable std::vector<std::uint32_t> stack_;  // query scratch
+};
+
+}  // namespace homcull::sort_detail

@@ -1,0 +1,369 @@
+// The incremental visibility sort (Snyder and Lengyel's IVS) as Tarjan's strongly connected
+// components over the "is hidden by" relation, found lazily.
+//
+// Tarjan's algorithm (Tarjan, "Depth-first search and linear graph algorithms", SIAM J.
+// Computing, 1972) emits a component only after every component it reaches. Following edges
+// from an object to the objects that may hide it, it therefore emits the occluders' layers
+// before the layer they hide: front to back, with each cycle as one layer. Two things keep
+// the tests few:
+// - an object already emitted is never tested again: its layer is in front of whatever is
+//   being visited, whether or not it hides it (Tarjan ignores edges to finished components);
+// - the roots are visited in the last frame's order. Where that order still holds, each
+//   object finds none of its occluders unvisited, and the order comes out unchanged, after
+//   one test per pair that the extents cannot settle and the order does not already cover.
+// The components do not depend on the order of the visit, so a sort from scratch (nearest
+// first) gives the same layers; the order within what the occlusions leave free may differ.
+#include <homcull/error.hpp>
+#include <homcull/visibility_sort.hpp>
+
+#include "extent_tree.hpp"
+#include "hull_occlusion.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+namespace homcull {
+
+using sort_detail::Extent;
+using sort_detail::ExtentTree;
+using sort_detail::PlacedHull;
+
+namespace {
+
+constexpr std::size_t kMaxPlanes = 16;
+
+double now_ms() {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// An object as this frame sees it: its bounding sphere about the eye.
+struct Placed {
+    glm::vec3 centre{0.0f};
+    float radius = 0;
+    glm::vec3 direction{0.0f};  // unit, from the eye to the centre
+    float sine = 1, cosine = 0;  // of the sphere's half-angle seen from the eye
+    float farthest = 0;         // distance from the eye to the sphere's far side
+    bool surrounds_eye = false;
+    bool active = false;
+};
+
+enum Visit : std::uint8_t { kUnvisited = 0, kOnStack = 1, kDone = 2 };
+
+}  // namespace
+
+struct VisibilitySorter::State {
+    // Shapes: hull points as structure of arrays, and each shape's bounding sphere.
+    std::vector<float> x, y, z;
+    std::vector<std::uint32_t> shape_first, shape_count;
+    std::vector<glm::vec3> shape_centre;
+    std::vector<float> shape_radius;
+    std::vector<std::uint32_t> object_shape;
+
+    // This frame.
+    std::vector<Placed> placed;
+    std::vector<Extent> extents;
+    std::vector<std::uint32_t> in_tree, surrounding, roots;
+    ExtentTree tree;
+    const glm::mat4* transforms = nullptr;
+    glm::dvec3 eye{0.0};
+    double margin_scale = 0;
+
+    // Tarjan's state and stacks.
+    std::vector<std::uint32_t> index, low;
+    std::uint32_t next_index = 0;
+    std::vector<std::uint8_t> visit;
+    std::vector<std::uint32_t> component_stack;
+    struct Frame {
+        std::uint32_t object;
+        std::uint32_t begin, next, end;  // its candidates: [begin, end) of `candidates`
+    };
+    std::vector<Frame> frames;
+    std::vector<std::uint32_t> candidates;
+
+    std::vector<std::uint32_t> last_order;
+    bool has_last_order = false;
+    VisibilitySort result;
+
+    PlacedHull hull(std::uint32_t object) const {
+        const std::uint32_t s = object_shape[object];
+        PlacedHull h;
+        h.x = x.data() + shape_first[s];
+        h.y = y.data() + shape_first[s];
+        h.z = z.data() + shape_first[s];
+        h.count = shape_count[s];
+        h.transform = transforms[object];
+        return h;
+    }
+
+    void place(const SortFrame& frame);
+    void collect_candidates(std::uint32_t object);
+    bool may_hide(std::uint32_t front, std::uint32_t back);
+    void visit_from(std::uint32_t root);
+    void emit_component(std::uint32_t root);
+};
+
+namespace {
+
+// The largest factor by which the transform's linear part stretches a length: the square root
+// of a bound on the largest eigenvalue of M^T M (Gershgorin's, exact for rotations with a
+// uniform scale).
+float stretch_bound(const glm::mat4& m) {
+    const glm::mat3 a(m);
+    const glm::mat3 g = glm::transpose(a) * a;
+    float bound = 0;
+    for (int r = 0; r < 3; ++r) bound = std::max(bound, std::abs(g[0][r]) + std::abs(g[1][r]) + std::abs(g[2][r]));
+    return std::sqrt(bound);
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+}  // namespace
+
+void VisibilitySorter::State::place(const SortFrame& frame) {
+    const std::size_t n = object_shape.size();
+    const glm::vec3 e(frame.eye);
+    in_tree.clear();
+    surrounding.clear();
+    double scale = glm::length(glm::dvec3(e));
+    for (std::uint32_t i = 0; i < n; ++i) {
+        Placed& p = placed[i];
+        p.active = false;
+        const glm::mat4& m = frame.transforms[i];
+        const std::uint32_t s = object_shape[i];
+        p.centre = glm::vec3(m * glm::vec4(shape_centre[s], 1.0f));
+        // Grown by a part in 10^6 (and of the centre's distance from the origin): the float
+        // roundings of the centre and of every transformed point.
+        p.radius = shape_radius[s] * stretch_bound(m) * (1.0f + 1e-6f) + 1e-6f * glm::length(p.centre);
+        if (!finite(p.centre) || !std::isfinite(p.radius)) continue;
+        bool outside = false;
+        for (std::size_t k = 0; k < frame.plane_count && !outside; ++k) {
+            const glm::vec4& plane = frame.planes[k];
+            outside = glm::dot(glm::vec3(plane), p.centre) + plane.w < -p.radius * glm::length(glm::vec3(plane));
+        }
+        if (outside) continue;
+        p.active = true;
+        scale = std::max(scale, double(glm::length(p.centre) + p.radius));
+        const glm::vec3 offset = p.centre - e;
+        const float distance = glm::length(offset);
+        p.farthest = distance + p.radius;
+        Extent& box = extents[i];
+        p.surrounds_eye = !(distance > p.radius);
+        if (p.surrounds_eye) {
+            for (int k = 0; k < 3; ++k) box.lo[k] = -1.0f, box.hi[k] = 1.0f;
+            box.nearest = 0.0f;
+            p.sine = 1.0f, p.cosine = 0.0f;
+            surrounding.push_back(i);
+            continue;
+        }
+        p.direction = offset / distance;
+        p.sine = p.radius / distance;
+        p.cosine = std::sqrt(std::max(0.0f, 1.0f - p.sine * p.sine));
+        box.nearest = distance - p.radius;
+        // The range of each direction component over the sphere's cone: cos(angle to the axis
+        // -+ the half-angle), reaching +-1 when the cone holds the axis. Widened by 1e-6
+        // against rounding.
+        for (int k = 0; k < 3; ++k) {
+            const float c = p.direction[k];
+            const float across = std::sqrt(std::max(0.0f, 1.0f - c * c)) * p.sine;
+            box.lo[k] = c <= -p.cosine ? -1.0f : c * p.cosine - across - 1e-6f;
+            box.hi[k] = c >= p.cosine ? 1.0f : c * p.cosine + across + 1e-6f;
+        }
+        in_tree.push_back(i);
+    }
+    margin_scale = scale;
+}
+
+void VisibilitySorter::State::collect_candidates(std::uint32_t object) {
+    const Placed& p = placed[object];
+    tree.query(extents[object], p.farthest, candidates);
+    for (std::uint32_t w : surrounding) candidates.push_back(w);
+}
+
+// Whether `front` may hide part of `back`: the cheap tests on spheres, then the hulls.
+bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) {
+    const Placed& f = placed[front];
+    const Placed& b = placed[back];
+    if (!f.surrounds_eye && !b.surrounds_eye) {
+        // The cones about the eye must overlap: angle between axes <= the half-angles' sum.
+        const float cos_sum = f.cosine * b.cosine - f.sine * b.sine;
+        if (glm::dot(f.direction, b.direction) < cos_sum - 1e-6f) return false;
+    }
+    ++result.stats.hull_tests;
+    // A part in 10^6 of the scene's reach from the origin: the float roundings of the points
+    // here and of the ground truth's (which places vertices in double, then rounds).
+    const double margin = 1e-6 * margin_scale;
+    return sort_detail::may_occlude(hull(front), hull(back), eye, margin, glm::dvec3(f.centre) - glm::dvec3(b.centre));
+}
+
+void VisibilitySorter::State::emit_component(std::uint32_t root) {
+    const std::uint32_t first = std::uint32_t(result.order.size());
+    std::uint32_t w;
+    do {
+        w = component_stack.back();
+        component_stack.pop_back();
+        visit[w] = kDone;
+        result.order.push_back(w);
+    } while (w != root);
+    const std::uint32_t count = std::uint32_t(result.order.size()) - first;
+    std::sort(result.order.begin() + first, result.order.end());
+    result.layers.push_back({first, count});
+}
+
+// Tarjan's algorithm from one root, without recursion: each frame walks the candidates
+// collected when its object was first visited.
+void VisibilitySorter::State::visit_from(std::uint32_t root) {
+    auto enter = [&](std::uint32_t v) {
+        index[v] = low[v] = next_index++;
+        visit[v] = kOnStack;
+        component_stack.push_back(v);
+        const std::uint32_t begin = std::uint32_t(candidates.size());
+        collect_candidates(v);
+        result.stats.candidates += candidates.size() - begin;
+        frames.push_back({v, begin, begin, std::uint32_t(candidates.size())});
+    };
+    enter(root);
+    while (!frames.empty()) {
+        Frame& f = frames.back();
+        const std::uint32_t v = f.object;
+        if (f.next < f.end) {
+            const std::uint32_t w = candidates[f.next++];
+            if (w == v || visit[w] == kDone) continue;
+            if (!may_hide(w, v)) continue;
+            result.pairs.push_back({w, v});
+            if (visit[w] == kUnvisited) {
+                enter(w);  // f is not used after this
+            } else {
+                low[v] = std::min(low[v], index[w]);
+            }
+            continue;
+        }
+        // Every candidate seen (the children's were appended after v's and are gone): v roots
+        // a component when nothing still on the stack below it is reachable from it.
+        candidates.resize(f.begin);
+        frames.pop_back();
+        if (low[v] == index[v]) emit_component(v);
+        if (!frames.empty()) {
+            const std::uint32_t parent = frames.back().object;
+            low[parent] = std::min(low[parent], low[v]);
+        }
+    }
+}
+
+const VisibilitySort& VisibilitySorter::sort(const SortFrame& frame) {
+    State& s = *state_;
+    if (frame.transforms == nullptr && !s.object_shape.empty()) throw Error("VisibilitySorter::sort: null transforms");
+    if (frame.plane_count > kMaxPlanes)
+        throw Error("VisibilitySorter::sort: " + std::to_string(frame.plane_count) + " planes, at most " +
+                    std::to_string(kMaxPlanes));
+    if (frame.plane_count > 0 && frame.planes == nullptr) throw Error("VisibilitySorter::sort: null planes");
+    const double start = now_ms();
+    VisibilitySort& r = s.result;
+    r.order.clear();
+    r.layers.clear();
+    r.pairs.clear();
+    r.stats = VisibilitySortStats{};
+    s.transforms = frame.transforms;
+    s.eye = glm::dvec3(frame.eye);
+
+    s.place(frame);
+    const std::size_t n = s.object_shape.size();
+    if (!finite(frame.eye)) {
+        for (Placed& p : s.placed) p.active = false;
+        s.in_tree.clear(), s.surrounding.clear();
+    }
+    const double placed_at = now_ms();
+    s.tree.build(s.extents, s.in_tree);
+    const double tree_at = now_ms();
+
+    // The roots: the last order's objects that are still here, then the others nearest first.
+    s.roots.clear();
+    for (std::uint32_t i = 0; i < n; ++i) s.visit[i] = kUnvisited;
+    if (frame.incremental && s.has_last_order) {
+        for (std::uint32_t i : s.last_order)
+            if (i < n && s.placed[i].active && s.visit[i] == kUnvisited) s.roots.push_back(i), s.visit[i] = kDone;
+    }
+    const std::size_t kept = s.roots.size();
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (s.placed[i].active && s.visit[i] == kUnvisited) s.roots.push_back(i);
+    std::sort(s.roots.begin() + kept, s.roots.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const float na = s.extents[a].nearest, nb = s.extents[b].nearest;
+        return na < nb || (na == nb && a < b);
+    });
+    for (std::uint32_t i : s.roots) s.visit[i] = kUnvisited;
+
+    s.next_index = 0;
+    for (std::uint32_t root : s.roots)
+        if (s.visit[root] == kUnvisited) s.visit_from(root);
+
+    r.stats.kept_last_order = s.has_last_order && frame.incremental && r.order == s.last_order;
+    s.last_order.assign(r.order.begin(), r.order.end());
+    s.has_last_order = true;
+
+    r.stats.sorted = std::uint32_t(r.order.size());
+    r.stats.left_out = std::uint32_t(n - r.order.size());
+    r.stats.layers = std::uint32_t(r.layers.size());
+    for (const SortLayer& layer : r.layers) {
+        if (layer.count < 2) continue;
+        ++r.stats.cycles;
+        r.stats.objects_in_cycles += layer.count;
+        r.stats.largest_cycle = std::max(r.stats.largest_cycle, layer.count);
+    }
+    r.stats.occlusions = r.pairs.size();
+    const double end = now_ms();
+    r.stats.extents_ms = placed_at - start;
+    r.stats.tree_ms = tree_at - placed_at;
+    r.stats.order_ms = end - tree_at;
+    r.stats.total_ms = end - start;
+    return r;
+}
+
+VisibilitySorter::VisibilitySorter(std::vector<std::vector<glm::vec3>> hull_points, std::vector<std::uint32_t> object_shapes)
+    : state_(std::make_unique<State>()) {
+    State& s = *state_;
+    for (std::size_t k = 0; k < hull_points.size(); ++k) {
+        const auto& points = hull_points[k];
+        if (points.empty()) throw Error("VisibilitySorter: shape " + std::to_string(k) + " has no points");
+        glm::vec3 lo(points[0]), hi(points[0]);
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            if (!finite(points[i]))
+                throw Error("VisibilitySorter: shape " + std::to_string(k) + ", point " + std::to_string(i) + " is not finite");
+            lo = glm::min(lo, points[i]), hi = glm::max(hi, points[i]);
+        }
+        const glm::vec3 centre = 0.5f * (lo + hi);
+        float radius = 0;
+        s.shape_first.push_back(std::uint32_t(s.x.size()));
+        s.shape_count.push_back(std::uint32_t(points.size()));
+        for (const glm::vec3& p : points) {
+            radius = std::max(radius, glm::length(p - centre));
+            s.x.push_back(p.x), s.y.push_back(p.y), s.z.push_back(p.z);
+        }
+        s.shape_centre.push_back(centre);
+        s.shape_radius.push_back(radius * (1.0f + 1e-6f));
+    }
+    for (std::size_t i = 0; i < object_shapes.size(); ++i) {
+        if (object_shapes[i] >= hull_points.size())
+            throw Error("VisibilitySorter: object " + std::to_string(i) + " names shape " + std::to_string(object_shapes[i]) +
+                        ", but there are " + std::to_string(hull_points.size()));
+    }
+    s.object_shape = std::move(object_shapes);
+    const std::size_t n = s.object_shape.size();
+    s.placed.resize(n);
+    s.extents.resize(n);
+    s.index.resize(n);
+    s.low.resize(n);
+    s.visit.resize(n);
+}
+
+VisibilitySorter::~VisibilitySorter() = default;
+VisibilitySorter::VisibilitySorter(VisibilitySorter&&) noexcept = default;
+VisibilitySorter& VisibilitySorter::operator=(VisibilitySorter&&) noexcept = default;
+
+std::size_t VisibilitySorter::object_count() const { return state_->object_shape.size(); }
+std::size_t VisibilitySorter::shape_count() const { return state_->shape_first.size(); }
+std::size_t VisibilitySorter::hull_point_count() const { return state_->x.size(); }
+const VisibilitySort& VisibilitySorter::last() const { return state_->result; }
+void VisibilitySorter::forget_order() { state_->has_last_order = false; }
+
+}  // namespace homcull

@@ -1,0 +1,296 @@
+// The visibility sort (homcull/visibility_sort.hpp): hand-built cycles, the incremental sort
+// against sorts from scratch, and every layer order checked against the occlusion edges of
+// Embree's every-hit rays (homcull/truth/sort_truth.hpp) on toothpicks and the shared scenes.
+#include "support.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/frustum.hpp>
+#include <homcull/generate.hpp>
+#include <homcull/io/scene_io.hpp>
+#include <homcull/scene_sort.hpp>
+#include <homcull/truth/ray_scene.hpp>
+#include <homcull/truth/sort_truth.hpp>
+#include <homcull/truth/walk_path.hpp>
+#include <homcull/visibility_sort.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+namespace homcull {
+namespace {
+
+// Each object's layer in a sort (kUnsorted for those left out).
+std::vector<std::uint32_t> layer_of(const VisibilitySort& sort, std::size_t objects) {
+    std::vector<std::uint32_t> layer(objects, kUnsorted);
+    for (std::uint32_t l = 0; l < sort.layers.size(); ++l)
+        for (std::uint32_t k = 0; k < sort.layers[l].count; ++k) layer[sort.order[sort.layers[l].first + k]] = l;
+    return layer;
+}
+
+// The layers as sets, for comparing sorts whose orders may differ.
+std::set<std::vector<std::uint32_t>> layer_sets(const VisibilitySort& sort) {
+    std::set<std::vector<std::uint32_t>> sets;
+    for (const SortLayer& l : sort.layers) sets.emplace(sort.order.begin() + l.first, sort.order.begin() + l.first + l.count);
+    return sets;
+}
+
+// Every pair the sort found occluding has its occluder's layer no later than its occluded's.
+void expect_pairs_respected(const VisibilitySort& sort, std::size_t objects) {
+    const std::vector<std::uint32_t> layer = layer_of(sort, objects);
+    for (const OcclusionPair& p : sort.pairs) EXPECT_LE(layer[p.occluder], layer[p.occluded]) << p.occluder << " -> " << p.occluded;
+}
+
+// The sort's frame for a camera over a scene placed relative to `origin`: the eye and the
+// view frustum's planes, moved to that origin.
+struct CameraFrame {
+    std::vector<glm::mat4> transforms;
+    std::array<glm::vec4, 6> planes;
+    SortFrame frame;
+
+    CameraFrame(const Scene& scene, const Camera& camera, Resolution display, const glm::dvec3& origin) {
+        sort_transforms(scene, origin, transforms);
+        const Frustum frustum = make_frustum(camera, double(display.width) / double(display.height));
+        for (int k = 0; k < 6; ++k) {
+            const glm::dvec4& p = frustum.planes[k];
+            planes[k] = glm::vec4(glm::vec3(p), float(p.w + glm::dot(glm::dvec3(p), origin)));
+        }
+        frame.transforms = transforms.data();
+        frame.eye = glm::vec3(camera.eye - origin);
+        frame.planes = planes.data();
+        frame.plane_count = 6;
+    }
+};
+
+struct Tally {
+    std::size_t frames = 0, edges = 0, violations = 0, grouped = 0, needless = 0, objects_in_cycles = 0, sorted = 0,
+                needlessly_grouped = 0, largest = 0;
+    void add(const SortCheck& check, const VisibilitySort& sort, std::size_t edge_count) {
+        ++frames;
+        edges += edge_count;
+        violations += check.violations;
+        grouped += check.grouped_layers;
+        needless += check.needless_layers;
+        objects_in_cycles += sort.stats.objects_in_cycles;
+        needlessly_grouped += check.needlessly_grouped;
+        largest = std::max<std::size_t>(largest, sort.stats.largest_cycle);
+        sorted += sort.stats.sorted;
+    }
+    void report(const char* what) const {
+        std::printf("[ sorting  ] %s: %zu frames, %zu true edges, %zu violations, %zu grouped layers (%zu needless, largest %zu), "
+                    "%.1f %% of the sorted objects in them, %.1f %% in none of their true cycles\n",
+                    what, frames, edges, violations, grouped, needless, largest,
+                    sorted ? 100.0 * double(objects_in_cycles) / double(sorted) : 0.0,
+                    sorted ? 100.0 * double(needlessly_grouped) / double(sorted) : 0.0);
+    }
+};
+
+// Sorts the scene from the camera and checks it against Embree's edges.
+void check_view(VisibilitySorter& sorter, const Scene& scene, const RayScene& rays, const Camera& camera, Resolution display,
+                Tally& tally) {
+    const glm::dvec3 origin = scene_anchor(scene);
+    CameraFrame f(scene, camera, display, origin);
+    const VisibilitySort& sort = sorter.sort(f.frame);
+    const SortTruth truth = occlusion_edges(rays, scene.objects.size(), camera, display);
+    const SortCheck check = check_sort(truth, layer_of(sort, scene.objects.size()));
+    EXPECT_EQ(check.violations, 0u) << scene.source << " from " << camera.eye.x << "," << camera.eye.y << "," << camera.eye.z;
+    for (const OcclusionEdge& e : check.violating) ADD_FAILURE() << "violated: " << e.front << " -> " << e.back << " (" << e.rays << " rays)";
+    EXPECT_EQ(check.unsorted_edges, 0u) << "an object the frustum planes left out was seen";
+    expect_pairs_respected(sort, scene.objects.size());
+    tally.add(check, sort, truth.edges.size());
+}
+
+// A thin straight stick as a box mesh from a to b, `half` thick across, its own object.
+std::uint32_t add_stick(Scene& scene, const std::string& name, glm::vec3 a, glm::vec3 b, float half) {
+    const glm::vec3 along = glm::normalize(b - a);
+    const glm::vec3 across = glm::normalize(glm::cross(along, glm::vec3(0, 0, 1))) * half;
+    const glm::vec3 up = glm::normalize(glm::cross(across, along)) * half;
+    Mesh mesh;
+    mesh.name = name;
+    for (int k = 0; k < 8; ++k)
+        mesh.positions.push_back(((k & 1) ? b : a) + ((k & 2) ? across : -across) + ((k & 4) ? up : -up));
+    mesh.indices = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+    return test::add_object_with_own_mesh(scene, std::move(mesh));
+}
+
+TEST(ConvexHull, KeepsTheCornersAndDropsWhatIsInside) {
+    std::vector<glm::vec3> points;
+    for (int k = 0; k < 8; ++k) points.emplace_back((k & 1) ? 1.f : -1.f, (k & 2) ? 2.f : -2.f, (k & 4) ? 3.f : -3.f);
+    // Inside points, points on faces and edges, and duplicates.
+    for (int k = 0; k < 50; ++k) points.emplace_back(0.03f * float(k) - 0.7f, 0.05f * float(k % 7), -2.5f + 0.1f * float(k));
+    points.emplace_back(1.f, 0.f, 0.f), points.emplace_back(1.f, 2.f, 0.f), points.push_back(points[3]);
+    const std::vector<glm::vec3> hull = convex_hull_points(points.data(), points.size());
+    ASSERT_EQ(hull.size(), 8u);
+    for (int k = 0; k < 8; ++k) EXPECT_EQ(hull[std::size_t(k)], points[std::size_t(k)]);  // in first-seen order
+
+    // A toothpick's ellipsoid is convex: every vertex is on its hull.
+    const Scene toothpicks = generate_toothpicks(ToothpickOptions{}, 0);
+    const Mesh& mesh = toothpicks.meshes[0];
+    EXPECT_EQ(convex_hull_points(mesh.positions.data(), mesh.positions.size()).size(), mesh.positions.size());
+
+    // Flat and tiny sets come back whole, without duplicates; a NaN is an error.
+    const std::vector<glm::vec3> flat = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0.5f, 0.5f, 0}, {1, 0, 0}};
+    EXPECT_EQ(convex_hull_points(flat.data(), flat.size()).size(), 5u);
+    const std::vector<glm::vec3> bad = {{0, 0, 0}, {1, std::nanf(""), 0}};
+    EXPECT_THROW(convex_hull_points(bad.data(), bad.size()), Error);
+    EXPECT_TRUE(convex_hull_points(nullptr, 0).empty());
+}
+
+// Three sticks in a triangle, each over the next where they cross (the classic cycle of three
+// pencils): no two of them form a cycle, yet no order of the three is right. One layer.
+TEST(VisibilitySort, ThreeOverlappingSticksAreOneLayer) {
+    Scene scene;
+    const double pi = 3.14159265358979323846;
+    glm::vec3 corner[3];
+    for (int i = 0; i < 3; ++i) corner[i] = glm::vec3(3.0 * std::cos(2 * pi * i / 3), 3.0 * std::sin(2 * pi * i / 3), 0.0);
+    for (int i = 0; i < 3; ++i) {
+        const glm::vec3 a = corner[i], b = corner[(i + 1) % 3], along = glm::normalize(b - a);
+        // Far at its start, near at its end: over the next stick, under the one before.
+        add_stick(scene, "stick" + std::to_string(i), a - along + glm::vec3(0, 0, -6.0f), b + along + glm::vec3(0, 0, -4.0f), 0.1f);
+    }
+    // A box in front of the first stick's middle (seen from the origin), and one behind them all.
+    test::add_box(scene, "front", {0.2f, 0.45f, -2.5f}, {0.5f, 0.75f, -2.0f});
+    test::add_box(scene, "back", {-8, -8, -12}, {8, 8, -11});
+
+    VisibilitySorter sorter = make_visibility_sorter(scene);
+    CameraFrame f(scene, test::camera_down_minus_z(), {96, 96}, glm::dvec3(0.0));
+    const VisibilitySort& sort = sorter.sort(f.frame);
+    ASSERT_EQ(sort.layers.size(), 3u);
+    EXPECT_EQ(std::vector<std::uint32_t>(sort.order.begin(), sort.order.end()), (std::vector<std::uint32_t>{3, 0, 1, 2, 4}));
+    EXPECT_EQ(sort.layers[1].count, 3u);
+    EXPECT_EQ(sort.stats.cycles, 1u);
+    EXPECT_EQ(sort.stats.objects_in_cycles, 3u);
+    EXPECT_EQ(sort.stats.left_out, 0u);
+    expect_pairs_respected(sort, scene.objects.size());
+
+    // Embree agrees: the three edges of the cycle are true, and the layer is needed.
+    const RayScene rays(scene);
+    const SortTruth truth = occlusion_edges(rays, scene.objects.size(), test::camera_down_minus_z(), {96, 96});
+    const SortCheck check = check_sort(truth, layer_of(sort, scene.objects.size()));
+    EXPECT_EQ(check.violations, 0u);
+    EXPECT_EQ(check.grouped_layers, 1u);
+    EXPECT_EQ(check.needless_layers, 0u);
+    for (std::uint32_t stick = 0; stick < 3; ++stick)
+        EXPECT_TRUE(std::any_of(truth.edges.begin(), truth.edges.end(),
+                                [&](const OcclusionEdge& e) { return e.front == stick && e.back == (stick + 1) % 3; }));
+}
+
+// Two interlocked objects (each in front of the other somewhere) are one layer, between what
+// lies in front of them and what lies behind.
+TEST(VisibilitySort, InterlockedPairIsOneLayer) {
+    Scene scene;
+    test::add_interlocked_pair(scene);
+    test::add_box(scene, "front", {-1, -1, -1.5f}, {1, 1, -1});
+    test::add_box(scene, "back", {-60, -60, -9}, {60, 60, -8});
+    VisibilitySorter sorter = make_visibility_sorter(scene);
+    CameraFrame f(scene, test::camera_down_minus_z(), {64, 64}, glm::dvec3(0.0));
+    const VisibilitySort& sort = sorter.sort(f.frame);
+    ASSERT_EQ(sort.layers.size(), 3u);
+    EXPECT_EQ(std::vector<std::uint32_t>(sort.order.begin(), sort.order.end()), (std::vector<std::uint32_t>{2, 0, 1, 3}));
+    EXPECT_EQ(sort.layers[1].count, 2u);
+
+    // Turned around (the eye behind everything, looking up +z), the order reverses.
+    Camera behind = test::camera_down_minus_z();
+    behind.eye = {0, 0, -20};
+    behind.target = {0, 0, 0};
+    CameraFrame g(scene, behind, {64, 64}, glm::dvec3(0.0));
+    const VisibilitySort& reversed = sorter.sort(g.frame);
+    EXPECT_EQ(std::vector<std::uint32_t>(reversed.order.begin(), reversed.order.end()), (std::vector<std::uint32_t>{3, 0, 1, 2}));
+}
+
+TEST(VisibilitySort, BadInputIsAnErrorOrLeftOut) {
+    Scene scene;
+    test::add_box(scene, "a", {-1, -1, -4}, {1, 1, -2});
+    test::add_box(scene, "b", {-1, -1, -8}, {1, 1, -6});
+    EXPECT_THROW(VisibilitySorter({{glm::vec3(0.0f)}}, {1}), Error);  // shape out of range
+    EXPECT_THROW(VisibilitySorter({{}}, {0}), Error);                  // an empty shape
+    VisibilitySorter sorter = make_visibility_sorter(scene);
+    SortFrame frame;
+    EXPECT_THROW(sorter.sort(frame), Error);  // no transforms
+    std::vector<glm::mat4> transforms(2, glm::mat4(1.0f));
+    frame.transforms = transforms.data();
+    std::vector<glm::vec4> planes(17, glm::vec4(0, 0, 1, 0));
+    frame.planes = planes.data();
+    frame.plane_count = planes.size();
+    EXPECT_THROW(sorter.sort(frame), Error);  // too many planes
+    frame.plane_count = 0;
+    transforms[1][3][0] = std::nanf("");  // a NaN translation: that object is left out
+    const VisibilitySort& sort = sorter.sort(frame);
+    EXPECT_EQ(sort.stats.sorted, 1u);
+    EXPECT_EQ(sort.stats.left_out, 1u);
+    frame.eye = glm::vec3(std::nanf(""));
+    EXPECT_EQ(sorter.sort(frame).stats.sorted, 0u);
+}
+
+// The toothpicks tumbling frame after frame: the incremental sort gives the same layers as a
+// sort from scratch every frame, both respect every occlusion they found, and Embree finds no
+// true edge that either order breaks.
+TEST(VisibilitySort, IncrementalSortsAgreeWithSortsFromScratchOnToothpicks) {
+    ToothpickOptions options;
+    options.count = 200;
+    Scene scene = generate_toothpicks(options, 0);
+    VisibilitySorter incremental = make_visibility_sorter(scene), scratch = make_visibility_sorter(scene);
+    Camera camera;
+    camera.eye = {0.0, 4.0, 24.0};
+    camera.target = {0.0, 0.0, 0.0};
+    camera.fov_y_degrees = 40.0;
+    const Resolution display{200, 150};
+    Tally tally;
+    std::size_t kept = 0, cycles = 0;
+    for (int frame = 0; frame < 12; ++frame) {
+        for (std::size_t i = 0; i < scene.objects.size(); ++i) scene.objects[i].world = toothpick_transform(options, int(i), frame);
+        scene.finalize();
+        CameraFrame f(scene, camera, display, glm::dvec3(0.0));
+        const VisibilitySort& a = incremental.sort(f.frame);
+        f.frame.incremental = false;
+        const VisibilitySort& b = scratch.sort(f.frame);
+        EXPECT_EQ(layer_sets(a), layer_sets(b)) << "frame " << frame;
+        expect_pairs_respected(a, scene.objects.size());
+        expect_pairs_respected(b, scene.objects.size());
+        kept += a.stats.kept_last_order;
+        cycles += a.stats.cycles;
+        if (frame % 4 == 0) {
+            const RayScene rays(scene);
+            const SortTruth truth = occlusion_edges(rays, scene.objects.size(), camera, display);
+            for (const VisibilitySort* s : {&a, &b}) {
+                const SortCheck check = check_sort(truth, layer_of(*s, scene.objects.size()));
+                EXPECT_EQ(check.violations, 0u) << "frame " << frame;
+                tally.add(check, *s, truth.edges.size());
+            }
+        }
+    }
+    tally.report("toothpicks, 200");
+    EXPECT_GT(cycles, 0u);  // toothpicks pass through each other: there are cycles to find
+}
+
+// Zero violations against Embree on every shared scene, along a walk and from random views.
+TEST(VisibilitySort, NoViolationsOnTheSharedScenes) {
+    const Resolution display{240, 136};
+    Tally all;
+    int scenes = 0;
+    for (const char* file : {"intel_castle.glb", "crytek_sponza.glb", "fzk_haus.glb", "openarena_oa_thor.glb", "openarena_pul1duel-oa.glb"}) {
+        const std::string path = test::shared_scene(file);
+        if (path.empty()) continue;
+        ++scenes;
+        const Scene scene = load_scene(path);
+        const RayScene rays(scene);
+        VisibilitySorter sorter = make_visibility_sorter(scene);
+        WalkOptions walk;
+        walk.frames = 24;
+        const CameraPath path_frames = walk_path(rays, scene, walk);
+        Tally tally;
+        for (std::size_t k = 0; k < path_frames.frames.size(); k += 6) check_view(sorter, scene, rays, path_frames.frames[k], display, tally);
+        sorter.forget_order();
+        for (const Camera& view : random_views(rays, scene, 4, 7).frames) check_view(sorter, scene, rays, view, display, tally);
+        tally.report(file);
+        all.frames += tally.frames;
+    }
+    if (scenes == 0) GTEST_SKIP() << "no shared scenes";
+    EXPECT_GT(all.frames, 0u);
+}
+
+}  // namespace
+}  // namespace homcull
