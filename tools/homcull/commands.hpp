@@ -14,5 +14,6 @@ void register_cull(CLI::App& app);
 void register_walk(CLI::App& app);
 void register_bake(CLI::App& app);
 void register_dump(CLI::App& app);
+void register_sort(CLI::App& app);
 
 }  // namespace homcull::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     homcull::cli::register_walk(app);
     homcull::cli::register_bake(app);
     homcull::cli::register_dump(app);
+    homcull::cli::register_sort(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
