@@ -87,6 +87,26 @@ TEST(Cli, CullJsonHasEveryObjectStagesAndTruth) {
     EXPECT_TRUE(j["overlap_exits"].contains("predictive_rejection"));
 }
 
+// homcull sort: moving toothpicks in front of one camera, every frame checked against Embree.
+TEST(Cli, SortPrintsLayersCyclesStagesAndTheCheck) {
+    const CliRun r = run_cli("sort --scene gen:toothpicks:count=60,seed=3 --eye 0,3,22 --target 0,0,0 --fov-y 40 "
+                             "--frames 4 --rounds 2 --resolution 160x120 --check --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["frames"].size(), 4u);
+    for (const auto& f : j["frames"]) {
+        std::size_t listed = 0;
+        for (const auto& layer : f["layers"]) listed += layer.size();
+        EXPECT_EQ(listed, f["sorted"].get<std::size_t>());
+        EXPECT_EQ(f["check"]["violations"].get<int>(), 0);
+        EXPECT_GE(f["total_ms"].get<double>(), 0.0);
+        EXPECT_TRUE(f["stages_ms"].contains("order"));
+    }
+    EXPECT_GT(j["summary"]["check"]["true_edges"].get<int>(), 0);
+    // A moving scene needs the toothpicks; a path and --frames do not go together.
+    EXPECT_NE(run_cli("sort --scene gen:city --eye 0,3,22 --target 0,0,0 --frames 3").exit_code, 0);
+}
+
 TEST(Cli, SoupCellsSplitLargeObjectsForEveryCommand) {
     // The city's objects hold 12 to a few hundred triangles: at 8, the larger ones split.
     CliRun r = run_cli("info --scene gen:city:seed=2,blocks=3 --json");

@@ -8,6 +8,8 @@
 #include <homcull/homcull.h>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/scene_sort.hpp>
+#include <homcull/visibility_sort.hpp>
 #include <homcull/world_triangles.hpp>
 
 #include <gtest/gtest.h>
@@ -260,6 +262,36 @@ TEST(FrameAllocations, CInterfaceTakesEveryByteFromTheEngine) {
     EXPECT_GT(engine.calls, 20u);
     EXPECT_EQ(engine.live, 0u);
     EXPECT_GT(occluded, 0u);  // the street hides something
+}
+
+// A visibility sorter allocates nothing per frame once it has seen its frames: tumbling
+// toothpicks (cycles come and go), incremental and from scratch, with and without planes.
+TEST(FrameAllocations, VisibilitySortNoneAfterWarmUp) {
+    ToothpickOptions options;
+    options.count = 200;
+    const Scene scene = generate_toothpicks(options, 0);
+    VisibilitySorter sorter = make_visibility_sorter(scene);
+    std::vector<std::vector<glm::mat4>> frames(8, std::vector<glm::mat4>(scene.objects.size()));
+    for (std::size_t f = 0; f < frames.size(); ++f)
+        for (int i = 0; i < options.count; ++i) frames[f][std::size_t(i)] = glm::mat4(toothpick_transform(options, i, int(f)));
+    const glm::vec4 planes[2] = {{0, 0, -1, 30}, {0.3f, 0, -1, 40}};
+    std::size_t sorted = 0;
+    const auto run = [&] {
+        for (const bool incremental : {true, false})
+            for (const std::size_t plane_count : {std::size_t(0), std::size_t(2)})
+                for (const auto& transforms : frames) {
+                    SortFrame frame;
+                    frame.transforms = transforms.data();
+                    frame.eye = {0.0f, 4.0f, 24.0f};
+                    frame.planes = planes;
+                    frame.plane_count = plane_count;
+                    frame.incremental = incremental;
+                    sorted += sorter.sort(frame).stats.sorted;
+                }
+    };
+    run();  // warm-up: the sorter's scratch grows to the busiest frame
+    EXPECT_EQ(allocations_of(run), 0u);
+    EXPECT_GT(sorted, 0u);
 }
 
 }  // namespace

@@ -14,12 +14,7 @@ glm::dvec3 support_point(const PlacedHull& hull, const glm::dvec3& d) {
     const float dx = w.x * m[0][0] + w.y * m[0][1] + w.z * m[0][2];
     const float dy = w.x * m[1][0] + w.y * m[1][1] + w.z * m[1][2];
     const float dz = w.x * m[2][0] + w.y * m[2][1] + w.z * m[2][2];
-    std::uint32_t best = 0;
-    float best_dot = hull.x[0] * dx + hull.y[0] * dy + hull.z[0] * dz;
-    for (std::uint32_t i = 1; i < hull.count; ++i) {
-        const float dot = hull.x[i] * dx + hull.y[i] * dy + hull.z[i] * dz;
-        if (dot > best_dot) best_dot = dot, best = i;
-    }
+    const std::uint32_t best = hull.scan(hull.x, hull.y, hull.z, hull.count, dx, dy, dz);
     const glm::vec4 p = m * glm::vec4(hull.x[best], hull.y[best], hull.z[best], 1.0f);
     return glm::dvec3(p);
 }

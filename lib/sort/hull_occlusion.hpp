@@ -11,20 +11,23 @@
 // The answer is conservative: "no" only with a certificate, a direction along which the two
 // sets are apart by more than a margin (the float roundings of the objects' coordinates, and
 // the ground truth's own). GJK that does not settle within its iterations says "yes".
+#include "sort/support_scan.hpp"
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
 
 namespace homcull::sort_detail {
 
-// One object's hull as the tests see it this frame: model-space points (structure of arrays)
-// and the model-to-world transform.
+// One object's hull as the tests see it this frame: model-space points (structure of arrays),
+// the model-to-world transform, and the support scan of the sorter's instruction set.
 struct PlacedHull {
     const float* x = nullptr;
     const float* y = nullptr;
     const float* z = nullptr;
     std::uint32_t count = 0;
     glm::mat4 transform{1.0f};
+    SupportScan scan = &support_scan_reference;
 };
 
 // The world point of the hull farthest along world direction d.

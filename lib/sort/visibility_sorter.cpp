@@ -16,6 +16,7 @@
 #include <homcull/error.hpp>
 #include <homcull/visibility_sort.hpp>
 
+#include "common/isa_choice.hpp"
 #include "extent_tree.hpp"
 #include "hull_occlusion.hpp"
 
@@ -57,8 +58,10 @@ struct VisibilitySorter::State {
     // Shapes: hull points as structure of arrays, and each shape's bounding sphere.
     std::vector<float> x, y, z;
     std::vector<std::uint32_t> shape_first, shape_count;
-    std::vector<glm::vec3> shape_centre;
-    std::vector<float> shape_radius;
+    std::vector<glm::vec3> shape_centre;  // of the points' bounding box
+    std::vector<glm::vec3> shape_half;    // half the box's sides
+    std::vector<float> shape_radius;      // of the bounding sphere about the box's centre
+    std::vector<float> box_x, box_y, box_z;  // the box's eight corners, per shape
     std::vector<std::uint32_t> object_shape;
 
     // This frame.
@@ -66,6 +69,7 @@ struct VisibilitySorter::State {
     std::vector<Extent> extents;
     std::vector<std::uint32_t> in_tree, surrounding, roots;
     ExtentTree tree;
+    sort_detail::SupportScan scan = &sort_detail::support_scan_reference;
     const glm::mat4* transforms = nullptr;
     glm::dvec3 eye{0.0};
     double margin_scale = 0;
@@ -86,6 +90,19 @@ struct VisibilitySorter::State {
     bool has_last_order = false;
     VisibilitySort result;
 
+    // The object's bounding box as a hull of eight points: the cheap test before the hull's.
+    PlacedHull box(std::uint32_t object) const {
+        const std::uint32_t s = object_shape[object];
+        PlacedHull h;
+        h.x = box_x.data() + 8 * s;
+        h.y = box_y.data() + 8 * s;
+        h.z = box_z.data() + 8 * s;
+        h.count = 8;
+        h.transform = transforms[object];
+        h.scan = scan;
+        return h;
+    }
+
     PlacedHull hull(std::uint32_t object) const {
         const std::uint32_t s = object_shape[object];
         PlacedHull h;
@@ -94,6 +111,7 @@ struct VisibilitySorter::State {
         h.z = z.data() + shape_first[s];
         h.count = shape_count[s];
         h.transform = transforms[object];
+        h.scan = scan;
         return h;
     }
 
@@ -118,6 +136,33 @@ float stretch_bound(const glm::mat4& m) {
 }
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+struct DistanceRange {
+    float nearest, farthest;
+};
+
+// Distances from the eye to an object's bounding box (the model-space box of half sides
+// `half` about the point that becomes `centre`, through the affine transform m): the
+// farthest corner exactly, and for the nearest a lower bound, the largest distance to one of
+// the box's three slabs (the box is their intersection). Tighter than the bounding sphere's
+// for long thin objects.
+DistanceRange box_distances(const glm::mat4& m, const glm::vec3& half, const glm::vec3& centre, const glm::vec3& eye) {
+    const glm::vec3 axis[3] = {glm::vec3(m[0]) * half.x, glm::vec3(m[1]) * half.y, glm::vec3(m[2]) * half.z};
+    const glm::vec3 to_eye = eye - centre;
+    DistanceRange r{0.0f, 0.0f};
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::vec3 c = ((corner & 1) ? axis[0] : -axis[0]) + ((corner & 2) ? axis[1] : -axis[1]) + ((corner & 4) ? axis[2] : -axis[2]);
+        r.farthest = std::max(r.farthest, glm::length(c - to_eye));
+    }
+    for (int k = 0; k < 3; ++k) {
+        const glm::vec3 normal = glm::cross(axis[(k + 1) % 3], axis[(k + 2) % 3]);
+        const float length = glm::length(normal);
+        if (!(length > 0.0f)) continue;
+        const glm::vec3 n = normal / length;
+        r.nearest = std::max(r.nearest, std::abs(glm::dot(n, to_eye)) - std::abs(glm::dot(n, axis[k])));
+    }
+    return r;
+}
 
 }  // namespace
 
@@ -147,7 +192,9 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
         scale = std::max(scale, double(glm::length(p.centre) + p.radius));
         const glm::vec3 offset = p.centre - e;
         const float distance = glm::length(offset);
-        p.farthest = distance + p.radius;
+        const float tolerance = 1e-6f * (glm::length(p.centre) + glm::length(e) + p.radius);
+        const DistanceRange to_box = box_distances(m, shape_half[s], p.centre, e);
+        p.farthest = std::min(distance + p.radius, to_box.farthest + tolerance);
         Extent& box = extents[i];
         p.surrounds_eye = !(distance > p.radius);
         if (p.surrounds_eye) {
@@ -160,7 +207,7 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
         p.direction = offset / distance;
         p.sine = p.radius / distance;
         p.cosine = std::sqrt(std::max(0.0f, 1.0f - p.sine * p.sine));
-        box.nearest = distance - p.radius;
+        box.nearest = std::max(distance - p.radius, to_box.nearest - tolerance);
         // The range of each direction component over the sphere's cone: cos(angle to the axis
         // -+ the half-angle), reaching +-1 when the cone holds the axis. Widened by 1e-6
         // against rounding.
@@ -190,11 +237,14 @@ bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) 
         const float cos_sum = f.cosine * b.cosine - f.sine * b.sine;
         if (glm::dot(f.direction, b.direction) < cos_sum - 1e-6f) return false;
     }
-    ++result.stats.hull_tests;
     // A part in 10^6 of the scene's reach from the origin: the float roundings of the points
     // here and of the ground truth's (which places vertices in double, then rounds).
     const double margin = 1e-6 * margin_scale;
-    return sort_detail::may_occlude(hull(front), hull(back), eye, margin, glm::dvec3(f.centre) - glm::dvec3(b.centre));
+    const glm::dvec3 start = glm::dvec3(f.centre) - glm::dvec3(b.centre);
+    ++result.stats.box_tests;
+    if (!sort_detail::may_occlude(box(front), box(back), eye, margin, start)) return false;
+    ++result.stats.hull_tests;
+    return sort_detail::may_occlude(hull(front), hull(back), eye, margin, start);
 }
 
 void VisibilitySorter::State::emit_component(std::uint32_t root) {
@@ -322,6 +372,8 @@ const VisibilitySort& VisibilitySorter::sort(const SortFrame& frame) {
 VisibilitySorter::VisibilitySorter(std::vector<std::vector<glm::vec3>> hull_points, std::vector<std::uint32_t> object_shapes)
     : state_(std::make_unique<State>()) {
     State& s = *state_;
+    // The instruction set of buffers made now (select_isa's default): the same answers on all.
+    s.scan = sort_detail::support_scan_for(detail::default_isa_choice());
     for (std::size_t k = 0; k < hull_points.size(); ++k) {
         const auto& points = hull_points[k];
         if (points.empty()) throw Error("VisibilitySorter: shape " + std::to_string(k) + " has no points");
@@ -340,6 +392,12 @@ VisibilitySorter::VisibilitySorter(std::vector<std::vector<glm::vec3>> hull_poin
             s.x.push_back(p.x), s.y.push_back(p.y), s.z.push_back(p.z);
         }
         s.shape_centre.push_back(centre);
+        s.shape_half.push_back(0.5f * (hi - lo));
+        for (int corner = 0; corner < 8; ++corner) {
+            s.box_x.push_back((corner & 1) ? hi.x : lo.x);
+            s.box_y.push_back((corner & 2) ? hi.y : lo.y);
+            s.box_z.push_back((corner & 4) ? hi.z : lo.z);
+        }
         s.shape_radius.push_back(radius * (1.0f + 1e-6f));
     }
     for (std::size_t i = 0; i < object_shapes.size(); ++i) {

@@ -218,6 +218,7 @@ void run_sort(const SortCommandOptions& o) {
                                 {"layers", r.layers},
                                 {"cycles", r.cycles},
                                 {"candidates", r.stats.candidates},
+                                {"box_tests", r.stats.box_tests},
                                 {"hull_tests", r.stats.hull_tests},
                                 {"occlusions", r.stats.occlusions},
                                 {"kept_last_order", r.stats.kept_last_order}};

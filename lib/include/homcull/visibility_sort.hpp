@@ -51,6 +51,7 @@ struct VisibilitySortStats {
     std::uint32_t objects_in_cycles = 0;  // objects in those layers
     std::uint32_t largest_cycle = 0;      // objects in the largest layer
     std::uint64_t candidates = 0;         // pairs the extent tree returned
+    std::uint64_t box_tests = 0;          // pairs tested on their bounding boxes (after the spheres)
     std::uint64_t hull_tests = 0;         // pairs that reached the convex-hull test
     std::uint64_t occlusions = 0;         // pairs that test found occluding (the pairs listed)
     bool kept_last_order = false;         // the last frame's order held: the sort changed nothing
