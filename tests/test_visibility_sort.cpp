@@ -4,7 +4,6 @@
 #include "support.hpp"
 
 #include <homcull/error.hpp>
-#include <homcull/frustum.hpp>
 #include <homcull/generate.hpp>
 #include <homcull/io/scene_io.hpp>
 #include <homcull/isa.hpp>
@@ -54,11 +53,7 @@ struct CameraFrame {
 
     CameraFrame(const Scene& scene, const Camera& camera, Resolution display, const glm::dvec3& origin) {
         sort_transforms(scene, origin, transforms);
-        const Frustum frustum = make_frustum(camera, double(display.width) / double(display.height));
-        for (int k = 0; k < 6; ++k) {
-            const glm::dvec4& p = frustum.planes[k];
-            planes[k] = glm::vec4(glm::vec3(p), float(p.w + glm::dot(glm::dvec3(p), origin)));
-        }
+        planes = sort_frustum_planes(camera, double(display.width) / double(display.height), origin);
         frame.transforms = transforms.data();
         frame.eye = glm::vec3(camera.eye - origin);
         frame.planes = planes.data();

@@ -1,4 +1,5 @@
 #include <homcull/error.hpp>
+#include <homcull/frustum.hpp>
 #include <homcull/scene_sort.hpp>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -32,6 +33,17 @@ void sort_transforms(const Scene& scene, const glm::dvec3& origin, std::vector<g
     out.resize(scene.objects.size());
     const glm::dmat4 shift = glm::translate(glm::dmat4(1.0), -origin);
     for (std::size_t i = 0; i < scene.objects.size(); ++i) out[i] = glm::mat4(shift * scene.objects[i].world);
+}
+
+std::array<glm::vec4, 6> sort_frustum_planes(const Camera& camera, double aspect, const glm::dvec3& origin) {
+    const Frustum frustum = make_frustum(camera, aspect);
+    std::array<glm::vec4, 6> planes;
+    for (std::size_t k = 0; k < 6; ++k) {
+        // dot(n, p) + w >= 0 with p = p' + origin: dot(n, p') + (w + dot(n, origin)) >= 0.
+        const glm::dvec4& p = frustum.planes[k];
+        planes[k] = glm::vec4(glm::vec3(p), float(p.w + glm::dot(glm::dvec3(p), origin)));
+    }
+    return planes;
 }
 
 }  // namespace homcull

@@ -5,7 +5,6 @@
 #include "options.hpp"
 
 #include <homcull/error.hpp>
-#include <homcull/frustum.hpp>
 #include <homcull/io/camera_path.hpp>
 #include <homcull/io/scene_io.hpp>
 #include <homcull/scene_sort.hpp>
@@ -103,11 +102,7 @@ struct FrameInput {
 FrameInput frame_input(const Scene& scene, const Camera& camera, Resolution display, const glm::dvec3& origin) {
     FrameInput in;
     sort_transforms(scene, origin, in.transforms);
-    const Frustum frustum = make_frustum(camera, double(display.width) / double(display.height));
-    for (int k = 0; k < 6; ++k) {
-        const glm::dvec4& p = frustum.planes[std::size_t(k)];
-        in.planes[std::size_t(k)] = glm::vec4(glm::vec3(p), float(p.w + glm::dot(glm::dvec3(p), origin)));
-    }
+    in.planes = sort_frustum_planes(camera, double(display.width) / double(display.height), origin);
     in.eye = glm::vec3(camera.eye - origin);
     return in;
 }

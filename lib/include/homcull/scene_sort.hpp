@@ -1,9 +1,11 @@
 #pragma once
 // A scene's objects as a visibility sort sees them (visibility_sort.hpp): one convex hull per
 // mesh, made at load time, and each object's transform per frame relative to an origin.
+#include <homcull/camera.hpp>
 #include <homcull/scene.hpp>
 #include <homcull/visibility_sort.hpp>
 
+#include <array>
 #include <vector>
 
 namespace homcull {
@@ -16,5 +18,9 @@ VisibilitySorter make_visibility_sorter(const Scene& scene);
 // Object i's model-to-world transform relative to `origin` (translate(-origin) * world, in
 // double, then rounded to float), into `out` (resized to the object count).
 void sort_transforms(const Scene& scene, const glm::dvec3& origin, std::vector<glm::mat4>& out);
+
+// The camera's view frustum (make_frustum, width / height = aspect) as SortFrame::planes,
+// relative to `origin`: the sort then leaves out the objects wholly outside the view.
+std::array<glm::vec4, 6> sort_frustum_planes(const Camera& camera, double aspect, const glm::dvec3& origin);
 
 }  // namespace homcull
