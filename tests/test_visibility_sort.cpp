@@ -118,7 +118,7 @@ TEST(ConvexHull, KeepsTheCornersAndDropsWhatIsInside) {
     // Inside points, points on faces and edges, and duplicates.
     for (int k = 0; k < 50; ++k) points.emplace_back(0.03f * float(k) - 0.7f, 0.05f * float(k % 7), -2.5f + 0.1f * float(k));
     points.emplace_back(1.f, 0.f, 0.f), points.emplace_back(1.f, 2.f, 0.f), points.push_back(points[3]);
-    const std::vector<glm::vec3> hull = convex_hull_points(points.data(), points.size());
+    const auto hull = convex_hull_points(points.data(), points.size());
     ASSERT_EQ(hull.size(), 8u);
     for (int k = 0; k < 8; ++k) EXPECT_EQ(hull[std::size_t(k)], points[std::size_t(k)]);  // in first-seen order
 

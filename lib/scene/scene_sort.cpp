@@ -7,7 +7,7 @@
 namespace homcull {
 
 VisibilitySorter make_visibility_sorter(const Scene& scene) {
-    std::vector<std::vector<glm::vec3>> hulls;
+    std::vector<detail::Vector<glm::vec3>> hulls;
     hulls.reserve(scene.meshes.size());
     std::vector<glm::vec3> used;
     std::vector<char> seen;
@@ -23,10 +23,12 @@ VisibilitySorter make_visibility_sorter(const Scene& scene) {
         if (used.empty()) used.emplace_back(0.0f);
         hulls.push_back(convex_hull_points(used.data(), used.size()));
     }
+    std::vector<HullPoints> views;
+    for (const auto& hull : hulls) views.push_back({hull.data(), hull.size()});
     std::vector<std::uint32_t> shapes;
     shapes.reserve(scene.objects.size());
     for (const Object& object : scene.objects) shapes.push_back(object.mesh);
-    return VisibilitySorter(std::move(hulls), std::move(shapes));
+    return VisibilitySorter(views.data(), views.size(), shapes.data(), shapes.size());
 }
 
 void sort_transforms(const Scene& scene, const glm::dvec3& origin, std::vector<glm::mat4>& out) {

@@ -6,6 +6,7 @@
 // longjmp across our frames. The sort only needs the hull's vertices, and any superset of
 // them is still correct (the tests run on the convex hull of whatever points they are given),
 // so this one falls back to every distinct point whenever its own checks find the hull broken.
+#include <homcull/detail/memory.hpp>
 #include <homcull/error.hpp>
 #include <homcull/visibility_sort.hpp>
 
@@ -23,7 +24,7 @@ struct HullFace {
     std::uint32_t v[3];
     glm::dvec3 normal;  // outward, unit length
     double offset;      // dot(normal, p) - offset: the signed distance of p above the face
-    std::vector<std::uint32_t> outside;  // points above this face and no face made before
+    detail::Vector<std::uint32_t> outside;  // points above this face and no face made before
     bool alive = true;
 
     double distance(const glm::dvec3& p) const { return glm::dot(normal, p) - offset; }
@@ -33,11 +34,11 @@ std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) { return (std::uint64_t
 
 class Quickhull {
 public:
-    Quickhull(const std::vector<glm::dvec3>& points, double tolerance) : p_(points), eps_(tolerance) {}
+    Quickhull(const detail::Vector<glm::dvec3>& points, double tolerance) : p_(points), eps_(tolerance) {}
 
     // False when the points have no volume (no starting tetrahedron) or the hull came out
     // broken; then the caller keeps every point.
-    bool run(std::vector<std::uint32_t>& vertices) {
+    bool run(detail::Vector<std::uint32_t>& vertices) {
         if (!start()) return false;
         for (std::size_t f = 0; f < faces_.size(); ++f) {
             // faces_ grows as points are added: every face made is visited once.
@@ -47,10 +48,14 @@ public:
     }
 
 private:
-    const std::vector<glm::dvec3>& p_;
+    const detail::Vector<glm::dvec3>& p_;
     double eps_;
-    std::vector<HullFace> faces_;
-    std::unordered_map<std::uint64_t, std::uint32_t> edge_face_;  // directed edge -> its face
+    detail::Vector<HullFace> faces_;
+    // Directed edge -> its face (from the hooks current where the hull is made, as every
+    // container here: the C interface's hulls come from the engine's allocator).
+    std::unordered_map<std::uint64_t, std::uint32_t, std::hash<std::uint64_t>, std::equal_to<std::uint64_t>,
+                       detail::HookAllocator<std::pair<const std::uint64_t, std::uint32_t>>>
+        edge_face_;
 
     bool make_face(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t* made) {
         HullFace face;
@@ -136,14 +141,14 @@ private:
     // Adds face f's farthest outside point: removes every face it sees, then fans new faces
     // from it to the horizon, the edges between the faces it sees and those it does not.
     void add_farthest(std::size_t f) {
-        std::vector<std::uint32_t>& outside = faces_[f].outside;
+        detail::Vector<std::uint32_t>& outside = faces_[f].outside;
         std::uint32_t apex = outside[0];
         for (std::uint32_t i : outside)
             if (faces_[f].distance(p_[i]) > faces_[f].distance(p_[apex])) apex = i;
         const glm::dvec3& q = p_[apex];
 
-        std::vector<std::uint32_t> seen{std::uint32_t(f)};
-        std::vector<char> is_seen(faces_.size(), 0);
+        detail::Vector<std::uint32_t> seen(1, std::uint32_t(f));
+        detail::Vector<char> is_seen(faces_.size(), 0);
         is_seen[f] = 1;
         for (std::size_t k = 0; k < seen.size(); ++k) {
             const HullFace& face = faces_[seen[k]];
@@ -157,7 +162,7 @@ private:
                 }
             }
         }
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> horizon;
+        detail::Vector<std::pair<std::uint32_t, std::uint32_t>> horizon;
         for (std::uint32_t g : seen) {
             const HullFace& face = faces_[g];
             for (int e = 0; e < 3; ++e) {
@@ -165,7 +170,7 @@ private:
                 if (twin == edge_face_.end() || !is_seen[twin->second]) horizon.emplace_back(face.v[e], face.v[(e + 1) % 3]);
             }
         }
-        std::vector<std::uint32_t> orphans;
+        detail::Vector<std::uint32_t> orphans;
         for (std::uint32_t g : seen) {
             for (std::uint32_t i : faces_[g].outside)
                 if (i != apex) orphans.push_back(i);
@@ -173,7 +178,7 @@ private:
             faces_[g].outside.shrink_to_fit();
             kill_face(g);
         }
-        std::vector<std::uint32_t> made;
+        detail::Vector<std::uint32_t> made;
         for (const auto& [a, b] : horizon) {
             std::uint32_t g;
             if (!make_face(a, b, apex, &g)) {
@@ -187,9 +192,9 @@ private:
 
     // The hull's vertices, after checking that it is closed (every edge has its twin) and
     // convex at every edge (each face's far vertex across an edge lies below it).
-    bool collect(std::vector<std::uint32_t>& vertices) {
+    bool collect(detail::Vector<std::uint32_t>& vertices) {
         if (broken_) return false;
-        std::vector<char> used(p_.size(), 0);
+        detail::Vector<char> used(p_.size(), 0);
         for (const HullFace& face : faces_) {
             if (!face.alive) continue;
             for (int e = 0; e < 3; ++e) {
@@ -212,14 +217,14 @@ private:
 
 }  // namespace
 
-std::vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t count) {
+detail::Vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t count) {
     if (count > 0 && points == nullptr) throw Error("convex_hull_points: null points");
     if (count >= std::size_t(UINT32_MAX)) throw Error("convex_hull_points: more than 2^32 - 1 points");
     // Distinct points in first-seen order (exact duplicates only: near ones are the hull's job).
-    std::vector<glm::vec3> distinct;
+    detail::Vector<glm::vec3> distinct;
     distinct.reserve(count);
     {
-        std::vector<std::uint32_t> order(count);
+        detail::Vector<std::uint32_t> order(count);
         for (std::uint32_t i = 0; i < count; ++i) {
             const glm::vec3& p = points[i];
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
@@ -234,7 +239,7 @@ std::vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t c
             return a < b;
         };
         std::sort(order.begin(), order.end(), less);
-        std::vector<char> keep(count, 0);
+        detail::Vector<char> keep(count, 0);
         for (std::size_t k = 0; k < count; ++k)
             if (k == 0 || points[order[k]] != points[order[k - 1]]) keep[order[k]] = 1;
         for (std::size_t i = 0; i < count; ++i)
@@ -242,15 +247,15 @@ std::vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t c
     }
     if (distinct.size() < 5) return distinct;
 
-    std::vector<glm::dvec3> p(distinct.begin(), distinct.end());
+    detail::Vector<glm::dvec3> p(distinct.begin(), distinct.end());
     double extent = 0.0;
     for (const glm::dvec3& q : p) extent = std::max({extent, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
     // Points within this of a face count as on it: a few float roundings of the largest
     // coordinate, far below what the sort's tests resolve.
     const double tolerance = 1e-12 + extent * 1e-9;
-    std::vector<std::uint32_t> vertices;
+    detail::Vector<std::uint32_t> vertices;
     if (!Quickhull(p, tolerance).run(vertices)) return distinct;
-    std::vector<glm::vec3> hull;
+    detail::Vector<glm::vec3> hull;
     hull.reserve(vertices.size());
     for (std::uint32_t i : vertices) hull.push_back(distinct[i]);
     return hull;

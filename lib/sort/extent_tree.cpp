@@ -27,7 +27,7 @@ bool overlaps(const Extent& a, const Extent& b) {
 
 }  // namespace
 
-void ExtentTree::build(const std::vector<Extent>& extents, const std::vector<std::uint32_t>& ids) {
+void ExtentTree::build(const detail::Vector<Extent>& extents, const detail::Vector<std::uint32_t>& ids) {
     extents_ = &extents;
     objects_.assign(ids.begin(), ids.end());
     nodes_.clear();
@@ -76,7 +76,7 @@ void ExtentTree::build(const std::vector<Extent>& extents, const std::vector<std
     }
 }
 
-void ExtentTree::query(const Extent& box, float farthest, std::vector<std::uint32_t>& out) const {
+void ExtentTree::query(const Extent& box, float farthest, detail::Vector<std::uint32_t>& out) const {
     if (nodes_.empty()) return;
     stack_.clear();
     stack_.push_back(0);

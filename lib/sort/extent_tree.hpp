@@ -8,8 +8,9 @@
 // extent is its range of distances from the eye: A can hide part of B only if A's nearest
 // point is nearer than B's farthest. The tree is rebuilt every frame, without allocation once
 // it has held its largest frame: median splits on the widest axis of the boxes' centres.
+#include <homcull/detail/memory.hpp>
+
 #include <cstdint>
-#include <vector>
 
 namespace homcull::sort_detail {
 
@@ -21,10 +22,10 @@ struct Extent {
 class ExtentTree {
 public:
     // A tree over extents[ids[k]] (ids: the objects to hold; extents indexed by object).
-    void build(const std::vector<Extent>& extents, const std::vector<std::uint32_t>& ids);
+    void build(const detail::Vector<Extent>& extents, const detail::Vector<std::uint32_t>& ids);
     // Appends to `out` every object held whose direction box overlaps `box` and whose nearest
     // distance is below `farthest`.
-    void query(const Extent& box, float farthest, std::vector<std::uint32_t>& out) const;
+    void query(const Extent& box, float farthest, detail::Vector<std::uint32_t>& out) const;
 
 private:
     struct Node {
@@ -32,15 +33,15 @@ private:
         std::uint32_t first = 0; // leaf: objects_[first, first + count); inner: first = right child
         std::uint32_t count = 0; // 0 for an inner node (its left child follows it)
     };
-    const std::vector<Extent>* extents_ = nullptr;
-    std::vector<Node> nodes_;
-    std::vector<std::uint32_t> objects_;
-    std::vector<float> keys_;  // build scratch: the split axis' centres
+    const detail::Vector<Extent>* extents_ = nullptr;
+    detail::Vector<Node> nodes_;
+    detail::Vector<std::uint32_t> objects_;
+    detail::Vector<float> keys_;  // build scratch: the split axis' centres
     struct Range {
         std::uint32_t node, first, count;
     };
-    std::vector<Range> work_;           // build scratch
-    mutable std::vector<std::uint32_t> stack_;  // query scratch
+    detail::Vector<Range> work_;           // build scratch
+    mutable detail::Vector<std::uint32_t> stack_;  // query scratch
 };
 
 }  // namespace homcull::sort_detail

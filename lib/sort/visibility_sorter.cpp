@@ -46,9 +46,34 @@ struct Placed {
     glm::vec3 direction{0.0f};  // unit, from the eye to the centre
     float sine = 1, cosine = 0;  // of the sphere's half-angle seen from the eye
     float farthest = 0;         // distance from the eye to the sphere's far side
+    glm::vec3 half_axis[3];     // the bounding box about `centre`: centre +- each half axis
     bool surrounds_eye = false;
     bool active = false;
 };
+
+// Whether a plane normal to one of a few axes parts front's bounding box from the hull of the
+// eye and back's bounding box, with more than `margin` between them: then front cannot hide
+// any of back. The axes: the boxes' face normals (cross products of their half axes, so that
+// sheared boxes are right too) and the line between their centres. Cheap, and it settles most
+// pairs where front lies behind back; the GJK tests take the rest.
+bool parted_on_box_axes(const Placed& front, const Placed& back, const glm::vec3& eye, float margin) {
+    const glm::vec3* f = front.half_axis;
+    const glm::vec3* b = back.half_axis;
+    const glm::vec3 axes[7] = {glm::cross(f[1], f[2]), glm::cross(f[2], f[0]), glm::cross(f[0], f[1]),
+                               glm::cross(b[1], b[2]), glm::cross(b[2], b[0]), glm::cross(b[0], b[1]),
+                               front.centre - back.centre};
+    for (const glm::vec3& n : axes) {
+        const float length = glm::length(n);
+        if (!(length > 0.0f)) continue;
+        const float reach_f = std::abs(glm::dot(n, f[0])) + std::abs(glm::dot(n, f[1])) + std::abs(glm::dot(n, f[2]));
+        const float reach_b = std::abs(glm::dot(n, b[0])) + std::abs(glm::dot(n, b[1])) + std::abs(glm::dot(n, b[2]));
+        const float at_f = glm::dot(n, front.centre), at_b = glm::dot(n, back.centre), at_eye = glm::dot(n, eye);
+        const float low_b = std::min(at_b - reach_b, at_eye), high_b = std::max(at_b + reach_b, at_eye);
+        const float gap = margin * length;
+        if (high_b < at_f - reach_f - gap || at_f + reach_f < low_b - gap) return true;
+    }
+    return false;
+}
 
 enum Visit : std::uint8_t { kUnvisited = 0, kOnStack = 1, kDone = 2 };
 
@@ -56,18 +81,18 @@ enum Visit : std::uint8_t { kUnvisited = 0, kOnStack = 1, kDone = 2 };
 
 struct VisibilitySorter::State {
     // Shapes: hull points as structure of arrays, and each shape's bounding sphere.
-    std::vector<float> x, y, z;
-    std::vector<std::uint32_t> shape_first, shape_count;
-    std::vector<glm::vec3> shape_centre;  // of the points' bounding box
-    std::vector<glm::vec3> shape_half;    // half the box's sides
-    std::vector<float> shape_radius;      // of the bounding sphere about the box's centre
-    std::vector<float> box_x, box_y, box_z;  // the box's eight corners, per shape
-    std::vector<std::uint32_t> object_shape;
+    detail::Vector<float> x, y, z;
+    detail::Vector<std::uint32_t> shape_first, shape_count;
+    detail::Vector<glm::vec3> shape_centre;  // of the points' bounding box
+    detail::Vector<glm::vec3> shape_half;    // half the box's sides
+    detail::Vector<float> shape_radius;      // of the bounding sphere about the box's centre
+    detail::Vector<float> box_x, box_y, box_z;  // the box's eight corners, per shape
+    detail::Vector<std::uint32_t> object_shape;
 
     // This frame.
-    std::vector<Placed> placed;
-    std::vector<Extent> extents;
-    std::vector<std::uint32_t> in_tree, surrounding, roots;
+    detail::Vector<Placed> placed;
+    detail::Vector<Extent> extents;
+    detail::Vector<std::uint32_t> in_tree, surrounding, roots;
     ExtentTree tree;
     sort_detail::SupportScan scan = &sort_detail::support_scan_reference;
     const glm::mat4* transforms = nullptr;
@@ -75,18 +100,18 @@ struct VisibilitySorter::State {
     double margin_scale = 0;
 
     // Tarjan's state and stacks.
-    std::vector<std::uint32_t> index, low;
+    detail::Vector<std::uint32_t> index, low;
     std::uint32_t next_index = 0;
-    std::vector<std::uint8_t> visit;
-    std::vector<std::uint32_t> component_stack;
+    detail::Vector<std::uint8_t> visit;
+    detail::Vector<std::uint32_t> component_stack;
     struct Frame {
         std::uint32_t object;
         std::uint32_t begin, next, end;  // its candidates: [begin, end) of `candidates`
     };
-    std::vector<Frame> frames;
-    std::vector<std::uint32_t> candidates;
+    detail::Vector<Frame> frames;
+    detail::Vector<std::uint32_t> candidates;
 
-    std::vector<std::uint32_t> last_order;
+    detail::Vector<std::uint32_t> last_order;
     bool has_last_order = false;
     VisibilitySort result;
 
@@ -141,13 +166,11 @@ struct DistanceRange {
     float nearest, farthest;
 };
 
-// Distances from the eye to an object's bounding box (the model-space box of half sides
-// `half` about the point that becomes `centre`, through the affine transform m): the
+// Distances from the eye to an object's bounding box (centre +- the three half axes): the
 // farthest corner exactly, and for the nearest a lower bound, the largest distance to one of
 // the box's three slabs (the box is their intersection). Tighter than the bounding sphere's
 // for long thin objects.
-DistanceRange box_distances(const glm::mat4& m, const glm::vec3& half, const glm::vec3& centre, const glm::vec3& eye) {
-    const glm::vec3 axis[3] = {glm::vec3(m[0]) * half.x, glm::vec3(m[1]) * half.y, glm::vec3(m[2]) * half.z};
+DistanceRange box_distances(const glm::vec3 (&axis)[3], const glm::vec3& centre, const glm::vec3& eye) {
     const glm::vec3 to_eye = eye - centre;
     DistanceRange r{0.0f, 0.0f};
     for (int corner = 0; corner < 8; ++corner) {
@@ -193,7 +216,9 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
         const glm::vec3 offset = p.centre - e;
         const float distance = glm::length(offset);
         const float tolerance = 1e-6f * (glm::length(p.centre) + glm::length(e) + p.radius);
-        const DistanceRange to_box = box_distances(m, shape_half[s], p.centre, e);
+        const glm::vec3& half = shape_half[s];
+        p.half_axis[0] = glm::vec3(m[0]) * half.x, p.half_axis[1] = glm::vec3(m[1]) * half.y, p.half_axis[2] = glm::vec3(m[2]) * half.z;
+        const DistanceRange to_box = box_distances(p.half_axis, p.centre, e);
         p.farthest = std::min(distance + p.radius, to_box.farthest + tolerance);
         Extent& box = extents[i];
         p.surrounds_eye = !(distance > p.radius);
@@ -240,6 +265,7 @@ bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) 
     // A part in 10^6 of the scene's reach from the origin: the float roundings of the points
     // here and of the ground truth's (which places vertices in double, then rounds).
     const double margin = 1e-6 * margin_scale;
+    if (parted_on_box_axes(f, b, glm::vec3(eye), float(margin))) return false;
     const glm::dvec3 start = glm::dvec3(f.centre) - glm::dvec3(b.centre);
     ++result.stats.box_tests;
     if (!sort_detail::may_occlude(box(front), box(back), eye, margin, start)) return false;
@@ -369,16 +395,20 @@ const VisibilitySort& VisibilitySorter::sort(const SortFrame& frame) {
     return r;
 }
 
-VisibilitySorter::VisibilitySorter(std::vector<std::vector<glm::vec3>> hull_points, std::vector<std::uint32_t> object_shapes)
-    : state_(std::make_unique<State>()) {
+VisibilitySorter::VisibilitySorter(const HullPoints* shapes, std::size_t shape_count, const std::uint32_t* object_shapes,
+                                   std::size_t object_count)
+    : state_(detail::make_hooked<State>()) {
+    if ((shape_count > 0 && !shapes) || (object_count > 0 && !object_shapes)) throw Error("VisibilitySorter: null shapes or objects");
+    if (object_count >= std::size_t(UINT32_MAX)) throw Error("VisibilitySorter: more than 2^32 - 1 objects");
     State& s = *state_;
     // The instruction set of buffers made now (select_isa's default): the same answers on all.
     s.scan = sort_detail::support_scan_for(detail::default_isa_choice());
-    for (std::size_t k = 0; k < hull_points.size(); ++k) {
-        const auto& points = hull_points[k];
-        if (points.empty()) throw Error("VisibilitySorter: shape " + std::to_string(k) + " has no points");
+    for (std::size_t k = 0; k < shape_count; ++k) {
+        const glm::vec3* points = shapes[k].points;
+        const std::size_t count = shapes[k].count;
+        if (count == 0 || !points) throw Error("VisibilitySorter: shape " + std::to_string(k) + " has no points");
         glm::vec3 lo(points[0]), hi(points[0]);
-        for (std::size_t i = 0; i < points.size(); ++i) {
+        for (std::size_t i = 0; i < count; ++i) {
             if (!finite(points[i]))
                 throw Error("VisibilitySorter: shape " + std::to_string(k) + ", point " + std::to_string(i) + " is not finite");
             lo = glm::min(lo, points[i]), hi = glm::max(hi, points[i]);
@@ -386,8 +416,9 @@ VisibilitySorter::VisibilitySorter(std::vector<std::vector<glm::vec3>> hull_poin
         const glm::vec3 centre = 0.5f * (lo + hi);
         float radius = 0;
         s.shape_first.push_back(std::uint32_t(s.x.size()));
-        s.shape_count.push_back(std::uint32_t(points.size()));
-        for (const glm::vec3& p : points) {
+        s.shape_count.push_back(std::uint32_t(count));
+        for (std::size_t i = 0; i < count; ++i) {
+            const glm::vec3& p = points[i];
             radius = std::max(radius, glm::length(p - centre));
             s.x.push_back(p.x), s.y.push_back(p.y), s.z.push_back(p.z);
         }
@@ -400,19 +431,31 @@ VisibilitySorter::VisibilitySorter(std::vector<std::vector<glm::vec3>> hull_poin
         }
         s.shape_radius.push_back(radius * (1.0f + 1e-6f));
     }
-    for (std::size_t i = 0; i < object_shapes.size(); ++i) {
-        if (object_shapes[i] >= hull_points.size())
+    for (std::size_t i = 0; i < object_count; ++i) {
+        if (object_shapes[i] >= shape_count)
             throw Error("VisibilitySorter: object " + std::to_string(i) + " names shape " + std::to_string(object_shapes[i]) +
-                        ", but there are " + std::to_string(hull_points.size()));
+                        ", but there are " + std::to_string(shape_count));
     }
-    s.object_shape = std::move(object_shapes);
-    const std::size_t n = s.object_shape.size();
-    s.placed.resize(n);
-    s.extents.resize(n);
-    s.index.resize(n);
-    s.low.resize(n);
-    s.visit.resize(n);
+    s.object_shape.assign(object_shapes, object_shapes + object_count);
+    s.placed.resize(object_count);
+    s.extents.resize(object_count);
+    s.index.resize(object_count);
+    s.low.resize(object_count);
+    s.visit.resize(object_count);
 }
+
+namespace {
+
+detail::Vector<HullPoints> views_of(const std::vector<std::vector<glm::vec3>>& shapes) {
+    detail::Vector<HullPoints> views;
+    for (const auto& shape : shapes) views.push_back({shape.data(), shape.size()});
+    return views;
+}
+
+}  // namespace
+
+VisibilitySorter::VisibilitySorter(const std::vector<std::vector<glm::vec3>>& shapes, const std::vector<std::uint32_t>& object_shapes)
+    : VisibilitySorter(views_of(shapes).data(), shapes.size(), object_shapes.data(), object_shapes.size()) {}
 
 VisibilitySorter::~VisibilitySorter() = default;
 VisibilitySorter::VisibilitySorter(VisibilitySorter&&) noexcept = default;

@@ -17,6 +17,8 @@
 //
 // No allocation per frame once the sorter has seen its largest frame; one sorter is not
 // thread-safe (sort from one thread at a time), but sorters are independent.
+#include <homcull/detail/memory.hpp>
+
 #include <glm/glm.hpp>
 
 #include <cstddef>
@@ -31,7 +33,7 @@ namespace homcull {
 // with no volume (fewer than four points, or all on one plane or line) come back with their
 // duplicates removed but otherwise whole, which holds their hull too. Throws homcull::Error
 // naming the first point that is not finite.
-std::vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t count);
+detail::Vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t count);
 
 // One layer of a sort: objects [first, first + count) of VisibilitySort::order.
 struct SortLayer {
@@ -60,11 +62,12 @@ struct VisibilitySortStats {
     double extents_ms = 0, tree_ms = 0, order_ms = 0, total_ms = 0;
 };
 
-// A sort's answer; it lives in the sorter until its next sort.
+// A sort's answer; it lives in the sorter until its next sort. (detail::Vector: std::vector
+// with the allocator of the sorter's memory, homcull/detail/memory.hpp.)
 struct VisibilitySort {
-    std::vector<std::uint32_t> order;  // the sorted objects, front to back, layer after layer
-    std::vector<SortLayer> layers;     // front to back
-    std::vector<OcclusionPair> pairs;  // the occlusions the tests found (not all of the graph:
+    detail::Vector<std::uint32_t> order;  // the sorted objects, front to back, layer after layer
+    detail::Vector<SortLayer> layers;     // front to back
+    detail::Vector<OcclusionPair> pairs;  // the occlusions the tests found (not all of the graph:
                                        // pairs the order already settled are not tested)
     VisibilitySortStats stats;
 };
@@ -86,13 +89,21 @@ struct SortFrame {
     bool incremental = true;
 };
 
+// A shape's points (model space), whose convex hull holds its mesh (see convex_hull_points;
+// any set holding the mesh is correct, a smaller one faster).
+struct HullPoints {
+    const glm::vec3* points = nullptr;
+    std::size_t count = 0;
+};
+
 class VisibilitySorter {
 public:
-    // hull_points[s]: shape s's points (model space), whose convex hull holds its mesh (see
-    // convex_hull_points; any set holding the mesh is correct, a smaller one faster).
-    // object_shapes[i]: object i's shape. Throws homcull::Error on a shape index out of range,
-    // an empty shape, or a point that is not finite.
-    VisibilitySorter(std::vector<std::vector<glm::vec3>> hull_points, std::vector<std::uint32_t> object_shapes);
+    // shapes[s]: shape s's points (copied). object_shapes[i]: object i's shape. Throws
+    // homcull::Error on a shape index out of range, an empty shape, or a point that is not
+    // finite. Everything the sorter holds comes from the memory hooks current here
+    // (homcull/detail/memory.hpp; operator new by default).
+    VisibilitySorter(const HullPoints* shapes, std::size_t shape_count, const std::uint32_t* object_shapes, std::size_t object_count);
+    VisibilitySorter(const std::vector<std::vector<glm::vec3>>& shapes, const std::vector<std::uint32_t>& object_shapes);
     ~VisibilitySorter();
     VisibilitySorter(VisibilitySorter&&) noexcept;
     VisibilitySorter& operator=(VisibilitySorter&&) noexcept;
@@ -114,7 +125,7 @@ public:
 
 private:
     struct State;
-    std::unique_ptr<State> state_;
+    detail::HookPtr<State> state_;
 };
 
 }  // namespace homcull
