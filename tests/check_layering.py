@@ -17,7 +17,7 @@ USES = {
     "raster": {"common"},
     "buffer": {"common", "raster"},
     "hom": {"common", "raster", "buffer"},
-    "capi": {"common", "raster", "buffer"},
+    "capi": {"common", "raster", "buffer", "sort"},
     "sort": {"common"},
     "scene": {"common", "raster", "buffer", "hom", "sort"},
     "tbb": {"common"},

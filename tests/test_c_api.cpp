@@ -537,6 +537,67 @@ TEST(CApi, OutOfMemoryAtEveryAllocation) {
 
 namespace {
 
+// The sorter: a cube mesh placed three times along -z, seen from the origin: nearest first;
+// from behind, the reverse; errors are results; an object with a NaN matrix is left out.
+TEST(CApi, SorterOrdersObjectsAndReportsErrors) {
+    homcull_context* context = make_context();
+    std::vector<float> cube;
+    for (int k = 0; k < 8; ++k) cube.insert(cube.end(), {(k & 1) ? 1.f : -1.f, (k & 2) ? 1.f : -1.f, (k & 4) ? 1.f : -1.f});
+    const std::uint32_t faces[36] = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+    homcull_mesh_desc md{};
+    md.positions = cube.data();
+    md.position_stride = 3 * sizeof(float);
+    md.vertex_count = 8;
+    md.indices = faces;
+    md.index_size = 4;
+    md.triangle_count = 12;
+    homcull_mesh* mesh = nullptr;
+    ASSERT_EQ(homcull_mesh_create(context, &md, &mesh), HOMCULL_OK) << homcull_last_error();
+    const homcull_mesh* meshes[3] = {mesh, mesh, mesh};
+    homcull_sorter_desc sd{meshes, 3};
+    homcull_sorter* sorter = nullptr;
+    ASSERT_EQ(homcull_sorter_create(context, &sd, &sorter), HOMCULL_OK) << homcull_last_error();
+    // Row-major translations to z = -20, -5 and -10.
+    float matrices[48] = {};
+    const float z[3] = {-20, -5, -10};
+    for (int i = 0; i < 3; ++i) {
+        for (int d = 0; d < 4; ++d) matrices[16 * i + 5 * d] = 1.0f;
+        matrices[16 * i + 11] = z[i];
+    }
+    homcull_sort_frame frame{};
+    frame.model_matrices = matrices;
+    frame.layout = HOMCULL_ROW_MAJOR;
+    homcull_sort_result result{};
+    ASSERT_EQ(homcull_sorter_sort(sorter, &frame, &result), HOMCULL_OK) << homcull_last_error();
+    ASSERT_EQ(result.order_count, 3u);
+    EXPECT_EQ(std::vector<std::uint32_t>(result.order, result.order + 3), (std::vector<std::uint32_t>{1, 2, 0}));
+    ASSERT_EQ(result.layer_count, 3u);
+    EXPECT_EQ(result.cycles, 0u);
+    EXPECT_EQ(result.pair_count, 0u);  // the nearest-first start already holds: nothing tested true
+    frame.eye[2] = -40.0f;
+    ASSERT_EQ(homcull_sorter_sort(sorter, &frame, &result), HOMCULL_OK);
+    EXPECT_EQ(std::vector<std::uint32_t>(result.order, result.order + 3), (std::vector<std::uint32_t>{0, 2, 1}));
+    EXPECT_GT(result.pair_count, 0u);  // last frame's order no longer held
+
+    matrices[3] = NAN;  // object 0 leaves
+    ASSERT_EQ(homcull_sorter_sort(sorter, &frame, &result), HOMCULL_OK);
+    EXPECT_EQ(result.order_count, 2u);
+    frame.layout = 7;
+    EXPECT_EQ(homcull_sorter_sort(sorter, &frame, &result), HOMCULL_ERROR_INVALID_ARGUMENT);
+    frame.layout = HOMCULL_ROW_MAJOR;
+    frame.plane_count = 17;
+    EXPECT_EQ(homcull_sorter_sort(sorter, &frame, &result), HOMCULL_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(homcull_sorter_sort(sorter, nullptr, &result), HOMCULL_ERROR_INVALID_ARGUMENT);
+    const homcull_mesh* none[1] = {nullptr};
+    homcull_sorter_desc bad{none, 1};
+    homcull_sorter* refused = nullptr;
+    EXPECT_EQ(homcull_sorter_create(context, &bad, &refused), HOMCULL_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(refused, nullptr);
+    homcull_sorter_destroy(sorter);
+    homcull_mesh_destroy(mesh);
+    homcull_context_destroy(context);
+}
+
 TEST(CApi, CppLayerOwnsItsHandles) {
     const Scene scene;
     EngineMemory memory;

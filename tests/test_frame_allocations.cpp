@@ -294,5 +294,93 @@ TEST(FrameAllocations, VisibilitySortNoneAfterWarmUp) {
     EXPECT_GT(sorted, 0u);
 }
 
+// The C interface's sorter: every byte from the engine's allocator, from creation (the hulls)
+// to the last sort, and its answers those of the C++ sorter over the same hulls.
+TEST(FrameAllocations, CInterfaceSorterTakesEveryByteFromTheEngine) {
+    ToothpickOptions options;
+    options.count = 150;
+    const Scene scene = generate_toothpicks(options, 0);
+    const Mesh& mesh = scene.meshes[0];
+    struct Engine {
+        std::size_t calls = 0, live = 0;
+    } engine;
+    homcull_context_desc desc{};
+    desc.allocator.allocate = [](void* user, std::size_t size, std::size_t alignment) -> void* {
+        auto& e = *static_cast<Engine*>(user);
+        ++e.calls, ++e.live;
+        return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+    };
+    desc.allocator.deallocate = [](void* user, void* p, std::size_t) {
+        --static_cast<Engine*>(user)->live;
+        std::free(p);
+    };
+    desc.allocator.user = &engine;
+    std::vector<std::vector<float>> matrices(4, std::vector<float>(16 * scene.objects.size()));
+    for (std::size_t f = 0; f < matrices.size(); ++f)
+        for (int i = 0; i < options.count; ++i) {
+            const glm::mat4 m(toothpick_transform(options, i, int(f)));
+            for (int k = 0; k < 16; ++k) matrices[f][16 * std::size_t(i) + std::size_t(k)] = m[k / 4][k % 4];
+        }
+    // The test's own containers are made before counting starts.
+    std::vector<std::vector<std::uint32_t>> orders(matrices.size(), std::vector<std::uint32_t>(scene.objects.size() + 1));
+    std::vector<const homcull_mesh*> object_meshes(scene.objects.size());
+    const std::size_t global = allocations_of([&] {
+        homcull_context* context = nullptr;
+        ASSERT_EQ(homcull_context_create(&desc, &context), HOMCULL_OK);
+        homcull_mesh_desc md{};
+        md.positions = &mesh.positions[0].x;
+        md.position_stride = 3 * sizeof(float);
+        md.vertex_count = mesh.positions.size();
+        md.indices = mesh.indices.data();
+        md.index_size = 4;
+        md.triangle_count = mesh.triangle_count();
+        homcull_mesh* m = nullptr;
+        ASSERT_EQ(homcull_mesh_create(context, &md, &m), HOMCULL_OK);
+        std::fill(object_meshes.begin(), object_meshes.end(), m);
+        homcull_sorter_desc sd{object_meshes.data(), object_meshes.size()};
+        homcull_sorter* sorter = nullptr;
+        ASSERT_EQ(homcull_sorter_create(context, &sd, &sorter), HOMCULL_OK) << homcull_last_error();
+        for (int round = 0; round < 2; ++round)
+            for (std::size_t f = 0; f < matrices.size(); ++f) {
+                homcull_sort_frame frame{};
+                frame.model_matrices = matrices[f].data();
+                frame.layout = HOMCULL_COLUMN_MAJOR;
+                frame.eye[1] = 3.0f, frame.eye[2] = 22.0f;
+                homcull_sort_result result{};
+                ASSERT_EQ(homcull_sorter_sort(sorter, &frame, &result), HOMCULL_OK) << homcull_last_error();
+                ASSERT_LE(result.order_count, scene.objects.size());
+                if (round == 1) {  // the order, then a count past its end
+                    std::copy(result.order, result.order + result.order_count, orders[f].begin());
+                    orders[f].back() = std::uint32_t(result.order_count);
+                }
+            }
+        homcull_sorter_destroy(sorter);
+        homcull_mesh_destroy(m);
+        homcull_context_destroy(context);
+    });
+    EXPECT_EQ(global, 0u);
+    EXPECT_EQ(engine.live, 0u);
+    for (auto& order : orders) order.resize(order.back());
+
+    // The C++ sorter, over the hull of the same vertices, gives the same orders.
+    const auto hull = convex_hull_points(mesh.positions.data(), mesh.positions.size());
+    const HullPoints shape{hull.data(), hull.size()};
+    const std::vector<std::uint32_t> shapes(scene.objects.size(), 0);
+    VisibilitySorter sorter(&shape, 1, shapes.data(), shapes.size());
+    for (int round = 0; round < 2; ++round)
+        for (std::size_t f = 0; f < matrices.size(); ++f) {
+            std::vector<glm::mat4> transforms(scene.objects.size());
+            for (std::size_t i = 0; i < transforms.size(); ++i)
+                for (int k = 0; k < 16; ++k) transforms[i][k / 4][k % 4] = matrices[f][16 * i + std::size_t(k)];
+            SortFrame frame;
+            frame.transforms = transforms.data();
+            frame.eye = {0.0f, 3.0f, 22.0f};
+            const VisibilitySort& sort = sorter.sort(frame);
+            if (round == 1) {
+                EXPECT_EQ(std::vector<std::uint32_t>(sort.order.begin(), sort.order.end()), orders[f]) << "frame " << f;
+            }
+        }
+}
+
 }  // namespace
 }  // namespace homcull

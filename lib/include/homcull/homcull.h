@@ -346,6 +346,58 @@ typedef struct homcull_frame_stats {
 } homcull_frame_stats;
 HOMCULL_API homcull_result homcull_buffer_frame_stats(const homcull_buffer* buffer, homcull_frame_stats* stats);
 
+/* ---- Visibility sorting ------------------------------------------------------------------------- */
+
+/* Orders objects front to back so that none hides part of one before it, with the occlusion
+ * cycles no order can draw grouped into layers (Snyder and Lengyel's incremental visibility
+ * sort; docs/visibility-sorting.md). Each object is the convex hull of a mesh's vertices, made
+ * when the sorter is created; a frame gives each object's model matrix and the eye. Answers are
+ * conservative for the hulls: no object ever hides part of one in an earlier layer. A sorter is
+ * used from one thread at a time; sorters are independent. No allocation per frame once a
+ * sorter has seen its busiest frame. */
+typedef struct homcull_sorter homcull_sorter;
+
+typedef struct homcull_sorter_desc {
+    const homcull_mesh* const* object_meshes;  /* object i's mesh (one hull per distinct mesh) */
+    size_t object_count;
+} homcull_sorter_desc;
+
+HOMCULL_API homcull_result homcull_sorter_create(homcull_context* context, const homcull_sorter_desc* desc, homcull_sorter** out);
+HOMCULL_API void homcull_sorter_destroy(homcull_sorter* sorter);
+
+typedef struct homcull_sort_frame {
+    const float* model_matrices;        /* object_count matrices, 16 floats each, in `layout` */
+    homcull_matrix_layout layout;
+    float eye[3];                       /* in the world of the model matrices */
+    const float* planes;                /* plane_count planes (a, b, c, d): a x + b y + c z + d >= 0
+                                           inside; objects wholly outside one are left out; may be null */
+    uint32_t plane_count;               /* at most 16 (the view frustum's six, say) */
+    uint32_t from_scratch;              /* nonzero: not from the last frame's order (same layers) */
+} homcull_sort_frame;
+
+typedef struct homcull_sort_layer {
+    uint32_t first, count;              /* objects order[first, first + count) */
+} homcull_sort_layer;
+
+typedef struct homcull_occlusion_pair {
+    uint32_t occluder, occluded;
+} homcull_occlusion_pair;
+
+/* A sort's answer, valid until the sorter's next sort or its destruction. */
+typedef struct homcull_sort_result {
+    const uint32_t* order;              /* the sorted objects (left out ones are not), front to back */
+    size_t order_count;
+    const homcull_sort_layer* layers;   /* front to back; a layer of more than one is a cycle */
+    size_t layer_count;
+    const homcull_occlusion_pair* pairs;/* the occlusions its tests found */
+    size_t pair_count;
+    uint32_t cycles;                    /* layers of more than one object */
+    uint32_t objects_in_cycles;
+} homcull_sort_result;
+
+/* Objects whose matrix is not finite are left out. */
+HOMCULL_API homcull_result homcull_sorter_sort(homcull_sorter* sorter, const homcull_sort_frame* frame, homcull_sort_result* out);
+
 /* ---- Layout checks: the sizes both sides of the interface agree on ---------------------------- */
 
 #define HOMCULL_CHECK_SIZE_(name, type, size) typedef char homcull_size_check_##name[(sizeof(type) == (size)) ? 1 : -1]
@@ -360,6 +412,11 @@ HOMCULL_CHECK_SIZE_(mesh_desc, homcull_mesh_desc, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(triangles, homcull_triangles, 5 * sizeof(void*) + 8);
 HOMCULL_CHECK_SIZE_(reserve_desc, homcull_reserve_desc, 16 + 4 * sizeof(size_t));
 HOMCULL_CHECK_SIZE_(job_system, homcull_job_system, 2 * sizeof(void*) + 8);
+HOMCULL_CHECK_SIZE_(sorter_desc, homcull_sorter_desc, 2 * sizeof(void*));
+HOMCULL_CHECK_SIZE_(sort_frame, homcull_sort_frame, 2 * sizeof(void*) + 24);
+HOMCULL_CHECK_SIZE_(sort_layer, homcull_sort_layer, 8);
+HOMCULL_CHECK_SIZE_(occlusion_pair, homcull_occlusion_pair, 8);
+HOMCULL_CHECK_SIZE_(sort_result, homcull_sort_result, 6 * sizeof(void*) + 8);
 
 #ifdef __cplusplus
 }
