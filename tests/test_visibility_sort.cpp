@@ -135,6 +135,42 @@ TEST(ConvexHull, KeepsTheCornersAndDropsWhatIsInside) {
     EXPECT_TRUE(convex_hull_points(nullptr, 0).empty());
 }
 
+// A hull of at most N points holds every point: along 500 directions its support reaches at
+// least as far as the points' (a hull holds a point when no direction separates them). The
+// same points in another order give the same hull.
+TEST(ConvexHull, LimitedHullsHoldEveryPoint) {
+    std::vector<glm::vec3> points;
+    std::uint64_t state = 7;
+    const auto uniform = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return float(double(state >> 11) / 9007199254740992.0) * 2.0f - 1.0f;
+    };
+    for (int k = 0; k < 3000; ++k) {  // a long, thin, lumpy ellipsoid's surface, off the origin
+        glm::vec3 d(uniform(), uniform(), uniform());
+        d = glm::normalize(d) * (1.0f + 0.05f * uniform());
+        points.push_back(glm::vec3(100.0f, -40.0f, 7.0f) + d * glm::vec3(4.0f, 0.3f, 0.5f));
+    }
+    const auto exact = convex_hull_points(points.data(), points.size());
+    for (const std::size_t limit : {std::size_t(8), std::size_t(16), std::size_t(64)}) {
+        const auto limited = convex_hull_points(points.data(), points.size(), limit);
+        ASSERT_LE(limited.size(), limit);
+        ASSERT_LT(limited.size(), exact.size());
+        float worst = 0.0f;  // how much farther the limited hull reaches, at most
+        for (int k = 0; k < 500; ++k) {
+            const glm::vec3 d = glm::normalize(glm::vec3(uniform(), uniform(), uniform()));
+            float reach = -1e30f, held = -1e30f;
+            for (const glm::vec3& p : points) reach = std::max(reach, glm::dot(p, d));
+            for (const glm::vec3& p : limited) held = std::max(held, glm::dot(p, d));
+            EXPECT_GE(held, reach) << limit << " points";
+            worst = std::max(worst, held - reach);
+        }
+        EXPECT_LT(worst, limit >= 64 ? 0.5f : 4.0f) << limit << " points: grown too much, " << worst;  // of a length of 8
+        std::vector<glm::vec3> reversed(points.rbegin(), points.rend());
+        const auto again = convex_hull_points(reversed.data(), reversed.size(), limit);
+        EXPECT_EQ(std::vector<glm::vec3>(again.begin(), again.end()), std::vector<glm::vec3>(limited.begin(), limited.end()));
+    }
+}
+
 // Three sticks in a triangle, each over the next where they cross (the classic cycle of three
 // pencils): no two of them form a cycle, yet no order of the three is right. One layer.
 TEST(VisibilitySort, ThreeOverlappingSticksAreOneLayer) {

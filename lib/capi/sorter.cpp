@@ -50,7 +50,7 @@ homcull_result homcull_sorter_create(homcull_context* context, const homcull_sor
             detail::Vector<glm::vec3> points;
             for (std::size_t k = 0; k + 2 < xyz.size(); k += 3) points.emplace_back(xyz[k], xyz[k + 1], xyz[k + 2]);
             if (points.empty()) points.emplace_back(0.0f);
-            hulls.push_back(convex_hull_points(points.data(), points.size()));
+            hulls.push_back(convex_hull_points(points.data(), points.size(), kSortHullPoints));
             views.push_back({hulls.back().data(), hulls.back().size()});
         }
         detail::Vector<std::uint32_t> shapes(n);

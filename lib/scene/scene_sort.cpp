@@ -6,7 +6,7 @@
 
 namespace homcull {
 
-VisibilitySorter make_visibility_sorter(const Scene& scene) {
+VisibilitySorter make_visibility_sorter(const Scene& scene, std::size_t hull_points) {
     std::vector<detail::Vector<glm::vec3>> hulls;
     hulls.reserve(scene.meshes.size());
     std::vector<glm::vec3> used;
@@ -21,7 +21,7 @@ VisibilitySorter make_visibility_sorter(const Scene& scene) {
             if (!seen[i]) seen[i] = 1, used.push_back(mesh.positions[i]);
         }
         if (used.empty()) used.emplace_back(0.0f);
-        hulls.push_back(convex_hull_points(used.data(), used.size()));
+        hulls.push_back(convex_hull_points(used.data(), used.size(), hull_points));
     }
     std::vector<HullPoints> views;
     for (const auto& hull : hulls) views.push_back({hull.data(), hull.size()});

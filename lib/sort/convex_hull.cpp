@@ -47,6 +47,13 @@ public:
         return collect(vertices);
     }
 
+    // The hull's faces as (outward unit normal, offset): dot(normal, p) <= offset inside.
+    void faces(detail::Vector<glm::dvec4>& out) const {
+        out.clear();
+        for (const HullFace& face : faces_)
+            if (face.alive) out.emplace_back(face.normal, face.offset);
+    }
+
 private:
     const detail::Vector<glm::dvec3>& p_;
     double eps_;
@@ -215,6 +222,89 @@ private:
     bool broken_ = false;
 };
 
+// Points within this of a face count as on it: a few float roundings of the largest
+// coordinate, far below what the sort's tests resolve.
+double hull_tolerance(const detail::Vector<glm::dvec3>& p) {
+    double extent = 0.0;
+    for (const glm::dvec3& q : p) extent = std::max({extent, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+    return 1e-12 + extent * 1e-9;
+}
+
+// Whether every point lies inside the faces (dot(normal, p) <= offset), and the least factor
+// by which the hull, grown about `centre`, holds them all.
+double needed_growth(const detail::Vector<glm::dvec4>& faces, const detail::Vector<glm::dvec3>& points, const glm::dvec3& centre) {
+    double growth = 1.0;
+    for (const glm::dvec4& f : faces) {
+        const glm::dvec3 n(f);
+        const double room = f.w - glm::dot(n, centre);
+        if (!(room > 0.0)) return -1.0;  // the centre is not inside
+        for (const glm::dvec3& q : points) growth = std::max(growth, glm::dot(n, q - centre) / room);
+    }
+    return growth;
+}
+
+// At most `limit` points whose hull holds all of `hull` (the vertices of a convex hull): that
+// many of them spread by farthest-point sampling (in the box's unit coordinates, so that a thin
+// object keeps points around its girth), their hull grown about its centroid until it holds
+// every vertex, and checked again after the rounding to float. Empty when that fails.
+detail::Vector<glm::vec3> grown_hull(detail::Vector<glm::vec3> hull, std::size_t limit) {
+    // In a fixed order, so that the same points given in any order make the same hull.
+    std::sort(hull.begin(), hull.end(), [](const glm::vec3& a, const glm::vec3& b) {
+        return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+    });
+    glm::dvec3 lo(hull[0]), hi(hull[0]);
+    for (const glm::vec3& v : hull) lo = glm::min(lo, glm::dvec3(v)), hi = glm::max(hi, glm::dvec3(v));
+    const glm::dvec3 middle = 0.5 * (lo + hi);
+    const double largest = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    const glm::dvec3 half = glm::max(0.5 * (hi - lo), glm::dvec3(1e-6 * largest + 1e-30));
+    detail::Vector<glm::dvec3> unit;  // the vertices in the box's unit coordinates
+    unit.reserve(hull.size());
+    for (const glm::vec3& v : hull) unit.push_back((glm::dvec3(v) - middle) / half);
+
+    detail::Vector<std::uint32_t> chosen;
+    detail::Vector<double> gap(unit.size(), 0.0);  // each vertex's distance to the chosen ones
+    std::uint32_t next = 0;
+    for (std::uint32_t i = 1; i < unit.size(); ++i)
+        if (glm::dot(unit[i], unit[i]) > glm::dot(unit[next], unit[next])) next = i;
+    for (std::uint32_t i = 0; i < unit.size(); ++i) gap[i] = glm::distance(unit[i], unit[next]);
+    chosen.push_back(next);
+    while (chosen.size() < limit) {
+        next = std::uint32_t(std::max_element(gap.begin(), gap.end()) - gap.begin());
+        if (!(gap[next] > 0.0)) break;
+        chosen.push_back(next);
+        for (std::uint32_t i = 0; i < unit.size(); ++i) gap[i] = std::min(gap[i], glm::distance(unit[i], unit[next]));
+    }
+    detail::Vector<glm::dvec3> base;
+    for (std::uint32_t i : chosen) base.push_back(unit[i]);
+    detail::Vector<std::uint32_t> base_vertices;
+    Quickhull base_hull(base, hull_tolerance(base));
+    if (!base_hull.run(base_vertices)) return {};
+    detail::Vector<glm::dvec4> faces;
+    base_hull.faces(faces);
+    glm::dvec3 centre(0.0);
+    for (const glm::dvec3& b : base) centre += b / double(base.size());
+    double growth = needed_growth(faces, unit, centre);
+    if (growth < 1.0) return {};
+
+    // Grown a little more than needed, rounded to float, then checked in model coordinates; a
+    // few more tries with more room when the rounding took a vertex out.
+    detail::Vector<glm::dvec3> model(hull.begin(), hull.end());
+    for (int attempt = 0; attempt < 4; ++attempt) {
+        growth *= 1.0 + 1e-5 * double(1 << (4 * attempt));
+        detail::Vector<glm::vec3> out;
+        for (std::uint32_t i : base_vertices) out.push_back(glm::vec3(middle + half * (centre + growth * (base[i] - centre))));
+        detail::Vector<glm::dvec3> placed(out.begin(), out.end());
+        detail::Vector<std::uint32_t> kept;
+        Quickhull check(placed, hull_tolerance(placed));
+        if (!check.run(kept)) return {};
+        check.faces(faces);
+        glm::dvec3 inside(0.0);
+        for (const glm::dvec3& q : placed) inside += q / double(placed.size());
+        if (needed_growth(faces, model, inside) <= 1.0) return out;
+    }
+    return {};
+}
+
 }  // namespace
 
 detail::Vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t count) {
@@ -248,17 +338,19 @@ detail::Vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_
     if (distinct.size() < 5) return distinct;
 
     detail::Vector<glm::dvec3> p(distinct.begin(), distinct.end());
-    double extent = 0.0;
-    for (const glm::dvec3& q : p) extent = std::max({extent, std::abs(q.x), std::abs(q.y), std::abs(q.z)});
-    // Points within this of a face count as on it: a few float roundings of the largest
-    // coordinate, far below what the sort's tests resolve.
-    const double tolerance = 1e-12 + extent * 1e-9;
     detail::Vector<std::uint32_t> vertices;
-    if (!Quickhull(p, tolerance).run(vertices)) return distinct;
+    if (!Quickhull(p, hull_tolerance(p)).run(vertices)) return distinct;
     detail::Vector<glm::vec3> hull;
     hull.reserve(vertices.size());
     for (std::uint32_t i : vertices) hull.push_back(distinct[i]);
     return hull;
+}
+
+detail::Vector<glm::vec3> convex_hull_points(const glm::vec3* points, std::size_t count, std::size_t max_points) {
+    detail::Vector<glm::vec3> exact = convex_hull_points(points, count);
+    if (max_points == 0 || exact.size() <= std::max<std::size_t>(max_points, 8)) return exact;
+    detail::Vector<glm::vec3> grown = grown_hull(exact, std::max<std::size_t>(max_points, 8));
+    return grown.empty() ? exact : grown;
 }
 
 }  // namespace homcull

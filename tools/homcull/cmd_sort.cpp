@@ -35,6 +35,7 @@ struct SortCommandOptions {
     bool all_directions = false;
     bool from_scratch = false;
     int rounds = 5;
+    std::size_t hull_points = kSortHullPoints;
     bool check = false;
     bool json = false;
 };
@@ -126,7 +127,7 @@ void run_sort(const SortCommandOptions& o) {
     const SortFrames frames = choose_frames(o, scene, rays.get());
 
     long long start = now_ns();
-    VisibilitySorter sorter = make_visibility_sorter(scene);
+    VisibilitySorter sorter = make_visibility_sorter(scene, o.hull_points);
     const double hull_ms = elapsed_ms(start);
 
     // Every frame's input made before any is timed (a moving scene is made again per frame).
@@ -289,6 +290,8 @@ void register_sort(CLI::App& app) {
     cmd->add_flag("--all-directions", o->all_directions, "Sort every object, not only those in the view frustum (the paper's setting)");
     cmd->add_flag("--from-scratch", o->from_scratch, "Sort each frame from scratch, not from the last frame's order");
     cmd->add_option("--rounds", o->rounds, "Runs over all the frames; each frame's time is the median")->capture_default_str();
+    cmd->add_option("--hull-points", o->hull_points, "At most N points per hull, grown to hold the mesh (0: exact hulls)")
+        ->capture_default_str();
     cmd->add_flag("--check", o->check, "Check every frame's layers against Embree's occlusion edges (every hit along each pixel's ray)");
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o, cmd] {

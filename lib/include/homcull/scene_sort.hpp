@@ -13,7 +13,8 @@ namespace homcull {
 // A sorter over the scene's objects: each mesh's hull (of the vertices its triangles use; a
 // mesh with none gets its one vertex at the model origin, a point never in front of anything
 // but the eye), object i's shape being its mesh. Throws homcull::Error on a non-finite vertex.
-VisibilitySorter make_visibility_sorter(const Scene& scene);
+// hull_points: the limit of convex_hull_points (0: exact hulls).
+VisibilitySorter make_visibility_sorter(const Scene& scene, std::size_t hull_points = kSortHullPoints);
 
 // Object i's model-to-world transform relative to `origin` (translate(-origin) * world, in
 // double, then rounded to float), into `out` (resized to the object count).
