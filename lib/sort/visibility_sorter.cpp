@@ -306,6 +306,9 @@ void VisibilitySorter::State::visit_from(std::uint32_t root) {
         if (f.next < f.end) {
             const std::uint32_t w = candidates[f.next++];
             if (w == v || visit[w] == kDone) continue;
+            // An edge to an object on the stack matters only when it lowers v's low link: in a
+            // large cycle most of them cannot, and their tests are skipped.
+            if (visit[w] == kOnStack && index[w] >= low[v]) continue;
             if (!may_hide(w, v)) continue;
             result.pairs.push_back({w, v});
             if (visit[w] == kUnvisited) {
