@@ -298,6 +298,47 @@ TEST(VisibilitySort, IncrementalSortsAgreeWithSortsFromScratchOnToothpicks) {
     EXPECT_GT(cycles, 0u);  // toothpicks pass through each other: there are cycles to find
 }
 
+// What a sorter remembers about still objects (their hulls' contact) gives the layers of a
+// sort that remembers nothing: toothpicks that move, stop for a few frames, and move again; and
+// a walk through the castle, whose objects never move.
+TEST(VisibilitySort, RememberedContactsGiveTheLayersOfAFreshSort) {
+    ToothpickOptions options;
+    options.count = 200;
+    Scene scene = generate_toothpicks(options, 0);
+    VisibilitySorter remembering = make_visibility_sorter(scene), fresh = make_visibility_sorter(scene);
+    std::uint64_t remembered = 0;
+    for (const int frame : {0, 1, 2, 2, 2, 3, 3, 4, 5, 5, 5, 5}) {
+        std::vector<glm::mat4> transforms(scene.objects.size());
+        for (int i = 0; i < options.count; ++i) transforms[std::size_t(i)] = glm::mat4(toothpick_transform(options, i, frame));
+        SortFrame f;
+        f.transforms = transforms.data();
+        f.eye = {1.0f, 4.0f, 24.0f};
+        const VisibilitySort& a = remembering.sort(f);
+        remembered += a.stats.remembered;
+        fresh.forget_order();
+        EXPECT_EQ(layer_sets(a), layer_sets(fresh.sort(f))) << "frame " << frame;
+    }
+    EXPECT_GT(remembered, 0u);
+
+    const std::string castle_file = test::shared_scene("intel_castle.glb");
+    if (castle_file.empty()) return;
+    const Scene castle = load_scene(castle_file);
+    const RayScene rays(castle);
+    WalkOptions walk;
+    walk.frames = 12;
+    const CameraPath path = walk_path(rays, castle, walk);
+    VisibilitySorter walking = make_visibility_sorter(castle), again = make_visibility_sorter(castle);
+    remembered = 0;
+    for (const Camera& camera : path.frames) {
+        CameraFrame f(castle, camera, {640, 360}, scene_anchor(castle));
+        const VisibilitySort& a = walking.sort(f.frame);
+        remembered += a.stats.remembered;
+        again.forget_order();
+        EXPECT_EQ(layer_sets(a), layer_sets(again.sort(f.frame)));
+    }
+    EXPECT_GT(remembered, 0u);
+}
+
 // Every instruction set gives the same sort (the support scan is the only SIMD kernel, and
 // its answers are defined to the bit), frame after frame of tumbling toothpicks.
 TEST(VisibilitySort, EveryInstructionSetGivesTheSameSort) {

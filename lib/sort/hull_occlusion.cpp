@@ -21,16 +21,16 @@ glm::dvec3 support_point(const PlacedHull& hull, const glm::dvec3& d) {
 
 namespace {
 
-// Support of hull(eye + back) - front along d: the Minkowski difference whose containing the
-// origin means the two sets meet.
+// Support of hull(back, plus the eye when given) - front along d: the Minkowski difference
+// whose containing the origin means the two sets meet.
 struct Difference {
     const PlacedHull& front;
     const PlacedHull& back;
-    glm::dvec3 eye;
+    const glm::dvec3* eye;
 
     glm::dvec3 operator()(const glm::dvec3& d) const {
         glm::dvec3 a = support_point(back, d);
-        if (glm::dot(eye, d) > glm::dot(a, d)) a = eye;
+        if (eye && glm::dot(*eye, d) > glm::dot(a, d)) a = *eye;
         return a - support_point(front, -d);
     }
 };
@@ -97,21 +97,19 @@ bool tetrahedron_case(Simplex& s, glm::dvec3& d) {
     return true;  // below all three faces (the fourth was settled before): inside
 }
 
-}  // namespace
-
-bool may_occlude(const PlacedHull& front, const PlacedHull& back, const glm::dvec3& eye, double margin, const glm::dvec3& start) {
-    const Difference support{front, back, eye};
+// GJK's loop: apart with the certificate's direction, or meeting, or not settled.
+HullContact gjk(const Difference& support, double margin, const glm::dvec3& start) {
     glm::dvec3 d = start;
     if (!(glm::dot(d, d) > 0.0)) d = glm::dvec3(1.0, 0.0, 0.0);
     Simplex s;
     for (int iteration = 0; iteration < 48; ++iteration) {
         const double length = glm::length(d);
-        if (!(length > 0.0)) return true;
+        if (!(length > 0.0)) return {Contact::meet, {}};
         d /= length;
         const glm::dvec3 a = support(d);
         // The certificate: nothing of the difference reaches past -margin along d, so a plane
         // normal to d parts the two sets with more than `margin` between them.
-        if (glm::dot(a, d) < -margin) return false;
+        if (glm::dot(a, d) < -margin) return {Contact::apart, d};
         s.p[s.n++] = a;
         bool inside = false;
         switch (s.n) {
@@ -120,9 +118,21 @@ bool may_occlude(const PlacedHull& front, const PlacedHull& back, const glm::dve
             case 3: inside = triangle_case(s, d); break;
             default: inside = tetrahedron_case(s, d); break;
         }
-        if (inside) return true;
+        if (inside) return {Contact::meet, {}};
     }
-    return true;  // not settled: conservatively, it may
+    return {Contact::unsettled, {}};
+}
+
+}  // namespace
+
+bool may_occlude(const PlacedHull& front, const PlacedHull& back, const glm::dvec3& eye, double margin, const glm::dvec3& start) {
+    // "No" only with the certificate; meeting or not settled: it may.
+    return gjk(Difference{front, back, &eye}, margin, start).contact != Contact::apart;
+}
+
+HullContact hull_contact(const PlacedHull& first, const PlacedHull& second, double margin, const glm::dvec3& start) {
+    // The difference first - second is below zero along d when first lies below second.
+    return gjk(Difference{second, first, nullptr}, margin, start);
 }
 
 }  // namespace homcull::sort_detail

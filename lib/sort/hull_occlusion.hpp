@@ -38,4 +38,14 @@ glm::dvec3 support_point(const PlacedHull& hull, const glm::dvec3& d);
 // direction GJK tries (any non-zero vector; the one from back towards front converges fast).
 bool may_occlude(const PlacedHull& front, const PlacedHull& back, const glm::dvec3& eye, double margin, const glm::dvec3& start);
 
+// Two hulls on their own, without the eye: apart (with the direction of a plane between them,
+// from `first` towards `second`), meeting (GJK enclosed the origin, or its simplex collapsed
+// there: within `margin`), or not settled within GJK's iterations.
+enum class Contact : std::uint8_t { apart, meet, unsettled };
+struct HullContact {
+    Contact contact = Contact::unsettled;
+    glm::dvec3 direction{0.0};  // apart: first lies below second along it
+};
+HullContact hull_contact(const PlacedHull& first, const PlacedHull& second, double margin, const glm::dvec3& start);
+
 }  // namespace homcull::sort_detail

@@ -19,10 +19,12 @@
 #include "common/isa_choice.hpp"
 #include "extent_tree.hpp"
 #include "hull_occlusion.hpp"
+#include "pair_cache.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace homcull {
@@ -89,6 +91,14 @@ struct VisibilitySorter::State {
     detail::Vector<float> box_x, box_y, box_z;  // the box's eight corners, per shape
     detail::Vector<std::uint32_t> object_shape;
 
+    // What stands still: each object's last transform, how often it moved, whether it moved
+    // this frame, and what the hull tests learned about pairs of still objects.
+    detail::Vector<glm::mat4> last_transform;
+    detail::Vector<std::uint32_t> moves;
+    detail::Vector<std::uint8_t> still;
+    bool seen_a_frame = false;
+    sort_detail::PairCache contacts;
+
     // This frame.
     detail::Vector<Placed> placed;
     detail::Vector<Extent> extents;
@@ -141,6 +151,7 @@ struct VisibilitySorter::State {
     }
 
     void place(const SortFrame& frame);
+    const sort_detail::PairContact& learn_contact(std::uint32_t a, std::uint32_t b, double margin);
     void collect_candidates(std::uint32_t object);
     bool may_hide(std::uint32_t front, std::uint32_t back);
     void visit_from(std::uint32_t root);
@@ -199,6 +210,8 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
         Placed& p = placed[i];
         p.active = false;
         const glm::mat4& m = frame.transforms[i];
+        still[i] = seen_a_frame && std::memcmp(&m, &last_transform[i], sizeof(glm::mat4)) == 0;
+        if (!still[i]) ++moves[i], last_transform[i] = m;
         const std::uint32_t s = object_shape[i];
         p.centre = glm::vec3(m * glm::vec4(shape_centre[s], 1.0f));
         // Grown by a part in 10^6 (and of the centre's distance from the origin): the float
@@ -245,6 +258,28 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
         in_tree.push_back(i);
     }
     margin_scale = scale;
+    seen_a_frame = true;
+}
+
+// GJK on two still objects' hulls alone, kept for the frames in which neither moves.
+const sort_detail::PairContact& VisibilitySorter::State::learn_contact(std::uint32_t a, std::uint32_t b, double margin) {
+    ++result.stats.hull_tests;
+    const PlacedHull ha = hull(a), hb = hull(b);
+    const sort_detail::HullContact c =
+        sort_detail::hull_contact(ha, hb, margin, glm::dvec3(placed[b].centre) - glm::dvec3(placed[a].centre));
+    sort_detail::PairContact& e = contacts.slot(a, b, moves[a], moves[b]);
+    e.contact = std::uint8_t(c.contact);
+    if (c.contact == sort_detail::Contact::apart) {
+        // Oriented from the lower id to the higher; the bounds rounded outwards to float.
+        const bool a_low = a < b;
+        const glm::dvec3 n = a_low ? c.direction : -c.direction;
+        const PlacedHull& lower = a_low ? ha : hb;
+        const PlacedHull& higher = a_low ? hb : ha;
+        e.normal = glm::vec3(n);
+        e.below = std::nextafter(float(glm::dot(n, sort_detail::support_point(lower, n))), 3.4e38f);
+        e.above = std::nextafter(float(glm::dot(n, sort_detail::support_point(higher, -n))), -3.4e38f);
+    }
+    return e;
 }
 
 void VisibilitySorter::State::collect_candidates(std::uint32_t object) {
@@ -266,6 +301,23 @@ bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) 
     // here and of the ground truth's (which places vertices in double, then rounds).
     const double margin = 1e-6 * margin_scale;
     if (parted_on_box_axes(f, b, glm::vec3(eye), float(margin))) return false;
+    if (still[front] && still[back]) {
+        const sort_detail::PairContact* known = contacts.find(front, back, moves[front], moves[back]);
+        if (!known) known = &learn_contact(front, back, margin);
+        if (known->contact == std::uint8_t(sort_detail::Contact::meet)) {
+            ++result.stats.remembered;
+            return true;  // hulls that meet: each may hide the other from anywhere
+        }
+        if (known->contact == std::uint8_t(sort_detail::Contact::apart)) {
+            // The hull of the eye and back stays on back's side of the plane between them.
+            const float side = glm::dot(known->normal, glm::vec3(eye));
+            const float room = float(margin);
+            if (back < front ? side < known->above - room : side > known->below + room) {
+                ++result.stats.remembered;
+                return false;
+            }
+        }
+    }
     const glm::dvec3 start = glm::dvec3(f.centre) - glm::dvec3(b.centre);
     ++result.stats.box_tests;
     if (!sort_detail::may_occlude(box(front), box(back), eye, margin, start)) return false;
@@ -440,6 +492,10 @@ VisibilitySorter::VisibilitySorter(const HullPoints* shapes, std::size_t shape_c
                         ", but there are " + std::to_string(shape_count));
     }
     s.object_shape.assign(object_shapes, object_shapes + object_count);
+    s.last_transform.resize(object_count);
+    s.moves.resize(object_count);
+    s.still.resize(object_count);
+    s.contacts.reset(object_count);
     s.placed.resize(object_count);
     s.extents.resize(object_count);
     s.index.resize(object_count);
@@ -468,6 +524,10 @@ std::size_t VisibilitySorter::object_count() const { return state_->object_shape
 std::size_t VisibilitySorter::shape_count() const { return state_->shape_first.size(); }
 std::size_t VisibilitySorter::hull_point_count() const { return state_->x.size(); }
 const VisibilitySort& VisibilitySorter::last() const { return state_->result; }
-void VisibilitySorter::forget_order() { state_->has_last_order = false; }
+void VisibilitySorter::forget_order() {
+    state_->has_last_order = false;
+    state_->seen_a_frame = false;  // nothing counts as still in the next frame
+    state_->contacts.clear();
+}
 
 }  // namespace homcull

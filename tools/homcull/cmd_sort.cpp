@@ -216,6 +216,7 @@ void run_sort(const SortCommandOptions& o) {
                                 {"candidates", r.stats.candidates},
                                 {"box_tests", r.stats.box_tests},
                                 {"hull_tests", r.stats.hull_tests},
+                                {"remembered", r.stats.remembered},
                                 {"occlusions", r.stats.occlusions},
                                 {"kept_last_order", r.stats.kept_last_order}};
             if (r.check)

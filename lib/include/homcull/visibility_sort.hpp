@@ -63,7 +63,8 @@ struct VisibilitySortStats {
     std::uint32_t largest_cycle = 0;      // objects in the largest layer
     std::uint64_t candidates = 0;         // pairs the extent tree returned
     std::uint64_t box_tests = 0;          // pairs tested on their bounding boxes (after the spheres)
-    std::uint64_t hull_tests = 0;         // pairs that reached the convex-hull test
+    std::uint64_t hull_tests = 0;         // GJK runs on hulls (the full test, or two still objects')
+    std::uint64_t remembered = 0;         // pairs of still objects answered from an earlier frame's test
     std::uint64_t occlusions = 0;         // pairs that test found occluding (the pairs listed)
     bool kept_last_order = false;         // the last frame's order held: the sort changed nothing
     // Stage times, milliseconds (steady clock): the objects' bounds and extents, the extent
@@ -129,7 +130,8 @@ public:
     const VisibilitySort& sort(const SortFrame& frame);
     // The last answer.
     const VisibilitySort& last() const;
-    // Forgets the last order: the next sort starts from scratch.
+    // Forgets the last order and what was learned about still objects: the next sort starts
+    // from scratch.
     void forget_order();
 
 private:
