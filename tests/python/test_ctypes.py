@@ -113,6 +113,29 @@ class homcull_frame_stats(Structure):
 
 
 # Opaque handles, each its own pointer type so that a mesh cannot be passed for a buffer.
+class homcull_sorter_desc(Structure):
+    _fields_ = [("object_meshes", c_void_p), ("object_count", c_size_t)]
+
+
+class homcull_sort_frame(Structure):
+    _fields_ = [("model_matrices", POINTER(c_float)), ("layout", homcull_matrix_layout), ("eye", c_float * 3),
+                ("planes", POINTER(c_float)), ("plane_count", c_uint32), ("from_scratch", c_uint32)]
+
+
+class homcull_sort_layer(Structure):
+    _fields_ = [("first", c_uint32), ("count", c_uint32)]
+
+
+class homcull_occlusion_pair(Structure):
+    _fields_ = [("occluder", c_uint32), ("occluded", c_uint32)]
+
+
+class homcull_sort_result(Structure):
+    _fields_ = [("order", POINTER(c_uint32)), ("order_count", c_size_t), ("layers", POINTER(homcull_sort_layer)),
+                ("layer_count", c_size_t), ("pairs", POINTER(homcull_occlusion_pair)), ("pair_count", c_size_t),
+                ("cycles", c_uint32), ("objects_in_cycles", c_uint32)]
+
+
 class homcull_context(Structure):
     pass
 
@@ -125,16 +148,22 @@ class homcull_buffer(Structure):
     pass
 
 
+class homcull_sorter(Structure):
+    pass
+
+
 context_p = POINTER(homcull_context)
 mesh_p = POINTER(homcull_mesh)
 buffer_p = POINTER(homcull_buffer)
+sorter_p = POINTER(homcull_sorter)
 
 # The name in each HOMCULL_CHECK_SIZE_(name, ...) line and the ctypes type it checks.
 MIRRORS = {
     "box": homcull_box, "rect": homcull_rect, "view": homcull_view, "buffer_desc": homcull_buffer_desc,
     "frame_stats": homcull_frame_stats, "allocator": homcull_allocator, "context_desc": homcull_context_desc,
     "mesh_desc": homcull_mesh_desc, "triangles": homcull_triangles, "reserve_desc": homcull_reserve_desc,
-    "job_system": homcull_job_system,
+    "job_system": homcull_job_system, "sorter_desc": homcull_sorter_desc, "sort_frame": homcull_sort_frame,
+    "sort_layer": homcull_sort_layer, "occlusion_pair": homcull_occlusion_pair, "sort_result": homcull_sort_result,
 }
 
 
@@ -168,6 +197,9 @@ def bind(lib):
     f("homcull_buffer_close_tasks", homcull_result, buffer_p, POINTER(c_size_t))
     f("homcull_buffer_run_task", homcull_result, buffer_p, c_size_t)
     f("homcull_buffer_finish_tasks", homcull_result, buffer_p)
+    f("homcull_sorter_create", homcull_result, context_p, POINTER(homcull_sorter_desc), POINTER(sorter_p))
+    f("homcull_sorter_destroy", None, sorter_p)
+    f("homcull_sorter_sort", homcull_result, sorter_p, POINTER(homcull_sort_frame), POINTER(homcull_sort_result))
 
 
 # ---- The checks -------------------------------------------------------------------------------------
@@ -385,6 +417,20 @@ def run(lib_path, header_path):
     check(0 < context_bytes <= python_bytes,
           f"homcull_context_allocated_bytes() is {context_bytes}, the Python allocator holds {python_bytes}")
 
+    # A sorter over the mesh placed twice along -z: the nearer one first, from the eye at the origin.
+    meshes = (mesh_p * 2)(mesh, mesh)
+    sorter = sorter_p()
+    made = lib.homcull_sorter_create(context, ctypes.byref(homcull_sorter_desc(ctypes.cast(meshes, c_void_p), 2)), ctypes.byref(sorter))
+    check(made == HOMCULL_OK, f"homcull_sorter_create: {lib.homcull_last_error()}")
+    matrices = (c_float * 32)(*([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -30, 1] + [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -8, 1]))
+    sort_frame = homcull_sort_frame(model_matrices=matrices, layout=HOMCULL_COLUMN_MAJOR)
+    sorted_objects = homcull_sort_result()
+    made = lib.homcull_sorter_sort(sorter, ctypes.byref(sort_frame), ctypes.byref(sorted_objects))
+    check(made == HOMCULL_OK, f"homcull_sorter_sort: {lib.homcull_last_error()}")
+    order = [sorted_objects.order[k] for k in range(sorted_objects.order_count)]
+    check(order == [1, 0], f"the sorter's order is {order}, not [1, 0] (nearest first)")
+    lib.homcull_sorter_destroy(sorter)
+
     lib.homcull_buffer_destroy(buffer)
     lib.homcull_mesh_destroy(mesh)
     # Only the context's own block is left.
@@ -403,6 +449,7 @@ def run(lib_path, header_path):
     print(f"  frame stats: {stats.triangles_in} in, {stats.triangles_drawn} drawn, {stats.triangles_skipped} skipped,"
           f" {stats.draw_calls} draw call(s), {stats.allocations} allocation(s)")
     print(f"  error: {lib.homcull_result_name(r).decode()}: {message.decode()}")
+    print(f"  sorter: order {order}, {sorted_objects.layer_count} layers")
     print(f"  Python allocator: {memory.calls} allocations ({context_bytes} bytes held by the mesh and buffer"
           f" mid-test), 0 blocks live at the end")
     print("PASS")
