@@ -36,6 +36,10 @@ using sort_detail::PlacedHull;
 namespace {
 
 constexpr std::size_t kMaxPlanes = 16;
+// Hull points of a pair above which GJK on the bounding boxes comes before GJK on the hulls:
+// below, the box test saves less than it costs when it fails (the castle's hulls have 23
+// points on average, the toothpicks' 289).
+constexpr std::uint32_t kBoxesFirstAbove = 64;
 
 double now_ms() {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -319,10 +323,14 @@ bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) 
         }
     }
     const glm::dvec3 start = glm::dvec3(f.centre) - glm::dvec3(b.centre);
-    ++result.stats.box_tests;
-    if (!sort_detail::may_occlude(box(front), box(back), eye, margin, start)) return false;
+    const PlacedHull front_hull = hull(front), back_hull = hull(back);
+    // The boxes first where they are much cheaper than the hulls (eight points each).
+    if (front_hull.count + back_hull.count > kBoxesFirstAbove) {
+        ++result.stats.box_tests;
+        if (!sort_detail::may_occlude(box(front), box(back), eye, margin, start)) return false;
+    }
     ++result.stats.hull_tests;
-    return sort_detail::may_occlude(hull(front), hull(back), eye, margin, start);
+    return sort_detail::may_occlude(front_hull, back_hull, eye, margin, start);
 }
 
 void VisibilitySorter::State::emit_component(std::uint32_t root) {

@@ -6,6 +6,7 @@
 
 #include <homcull/error.hpp>
 #include <homcull/io/camera_path.hpp>
+#include <homcull/isa.hpp>
 #include <homcull/io/scene_io.hpp>
 #include <homcull/scene_sort.hpp>
 #include <homcull/truth/ray_scene.hpp>
@@ -36,6 +37,7 @@ struct SortCommandOptions {
     bool from_scratch = false;
     int rounds = 5;
     std::size_t hull_points = kSortHullPoints;
+    std::string isa = "best";
     bool check = false;
     bool json = false;
 };
@@ -126,6 +128,7 @@ void run_sort(const SortCommandOptions& o) {
     if (o.walk > 0 || o.random > 0) rays = std::make_unique<RayScene>(scene);
     const SortFrames frames = choose_frames(o, scene, rays.get());
 
+    select_isa(o.isa);  // the support scan's instruction set, taken when the sorter is made
     long long start = now_ns();
     VisibilitySorter sorter = make_visibility_sorter(scene, o.hull_points);
     const double hull_ms = elapsed_ms(start);
@@ -291,6 +294,8 @@ void register_sort(CLI::App& app) {
     cmd->add_flag("--all-directions", o->all_directions, "Sort every object, not only those in the view frustum (the paper's setting)");
     cmd->add_flag("--from-scratch", o->from_scratch, "Sort each frame from scratch, not from the last frame's order");
     cmd->add_option("--rounds", o->rounds, "Runs over all the frames; each frame's time is the median")->capture_default_str();
+    cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
+        ->capture_default_str();
     cmd->add_option("--hull-points", o->hull_points, "At most N points per hull, grown to hold the mesh (0: exact hulls)")
         ->capture_default_str();
     cmd->add_flag("--check", o->check, "Check every frame's layers against Embree's occlusion edges (every hit along each pixel's ray)");
