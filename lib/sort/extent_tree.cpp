@@ -19,12 +19,6 @@ void grow(Extent& into, const Extent& e) {
     into.nearest = std::min(into.nearest, e.nearest);
 }
 
-bool overlaps(const Extent& a, const Extent& b) {
-    for (int k = 0; k < 3; ++k)
-        if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
-    return true;
-}
-
 }  // namespace
 
 void ExtentTree::build(const detail::Vector<Extent>& extents, const detail::Vector<std::uint32_t>& ids) {
@@ -83,7 +77,7 @@ void ExtentTree::query(const Extent& box, float farthest, detail::Vector<std::ui
     while (!stack_.empty()) {
         const Node& node = nodes_[stack_.back()];
         stack_.pop_back();
-        if (!(node.bounds.nearest < farthest) || !overlaps(node.bounds, box)) continue;
+        if (!(node.bounds.nearest < farthest) || !boxes_overlap(node.bounds, box)) continue;
         if (node.count == 0) {
             stack_.push_back(node.first - 1);  // left child
             stack_.push_back(node.first);      // right child
@@ -92,7 +86,7 @@ void ExtentTree::query(const Extent& box, float farthest, detail::Vector<std::ui
         for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
             const std::uint32_t id = objects_[k];
             const Extent& e = (*extents_)[id];
-            if (e.nearest < farthest && overlaps(e, box)) out.push_back(id);
+            if (e.nearest < farthest && boxes_overlap(e, box)) out.push_back(id);
         }
     }
 }

@@ -19,6 +19,13 @@ struct Extent {
     float nearest = 0;   // distance from the eye to the bounding sphere (0 when it holds the eye)
 };
 
+// Whether two extents' boxes overlap (the nearest distances aside).
+inline bool boxes_overlap(const Extent& a, const Extent& b) {
+    for (int k = 0; k < 3; ++k)
+        if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
+    return true;
+}
+
 class ExtentTree {
 public:
     // A tree over extents[ids[k]] (ids: the objects to hold; extents indexed by object).

@@ -107,6 +107,13 @@ struct VisibilitySorter::State {
     detail::Vector<Placed> placed;
     detail::Vector<Extent> extents;
     detail::Vector<std::uint32_t> in_tree, surrounding, roots;
+    // Image extents: objects wholly in front of the eye along this frame's view axis have a box
+    // in the image plane of that axis (their bounding boxes' corners, projected); the others
+    // ("wide") keep their direction boxes only.
+    detail::Vector<Extent> image;
+    detail::Vector<std::uint8_t> projected;
+    detail::Vector<std::uint32_t> in_image_tree, wide;
+    ExtentTree image_tree;
     ExtentTree tree;
     sort_detail::SupportScan scan = &sort_detail::support_scan_reference;
     const glm::mat4* transforms = nullptr;
@@ -155,6 +162,7 @@ struct VisibilitySorter::State {
     }
 
     void place(const SortFrame& frame);
+    void project(const glm::vec3& from);  // the eye, in float
     const sort_detail::PairContact& learn_contact(std::uint32_t a, std::uint32_t b, double margin);
     void collect_candidates(std::uint32_t object);
     bool may_hide(std::uint32_t front, std::uint32_t back);
@@ -213,6 +221,7 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
     for (std::uint32_t i = 0; i < n; ++i) {
         Placed& p = placed[i];
         p.active = false;
+        projected[i] = 0;  // until project() gives it an image box
         const glm::mat4& m = frame.transforms[i];
         still[i] = seen_a_frame && std::memcmp(&m, &last_transform[i], sizeof(glm::mat4)) == 0;
         if (!still[i]) ++moves[i], last_transform[i] = m;
@@ -263,6 +272,62 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
     }
     margin_scale = scale;
     seen_a_frame = true;
+    project(e);
+}
+
+// The view axis: the mean of the directions to the objects. Each object whose bounding box lies
+// wholly within 75 degrees of it gets the box of its corners' central projection onto the plane
+// one unit along it (a convex set in front of the eye projects into the hull of its corners'
+// projections): two objects can overlap on screen only if those boxes overlap. Much tighter
+// than the direction boxes of the spheres for long, thin objects.
+void VisibilitySorter::State::project(const glm::vec3& from) {
+    in_image_tree.clear();
+    wide.clear();
+    glm::vec3 sum(0.0f);
+    for (std::uint32_t i : in_tree) sum += placed[i].direction;
+    const float length = glm::length(sum);
+    if (!(length > 1e-3f * float(in_tree.size()))) {
+        wide.assign(in_tree.begin(), in_tree.end());
+        for (std::uint32_t i : in_tree) projected[i] = 0;
+        return;
+    }
+    const glm::vec3 axis = sum / length;
+    const glm::vec3 helper = std::abs(axis.x) < 0.6f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    const glm::vec3 right = glm::normalize(glm::cross(axis, helper)), up = glm::cross(right, axis);
+    const float slack = float(1e-6 * margin_scale);
+    for (std::uint32_t i : in_tree) {
+        const Placed& p = placed[i];
+        const glm::vec3* h = p.half_axis;
+        const glm::vec3 centre = p.centre - from;
+        Extent box;
+        box.lo[0] = box.lo[1] = 3.4e38f, box.hi[0] = box.hi[1] = -3.4e38f;
+        box.lo[2] = box.hi[2] = 0.0f;
+        box.nearest = extents[i].nearest;
+        bool in_front = true;
+        float least_depth = 3.4e38f;
+        for (int corner = 0; corner < 8 && in_front; ++corner) {
+            const glm::vec3 c = centre + ((corner & 1) ? h[0] : -h[0]) + ((corner & 2) ? h[1] : -h[1]) + ((corner & 4) ? h[2] : -h[2]);
+            const float depth = glm::dot(c, axis);
+            in_front = depth > 0.25f * glm::length(c) + 2.0f * slack;
+            const float across = glm::dot(c, right) / depth, upward = glm::dot(c, up) / depth;
+            box.lo[0] = std::min(box.lo[0], across), box.hi[0] = std::max(box.hi[0], across);
+            box.lo[1] = std::min(box.lo[1], upward), box.hi[1] = std::max(box.hi[1], upward);
+            least_depth = std::min(least_depth, depth);
+        }
+        projected[i] = in_front;
+        if (!in_front) {
+            wide.push_back(i);
+            continue;
+        }
+        // Widened for the roundings: a part in 10^6 of the scene's reach, seen at the nearest
+        // corner's depth, and of the coordinates themselves.
+        for (int k = 0; k < 2; ++k) {
+            const float pad = slack / least_depth + 1e-6f * std::max(std::abs(box.lo[k]), std::abs(box.hi[k]));
+            box.lo[k] -= pad, box.hi[k] += pad;
+        }
+        image[i] = box;
+        in_image_tree.push_back(i);
+    }
 }
 
 // GJK on two still objects' hulls alone, kept for the frames in which neither moves.
@@ -288,7 +353,14 @@ const sort_detail::PairContact& VisibilitySorter::State::learn_contact(std::uint
 
 void VisibilitySorter::State::collect_candidates(std::uint32_t object) {
     const Placed& p = placed[object];
-    tree.query(extents[object], p.farthest, candidates);
+    if (projected[object]) {
+        image_tree.query(image[object], p.farthest, candidates);
+        const Extent& directions = extents[object];
+        for (std::uint32_t w : wide)
+            if (extents[w].nearest < p.farthest && sort_detail::boxes_overlap(extents[w], directions)) candidates.push_back(w);
+    } else {
+        tree.query(extents[object], p.farthest, candidates);  // every object's direction box
+    }
     for (std::uint32_t w : surrounding) candidates.push_back(w);
 }
 
@@ -410,10 +482,14 @@ const VisibilitySort& VisibilitySorter::sort(const SortFrame& frame) {
     const std::size_t n = s.object_shape.size();
     if (!finite(frame.eye)) {
         for (Placed& p : s.placed) p.active = false;
-        s.in_tree.clear(), s.surrounding.clear();
+        s.in_tree.clear(), s.surrounding.clear(), s.in_image_tree.clear(), s.wide.clear();
     }
     const double placed_at = now_ms();
-    s.tree.build(s.extents, s.in_tree);
+    s.image_tree.build(s.image, s.in_image_tree);
+    // The direction tree answers the queries of the objects without an image box (the wide
+    // ones and those around the eye) only.
+    if (!s.wide.empty() || !s.surrounding.empty()) s.tree.build(s.extents, s.in_tree);
+    else s.tree.build(s.extents, s.wide);
     const double tree_at = now_ms();
 
     // The roots: the last order's objects that are still here, then the others nearest first.
@@ -505,6 +581,8 @@ VisibilitySorter::VisibilitySorter(const HullPoints* shapes, std::size_t shape_c
     s.still.resize(object_count);
     s.contacts.reset(object_count);
     s.placed.resize(object_count);
+    s.image.resize(object_count);
+    s.projected.resize(object_count);
     s.extents.resize(object_count);
     s.index.resize(object_count);
     s.low.resize(object_count);

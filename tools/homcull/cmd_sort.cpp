@@ -226,6 +226,11 @@ void run_sort(const SortCommandOptions& o) {
                 f["check"] = {{"true_edges", r.true_edges}, {"violations", r.check->violations},
                               {"unsorted_edges", r.check->unsorted_edges}, {"grouped_layers", r.check->grouped_layers},
                               {"needless_layers", r.check->needless_layers}, {"needlessly_grouped", r.check->needlessly_grouped}};
+            if (r.check) {
+                nlohmann::json violating = nlohmann::json::array();
+                for (const OcclusionEdge& e : r.check->violating) violating.push_back({e.front, e.back, e.rays});
+                f["check"]["violating"] = violating;  // the first 20: front, back, rays
+            }
             out_frames.push_back(f);
         }
         nlohmann::json summary = {{"frames", results.size()},
