@@ -3,6 +3,9 @@
 // Embree's every-hit rays (homcull/truth/sort_truth.hpp) on toothpicks and the shared scenes.
 #include "support.hpp"
 
+#include "common/isa_choice.hpp"
+#include "sort/support_scan.hpp"
+
 #include <homcull/error.hpp>
 #include <homcull/generate.hpp>
 #include <homcull/io/scene_io.hpp>
@@ -337,6 +340,29 @@ TEST(VisibilitySort, RememberedContactsGiveTheLayersOfAFreshSort) {
         EXPECT_EQ(layer_sets(a), layer_sets(again.sort(f.frame)));
     }
     EXPECT_GT(remembered, 0u);
+}
+
+// The support scan's kernels give the reference's answer (the first point of the largest dot
+// product) for every count, with ties and repeated points.
+TEST(VisibilitySort, SupportScanKernelsGiveTheReferenceAnswer) {
+    std::uint64_t state = 11;
+    const auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return std::int32_t(state >> 59) - 16;  // small integers: many ties
+    };
+    for (const std::string& isa : available_isas()) {
+        const sort_detail::SupportScan scan = sort_detail::support_scan_for(detail::isa_choice(isa));
+        for (std::uint32_t count = 1; count < 300; count += count < 40 ? 1 : 37) {
+            std::vector<float> x(count), y(count), z(count);
+            for (std::uint32_t i = 0; i < count; ++i) x[i] = float(next()), y[i] = float(next()), z[i] = float(next());
+            for (int trial = 0; trial < 20; ++trial) {
+                const float dx = float(next()) * 0.5f, dy = float(next()), dz = float(next()) * 0.25f;
+                EXPECT_EQ(scan(x.data(), y.data(), z.data(), count, dx, dy, dz),
+                          sort_detail::support_scan_reference(x.data(), y.data(), z.data(), count, dx, dy, dz))
+                    << isa << ", " << count << " points";
+            }
+        }
+    }
 }
 
 // Every instruction set gives the same sort (the support scan is the only SIMD kernel, and

@@ -21,22 +21,43 @@ std::uint32_t SupportScanKernel(const float* x, const float* y, const float* z, 
     float best_dot = -3.4e38f;
     if (count >= lanes) {
         const auto vx = hn::Set(df, dx), vy = hn::Set(df, dy), vz = hn::Set(df, dz);
-        auto lane_dot = hn::Set(df, -3.4e38f);
-        auto lane_index = hn::Zero(di);
-        auto index = hn::Iota(di, 0);
         const auto step = hn::Set(di, std::int32_t(lanes));
+        // Four independent running maxima (each over every fourth vector), so that the
+        // compare-and-select chains overlap instead of waiting on one another.
+        auto dot0 = hn::Set(df, -3.4e38f), dot1 = dot0, dot2 = dot0, dot3 = dot0;
+        auto at0 = hn::Zero(di), at1 = at0, at2 = at0, at3 = at0;
+        auto index = hn::Iota(di, 0);
+        const auto keep = [&](std::uint32_t k, decltype(dot0)& running, decltype(at0)& at, const decltype(index)& where) {
+            const auto dot = hn::Add(hn::Add(hn::Mul(hn::LoadU(df, x + k), vx), hn::Mul(hn::LoadU(df, y + k), vy)),
+                                     hn::Mul(hn::LoadU(df, z + k), vz));
+            const auto better = hn::Gt(dot, running);
+            running = hn::IfThenElse(better, dot, running);
+            at = hn::IfThenElse(hn::RebindMask(di, better), where, at);
+        };
+        for (; i + 4 * lanes <= count; i += 4 * lanes) {
+            keep(i, dot0, at0, index);
+            keep(i + lanes, dot1, at1, hn::Add(index, step));
+            keep(i + 2 * lanes, dot2, at2, hn::Add(index, hn::Add(step, step)));
+            keep(i + 3 * lanes, dot3, at3, hn::Add(index, hn::Add(hn::Add(step, step), step)));
+            index = hn::Add(index, hn::Add(hn::Add(step, step), hn::Add(step, step)));
+        }
         for (; i + lanes <= count; i += lanes) {
-            const auto dot = hn::Add(hn::Add(hn::Mul(hn::LoadU(df, x + i), vx), hn::Mul(hn::LoadU(df, y + i), vy)),
-                                     hn::Mul(hn::LoadU(df, z + i), vz));
-            const auto better = hn::Gt(dot, lane_dot);
-            lane_dot = hn::IfThenElse(better, dot, lane_dot);
-            lane_index = hn::IfThenElse(hn::RebindMask(di, better), index, lane_index);
+            keep(i, dot0, at0, index);
             index = hn::Add(index, step);
         }
+        // Merge the four: the larger dot, and on a tie the lower index (the first point).
+        const auto merge = [&](decltype(dot0)& running, decltype(at0)& at, const decltype(dot0)& other_dot, const decltype(at0)& other_at) {
+            const auto better = hn::Or(hn::Gt(other_dot, running), hn::And(hn::Eq(other_dot, running), hn::RebindMask(df, hn::Lt(other_at, at))));
+            running = hn::IfThenElse(better, other_dot, running);
+            at = hn::IfThenElse(hn::RebindMask(di, better), other_at, at);
+        };
+        merge(dot0, at0, dot1, at1);
+        merge(dot2, at2, dot3, at3);
+        merge(dot0, at0, dot2, at2);
         HWY_ALIGN float dots[hn::MaxLanes(df)];
         HWY_ALIGN std::int32_t indices[hn::MaxLanes(di)];
-        hn::Store(lane_dot, df, dots);
-        hn::Store(lane_index, di, indices);
+        hn::Store(dot0, df, dots);
+        hn::Store(at0, di, indices);
         best_dot = dots[0], best = std::uint32_t(indices[0]);
         for (std::uint32_t j = 1; j < lanes; ++j) {
             const std::uint32_t at = std::uint32_t(indices[j]);
