@@ -78,6 +78,8 @@ std::vector<float> pyramid_by_definition(const OcclusionBuffer& b);
 // centre must hit something at or before the claimed depth (the ray parameter is the view
 // depth; 10^-5 absorbs Embree's float rounding). Adds a failure naming `what` and the sample at
 // the first that does not; returns the number of claimed samples.
+// Embree's first-hit object id at every pixel centre of `display` (kNoObject: nothing).
+std::vector<std::uint32_t> embree_first_hits(const RayScene& rays, const Scene& scene, const Camera& camera, Resolution display);
 long expect_claims_behind_embree_hits(const RayScene& rays, const Camera& camera, const OcclusionBuffer& buffer, const std::string& what);
 
 // A fresh, empty folder for one test's files.

@@ -2,6 +2,7 @@
 // library has it (tests/CMakeLists.txt).
 #include "support.hpp"
 
+#include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/ray_scene.hpp>
 
 #include <gtest/gtest.h>
@@ -11,6 +12,13 @@
 #include <vector>
 
 namespace homcull::test {
+
+std::vector<std::uint32_t> embree_first_hits(const RayScene& rays, const Scene& scene, const Camera& camera, Resolution display) {
+    TruthOptions options;
+    options.resolution = display;
+    options.keep_sample_ids = true;
+    return compute_ground_truth(rays, scene, camera, options).sample_ids;
+}
 
 long expect_claims_behind_embree_hits(const RayScene& rays, const Camera& camera, const OcclusionBuffer& buffer, const std::string& what) {
     std::vector<float> bound_w;

@@ -6,7 +6,6 @@
 
 #include <homcull/generate.hpp>
 #include <homcull/truth/bsp_painter.hpp>
-#include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/sort_truth.hpp>
 
 #include <gtest/gtest.h>
@@ -29,11 +28,8 @@ void compare_with_embree(const Scene& scene, const BspTree& tree, const RayScene
     tree.painter_order(camera.eye, order);
     std::vector<std::uint8_t> ambiguous;
     const std::vector<std::uint32_t> painted = paint_ids(order, tree.anchor(), camera, display, &ambiguous);
-    TruthOptions options;
-    options.resolution = display;
-    options.keep_sample_ids = true;
-    const TruthResult truth = compute_ground_truth(rays, scene, camera, options);
-    ASSERT_EQ(truth.sample_ids.size(), painted.size());
+    const std::vector<std::uint32_t> seen = test::embree_first_hits(rays, scene, camera, display);
+    ASSERT_EQ(seen.size(), painted.size());
     for (std::size_t p = 0; p < painted.size(); ++p) {
         ++tally.pixels;
         tally.covered += painted[p] != kNoObject;
@@ -41,11 +37,11 @@ void compare_with_embree(const Scene& scene, const BspTree& tree, const RayScene
             ++tally.ambiguous;
             continue;
         }
-        if (painted[p] != truth.sample_ids[p]) {
+        if (painted[p] != seen[p]) {
             ++tally.mismatches;
             if (tally.mismatches <= 5)
                 ADD_FAILURE() << what << ": pixel (" << p % std::size_t(display.width) << ", " << p / std::size_t(display.width)
-                              << ") painted object " << painted[p] << ", Embree sees " << truth.sample_ids[p];
+                              << ") painted object " << painted[p] << ", Embree sees " << seen[p];
         }
     }
 }
@@ -93,13 +89,11 @@ TEST(BspPainter, BackToFrontOrderPaintsEmbreesFirstHitsOnACity) {
     std::vector<const BspPolygon*> order;
     tree.painter_order(camera.eye, order);
     std::reverse(order.begin(), order.end());
-    TruthOptions truth_options;
-    truth_options.resolution = {64, 36};
-    truth_options.keep_sample_ids = true;
-    const std::vector<std::uint32_t> wrong = paint_ids(order, tree.anchor(), camera, truth_options.resolution);
-    const TruthResult truth = compute_ground_truth(rays, city, camera, truth_options);
+    const Resolution small{64, 36};
+    const std::vector<std::uint32_t> wrong = paint_ids(order, tree.anchor(), camera, small);
+    const std::vector<std::uint32_t> seen = test::embree_first_hits(rays, city, camera, small);
     std::size_t differ = 0;
-    for (std::size_t p = 0; p < wrong.size(); ++p) differ += wrong[p] != truth.sample_ids[p];
+    for (std::size_t p = 0; p < wrong.size(); ++p) differ += wrong[p] != seen[p];
     EXPECT_GT(differ, wrong.size() / 10);
 }
 

@@ -192,23 +192,30 @@ TEST(FrameAllocations, NoneFromTheFirstFrameAfterAReserve) {
 // making meshes and buffers, frames, draws (registered meshes and triangles), queries, a
 // resolution change and destroying it all never call the global operator new; and what the
 // engine gave is all given back.
+// An engine's allocator that counts its calls and the blocks still live.
+struct EngineAllocator {
+    std::size_t calls = 0, live = 0;
+    homcull_context_desc context_desc() {
+        homcull_context_desc desc{};
+        desc.allocator.allocate = [](void* user, std::size_t size, std::size_t alignment) -> void* {
+            auto& e = *static_cast<EngineAllocator*>(user);
+            ++e.calls, ++e.live;
+            return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+        };
+        desc.allocator.deallocate = [](void* user, void* p, std::size_t) {
+            --static_cast<EngineAllocator*>(user)->live;
+            std::free(p);
+        };
+        desc.allocator.user = this;
+        return desc;
+    }
+};
+
 TEST(FrameAllocations, CInterfaceTakesEveryByteFromTheEngine) {
     const test::CityStreet street;
     const WorldTriangles& occluders = street.occluders;
-    struct Engine {
-        std::size_t calls = 0, live = 0;
-    } engine;
-    homcull_context_desc desc{};
-    desc.allocator.allocate = [](void* user, std::size_t size, std::size_t alignment) -> void* {
-        auto& e = *static_cast<Engine*>(user);
-        ++e.calls, ++e.live;
-        return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
-    };
-    desc.allocator.deallocate = [](void* user, void* p, std::size_t) {
-        --static_cast<Engine*>(user)->live;
-        std::free(p);
-    };
-    desc.allocator.user = &engine;
+    EngineAllocator engine;
+    const homcull_context_desc desc = engine.context_desc();
     const glm::dmat4 clip = projection_matrix(street.camera, 320.0 / 180.0) * view_matrix(street.camera);
     homcull_view view{};
     for (int c = 0; c < 4; ++c)
@@ -302,20 +309,8 @@ TEST(FrameAllocations, CInterfaceSorterTakesEveryByteFromTheEngine) {
     options.count = 150;
     const Scene scene = generate_toothpicks(options, 0);
     const Mesh& mesh = scene.meshes[0];
-    struct Engine {
-        std::size_t calls = 0, live = 0;
-    } engine;
-    homcull_context_desc desc{};
-    desc.allocator.allocate = [](void* user, std::size_t size, std::size_t alignment) -> void* {
-        auto& e = *static_cast<Engine*>(user);
-        ++e.calls, ++e.live;
-        return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
-    };
-    desc.allocator.deallocate = [](void* user, void* p, std::size_t) {
-        --static_cast<Engine*>(user)->live;
-        std::free(p);
-    };
-    desc.allocator.user = &engine;
+    EngineAllocator engine;
+    const homcull_context_desc desc = engine.context_desc();
     std::vector<std::vector<float>> matrices(4, std::vector<float>(16 * scene.objects.size()));
     for (std::size_t f = 0; f < matrices.size(); ++f)
         for (int i = 0; i < options.count; ++i) {

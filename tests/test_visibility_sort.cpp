@@ -12,7 +12,6 @@
 #include <homcull/isa.hpp>
 #include <homcull/scene_sort.hpp>
 #include <homcull/truth/bsp_painter.hpp>
-#include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/ray_scene.hpp>
 #include <homcull/truth/sort_truth.hpp>
 #include <homcull/truth/walk_path.hpp>
@@ -464,21 +463,18 @@ TEST(VisibilitySort, LayersPaintEmbreesImageOnConvexObjects) {
         std::vector<std::uint8_t> ambiguous;
         const std::vector<std::uint32_t> painted = paint_ids(painter_order(false), anchor, camera, display, &ambiguous);
         const std::vector<std::uint32_t> wrong = paint_ids(painter_order(true), anchor, camera, display);
-        TruthOptions options;
-        options.resolution = display;
-        options.keep_sample_ids = true;
-        const TruthResult truth = compute_ground_truth(rays, scene, camera, options);
-        ASSERT_EQ(truth.sample_ids.size(), painted.size());
+        const std::vector<std::uint32_t> seen = test::embree_first_hits(rays, scene, camera, display);
+        ASSERT_EQ(seen.size(), painted.size());
         for (std::size_t p = 0; p < painted.size(); ++p) {
             ++pixels;
-            covered += truth.sample_ids[p] != kNoObject;
-            reversed_mismatches += wrong[p] != truth.sample_ids[p];
+            covered += seen[p] != kNoObject;
+            reversed_mismatches += wrong[p] != seen[p];
             if (ambiguous[p]) {
                 ++ambiguous_pixels;
                 continue;
             }
-            if (painted[p] != truth.sample_ids[p] && ++mismatches <= 5)
-                ADD_FAILURE() << "view " << view << ", pixel " << p << ": painted " << painted[p] << ", Embree sees " << truth.sample_ids[p];
+            if (painted[p] != seen[p] && ++mismatches <= 5)
+                ADD_FAILURE() << "view " << view << ", pixel " << p << ": painted " << painted[p] << ", Embree sees " << seen[p];
         }
     }
     std::printf("[ painter  ] %zu pixels, %zu covered, %zu ambiguous, %zu mismatches; the layers reversed: %zu\n", pixels, covered,
