@@ -103,8 +103,17 @@ TEST(Cli, SortPrintsLayersCyclesStagesAndTheCheck) {
         EXPECT_TRUE(f["stages_ms"].contains("order"));
     }
     EXPECT_GT(j["summary"]["check"]["true_edges"].get<int>(), 0);
-    // A moving scene needs the toothpicks; a path and --frames do not go together.
+    // A moving scene needs the toothpicks.
     EXPECT_NE(run_cli("sort --scene gen:city --eye 0,3,22 --target 0,0,0 --frames 3").exit_code, 0);
+    // Toothpicks moving along a camera path: frame k seen by the path's camera k (repeated).
+    const std::string path = test::temp_dir("cli_sort_path") + "/path.json";
+    test::write_text(path, R"({"frames":[{"eye":[0,3,22],"target":[0,0,0]},{"eye":[22,3,0],"target":[0,0,0]}]})");
+    const CliRun along = run_cli("sort --scene gen:toothpicks:count=40 --path " + path + " --frames 3 --rounds 1 --json");
+    ASSERT_EQ(along.exit_code, 0) << along.err;
+    const auto k = nlohmann::json::parse(along.out);
+    ASSERT_EQ(k["frames"].size(), 3u);
+    EXPECT_EQ(k["frames"][2]["camera"]["eye"], k["frames"][0]["camera"]["eye"]);
+    EXPECT_NE(k["frames"][1]["camera"]["eye"], k["frames"][0]["camera"]["eye"]);
 }
 
 TEST(Cli, SoupCellsSplitLargeObjectsForEveryCommand) {

@@ -84,7 +84,13 @@ SortFrames choose_frames(const SortCommandOptions& o, const Scene& scene, const 
     }
     if (f.cameras.empty()) throw Error("sort: the camera path has no frames");
     if (o.frames > 0) {
-        if (given > 0) throw Error("sort: --frames N moves the scene in front of one camera; it does not go with a path");
+        // Frame k: the scene at its frame k, seen by the path's camera k (the path repeated
+        // when it is shorter).
+        if (given > 0) {
+            const std::vector<Camera> path = f.cameras;
+            f.cameras.clear();
+            for (int k = 0; k < o.frames; ++k) f.cameras.push_back(path[std::size_t(k) % path.size()]);
+        }
         for (int k = 0; k < o.frames; ++k) {
             const std::optional<std::string> spec = toothpicks_at(o.scene.file, k);
             if (!spec) throw Error("sort: --frames N needs a moving scene (gen:toothpicks)");
@@ -294,7 +300,9 @@ void register_sort(CLI::App& app) {
     cmd->add_option("--walk", o->walk, "Sort along a walk of N frames through the scene (Embree finds the floors)");
     cmd->add_option("--random", o->random, "Sort from N random viewpoints in the scene's free space");
     cmd->add_option("--seed", o->seed, "Seed of --walk or --random")->capture_default_str();
-    cmd->add_option("--frames", o->frames, "Move gen:toothpicks through N frames in front of one camera (--eye/--target)");
+    cmd->add_option("--frames", o->frames,
+                    "Move gen:toothpicks through N frames, in front of one camera (--eye/--target) or along a path (frame k "
+                    "seen by the path's camera k)");
     cmd->add_option("--resolution", o->resolution, "Display WxH: the frustum's aspect, and the rays of --check")->capture_default_str();
     cmd->add_flag("--all-directions", o->all_directions, "Sort every object, not only those in the view frustum (the paper's setting)");
     cmd->add_flag("--from-scratch", o->from_scratch, "Sort each frame from scratch, not from the last frame's order");
