@@ -6,7 +6,7 @@
 namespace homcull::sort_detail {
 
 void PairCache::reset(std::size_t objects) {
-    // Sixteen slots per object, from 1,024 to 2^20 (32 MiB at most).
+    // Sixteen slots per object, from 1,024 to 2^20 (2^20 * sizeof(PairContact), 40 MiB, at most).
     std::size_t size = 1024;
     while (size < 16 * objects && size < (std::size_t(1) << 20)) size *= 2;
     entries_.assign(size, PairContact{});

@@ -4,13 +4,17 @@
 // Tarjan's algorithm (Tarjan, "Depth-first search and linear graph algorithms", SIAM J.
 // Computing, 1972) emits a component only after every component it reaches. Following edges
 // from an object to the objects that may hide it, it therefore emits the occluders' layers
-// before the layer they hide: front to back, with each cycle as one layer. Two things keep
+// before the layer they hide: front to back, with each cycle as one layer. Three things keep
 // the tests few:
 // - an object already emitted is never tested again: its layer is in front of whatever is
 //   being visited, whether or not it hides it (Tarjan ignores edges to finished components);
+// - an edge to an object still on the stack is tested only when it could lower the visited
+//   object's low link (inside a large cycle most cannot);
 // - the roots are visited in the last frame's order. Where that order still holds, each
 //   object finds none of its occluders unvisited, and the order comes out unchanged, after
 //   one test per pair that the extents cannot settle and the order does not already cover.
+// Each test (may_hide) runs the cheap rejections first and GJK last; pairs of objects that
+// have not moved answer from what an earlier frame learned (pair_cache.hpp).
 // The components do not depend on the order of the visit, so a sort from scratch (nearest
 // first) gives the same layers; the order within what the occlusions leave free may differ.
 #include <homcull/error.hpp>
@@ -364,7 +368,8 @@ void VisibilitySorter::State::collect_candidates(std::uint32_t object) {
     for (std::uint32_t w : surrounding) candidates.push_back(w);
 }
 
-// Whether `front` may hide part of `back`: the cheap tests on spheres, then the hulls.
+// Whether `front` may hide part of `back`: the spheres' cones, the boxes' axes, what is known of
+// a still pair, GJK on the boxes (large hulls only), then GJK on the hulls.
 bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) {
     const Placed& f = placed[front];
     const Placed& b = placed[back];
@@ -385,10 +390,13 @@ bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) 
             return true;  // hulls that meet: each may hide the other from anywhere
         }
         if (known->contact == std::uint8_t(sort_detail::Contact::apart)) {
-            // The hull of the eye and back stays on back's side of the plane between them.
+            // The hull of the eye and back stays on back's side of the plane between them, more
+            // than this frame's margin from front (the margin may have grown since the pair was
+            // learned, so back's own bound is checked against it too).
             const float side = glm::dot(known->normal, glm::vec3(eye));
             const float room = float(margin);
-            if (back < front ? side < known->above - room : side > known->below + room) {
+            if (back < front ? std::max(side, known->below) < known->above - room
+                             : std::min(side, known->above) > known->below + room) {
                 ++result.stats.remembered;
                 return false;
             }
