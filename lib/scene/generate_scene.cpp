@@ -51,7 +51,43 @@ int to_int(const std::string& key, const std::string& value, std::string_view sp
     return int(v);
 }
 
+
+// The toothpicks' options (and frame) from a spec's key=value options.
+ToothpickSpec toothpick_options(std::map<std::string, std::string>& options, std::string_view spec) {
+    auto take = [&](const char* key) -> const std::string* {
+        auto it = options.find(key);
+        return it == options.end() ? nullptr : &it->second;
+    };
+    ToothpickSpec t;
+    if (auto v = take("seed")) t.options.seed = to_seed(*v, spec);
+    if (auto v = take("count")) t.options.count = to_int("count", *v, spec);
+    if (auto v = take("frame")) t.frame = to_int("frame", *v, spec);
+    if (auto v = take("cube")) t.options.cube = to_number("cube", *v, spec);
+    if (auto v = take("length")) t.options.length = to_number("length", *v, spec);
+    if (auto v = take("thickness")) t.options.thickness = to_number("thickness", *v, spec);
+    if (auto v = take("speed")) t.options.speed = to_number("speed", *v, spec);
+    if (auto v = take("tumble")) t.options.tumble = to_number("tumble", *v, spec);
+    if (auto v = take("density")) {
+        if (*v != "uniform" && *v != "scale")
+            throw Error("generated scene '" + std::string(spec) + "': density must be uniform or scale, got '" + *v + "'");
+        t.options.uniform_density = *v == "uniform";
+    }
+    for (const char* k : {"seed", "count", "frame", "cube", "length", "thickness", "speed", "tumble", "density"}) options.erase(k);
+    if (!options.empty())
+        throw Error("generated scene '" + std::string(spec) + "': unknown option '" + options.begin()->first +
+                    "' (toothpicks takes seed, count, density, frame, cube, length, thickness, speed, tumble)");
+    return t;
+}
+
 }  // namespace
+
+std::optional<ToothpickSpec> toothpick_spec(std::string_view spec) {
+    if (spec.substr(0, 4) == "gen:") spec.remove_prefix(4);
+    const std::size_t colon = spec.find(':');
+    if (spec.substr(0, colon) != "toothpicks") return std::nullopt;
+    auto options = parse_options(colon == std::string_view::npos ? std::string_view{} : spec.substr(colon + 1), spec);
+    return toothpick_options(options, spec);
+}
 
 Scene generate_scene(std::string_view spec) {
     const std::size_t colon = spec.find(':');
@@ -86,26 +122,8 @@ Scene generate_scene(std::string_view spec) {
                         "' (forest takes seed, radius, spacing, rocks)");
         scene = generate_forest(o);
     } else if (name == "toothpicks") {
-        ToothpickOptions o;
-        int frame = 0;
-        if (auto v = take("seed")) o.seed = to_seed(*v, spec);
-        if (auto v = take("count")) o.count = to_int("count", *v, spec);
-        if (auto v = take("frame")) frame = to_int("frame", *v, spec);
-        if (auto v = take("cube")) o.cube = to_number("cube", *v, spec);
-        if (auto v = take("length")) o.length = to_number("length", *v, spec);
-        if (auto v = take("thickness")) o.thickness = to_number("thickness", *v, spec);
-        if (auto v = take("speed")) o.speed = to_number("speed", *v, spec);
-        if (auto v = take("tumble")) o.tumble = to_number("tumble", *v, spec);
-        if (auto v = take("density")) {
-            if (*v != "uniform" && *v != "scale")
-                throw Error("generated scene '" + std::string(spec) + "': density must be uniform or scale, got '" + *v + "'");
-            o.uniform_density = *v == "uniform";
-        }
-        for (const char* k : {"seed", "count", "frame", "cube", "length", "thickness", "speed", "tumble", "density"}) options.erase(k);
-        if (!options.empty())
-            throw Error("generated scene '" + std::string(spec) + "': unknown option '" + options.begin()->first +
-                        "' (toothpicks takes seed, count, density, frame, cube, length, thickness, speed, tumble)");
-        scene = generate_toothpicks(o, frame);
+        const ToothpickSpec t = toothpick_options(options, spec);
+        scene = generate_toothpicks(t.options, t.frame);
     } else {
         throw Error("unknown generated scene '" + name + "' (known: city, forest, toothpicks)");
     }

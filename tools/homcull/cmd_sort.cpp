@@ -5,9 +5,9 @@
 #include "options.hpp"
 
 #include <homcull/error.hpp>
+#include <homcull/generate.hpp>
 #include <homcull/io/camera_path.hpp>
 #include <homcull/isa.hpp>
-#include <homcull/io/scene_io.hpp>
 #include <homcull/scene_sort.hpp>
 #include <homcull/truth/ray_scene.hpp>
 #include <homcull/truth/sort_truth.hpp>
@@ -42,26 +42,11 @@ struct SortCommandOptions {
     bool json = false;
 };
 
-// "gen:toothpicks:..." with frame=K in place of any frame it names; other specs: empty.
-std::optional<std::string> toothpicks_at(const std::string& spec, int frame) {
-    const std::string prefix = "gen:toothpicks";
-    if (spec.rfind(prefix, 0) != 0) return std::nullopt;
-    std::string options = spec.size() > prefix.size() + 1 ? spec.substr(prefix.size() + 1) : "";
-    std::string kept;
-    std::size_t start = 0;
-    while (start <= options.size() && !options.empty()) {
-        const std::size_t comma = std::min(options.find(',', start), options.size());
-        const std::string item = options.substr(start, comma - start);
-        if (!item.empty() && item.rfind("frame=", 0) != 0) kept += item + ",";
-        start = comma + 1;
-    }
-    return prefix + ":" + kept + "frame=" + std::to_string(frame);
-}
-
 // The frames to sort: a camera and (for a moving scene) the scene's spec at that frame.
 struct SortFrames {
     std::vector<Camera> cameras;
-    std::vector<std::string> moving_specs;  // empty: the scene stands still
+    std::optional<ToothpickSpec> toothpicks;  // a moving scene: the toothpicks' options
+    std::vector<int> scene_frames;            // and the scene's frame for each camera
     std::string source;
 };
 
@@ -91,12 +76,10 @@ SortFrames choose_frames(const SortCommandOptions& o, const Scene& scene, const 
             f.cameras.clear();
             for (int k = 0; k < o.frames; ++k) f.cameras.push_back(path[std::size_t(k) % path.size()]);
         }
-        for (int k = 0; k < o.frames; ++k) {
-            const std::optional<std::string> spec = toothpicks_at(o.scene.file, k);
-            if (!spec) throw Error("sort: --frames N needs a moving scene (gen:toothpicks)");
-            f.moving_specs.push_back(*spec);
-        }
-        f.source += ", frames 0-" + std::to_string(o.frames - 1);
+        f.toothpicks = toothpick_spec(o.scene.file);
+        if (!f.toothpicks) throw Error("sort: --frames N needs a moving scene (gen:toothpicks)");
+        for (int k = 0; k < o.frames; ++k) f.scene_frames.push_back(f.toothpicks->frame + k);
+        f.source += ", frames " + std::to_string(f.scene_frames.front()) + "-" + std::to_string(f.scene_frames.back());
     }
     return f;
 }
@@ -116,6 +99,12 @@ FrameInput frame_input(const Scene& scene, const Camera& camera, Resolution disp
     return in;
 }
 
+// The toothpicks placed at `frame` (their transforms, then the bounds).
+void move_toothpicks(Scene& scene, const ToothpickOptions& options, int frame) {
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) scene.objects[i].world = toothpick_transform(options, int(i), frame);
+    scene.finalize();
+}
+
 struct FrameResult {
     VisibilitySortStats stats;
     std::vector<double> total_ms;  // one per round
@@ -127,7 +116,6 @@ struct FrameResult {
 
 void run_sort(const SortCommandOptions& o) {
     const Resolution display = parse_resolution(o.resolution);
-    if (o.rounds < 1) throw Error("sort: --rounds must be at least 1");
     Scene scene = load_chosen_scene(o.scene);
     const glm::dvec3 origin = scene_anchor(scene);
     std::unique_ptr<RayScene> rays;
@@ -139,18 +127,14 @@ void run_sort(const SortCommandOptions& o) {
     VisibilitySorter sorter = make_visibility_sorter(scene, o.hull_points);
     const double hull_ms = elapsed_ms(start);
 
-    // Every frame's input made before any is timed (a moving scene is made again per frame).
+    // Every frame's input made before any is timed; a moving scene is a copy moved per frame.
+    const bool moving = frames.toothpicks.has_value();
+    Scene moved = moving ? scene : Scene{};
     std::vector<FrameInput> inputs;
-    std::vector<Scene> moved;
     for (std::size_t k = 0; k < frames.cameras.size(); ++k) {
-        const Scene* at = &scene;
-        if (!frames.moving_specs.empty()) {
-            moved.push_back(load_scene(frames.moving_specs[k]));
-            at = &moved.back();
-        }
-        inputs.push_back(frame_input(*at, frames.cameras[k], display, origin));
+        if (moving) move_toothpicks(moved, frames.toothpicks->options, frames.scene_frames[k]);
+        inputs.push_back(frame_input(moving ? moved : scene, frames.cameras[k], display, origin));
     }
-    if (!o.check) moved.clear();
 
     std::vector<FrameResult> results(inputs.size());
     for (int round = 0; round < o.rounds; ++round) {
@@ -171,15 +155,14 @@ void run_sort(const SortCommandOptions& o) {
                 if (l.count > 1) r.cycles.push_back(r.layers.back());
             }
             if (o.check) {
-                const Scene& at = frames.moving_specs.empty() ? scene : moved[k];
+                // The ray scene of this frame: the still scene's is made once and kept.
+                if (moving) move_toothpicks(moved, frames.toothpicks->options, frames.scene_frames[k]);
+                const Scene& at = moving ? moved : scene;
                 std::unique_ptr<RayScene> own;
-                const RayScene* truth_rays = rays.get();
-                if (!frames.moving_specs.empty() || !truth_rays) {
-                    own = std::make_unique<RayScene>(at);
-                    truth_rays = own.get();
-                    if (frames.moving_specs.empty()) rays = std::move(own), truth_rays = rays.get();
-                }
-                const SortTruth truth = occlusion_edges(*truth_rays, at.objects.size(), frames.cameras[k], display);
+                if (moving) own = std::make_unique<RayScene>(at);
+                else if (!rays) rays = std::make_unique<RayScene>(scene);
+                const RayScene& truth_rays = moving ? *own : *rays;
+                const SortTruth truth = occlusion_edges(truth_rays, at.objects.size(), frames.cameras[k], display);
                 std::vector<std::uint32_t> layer_of(at.objects.size(), kUnsorted);
                 for (std::uint32_t l = 0; l < r.layers.size(); ++l)
                     for (std::uint32_t id : r.layers[l]) layer_of[id] = l;
@@ -297,16 +280,20 @@ void register_sort(CLI::App& app) {
     add_scene_option(*cmd, o->scene, true,
                      "Scene file or generated scene; gen:toothpicks[:count=1600,density=uniform,...] moves with --frames N");
     add_camera_options(*cmd, o->camera);
-    cmd->add_option("--walk", o->walk, "Sort along a walk of N frames through the scene (Embree finds the floors)");
-    cmd->add_option("--random", o->random, "Sort from N random viewpoints in the scene's free space");
+    cmd->add_option("--walk", o->walk, "Sort along a walk of N frames through the scene (Embree finds the floors)")
+        ->check(CLI::Range(0, 1000000));
+    cmd->add_option("--random", o->random, "Sort from N random viewpoints in the scene's free space")->check(CLI::Range(0, 1000000));
     cmd->add_option("--seed", o->seed, "Seed of --walk or --random")->capture_default_str();
     cmd->add_option("--frames", o->frames,
                     "Move gen:toothpicks through N frames, in front of one camera (--eye/--target) or along a path (frame k "
-                    "seen by the path's camera k)");
+                    "seen by the path's camera k)")
+        ->check(CLI::Range(0, 1000000));
     cmd->add_option("--resolution", o->resolution, "Display WxH: the frustum's aspect, and the rays of --check")->capture_default_str();
     cmd->add_flag("--all-directions", o->all_directions, "Sort every object, not only those in the view frustum (the paper's setting)");
     cmd->add_flag("--from-scratch", o->from_scratch, "Sort each frame from scratch, not from the last frame's order");
-    cmd->add_option("--rounds", o->rounds, "Runs over all the frames; each frame's time is the median")->capture_default_str();
+    cmd->add_option("--rounds", o->rounds, "Runs over all the frames; each frame's time is the median")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
     cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
         ->capture_default_str();
     cmd->add_option("--hull-points", o->hull_points, "At most N points per hull, grown to hold the mesh (0: exact hulls)")

@@ -5,6 +5,7 @@
 #include <homcull/scene.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 namespace homcull {
@@ -56,6 +57,14 @@ Scene generate_toothpicks(const ToothpickOptions& options, int frame = 0);
 // Toothpick `index`'s model-to-world transform at `frame` (what generate_toothpicks places
 // it with), for moving an already generated scene along frames.
 glm::dmat4 toothpick_transform(const ToothpickOptions& options, int index, int frame);
+// The options and frame of a "toothpicks:..." spec (with or without "gen:" in front), as
+// generate_scene reads them; nullopt for any other scene. Throws homcull::Error as
+// generate_scene does on a bad option.
+struct ToothpickSpec {
+    ToothpickOptions options;
+    int frame = 0;
+};
+std::optional<ToothpickSpec> toothpick_spec(std::string_view spec);
 
 // "city", "forest", "toothpicks", or one with options: "city:seed=3,blocks=10",
 // "forest:seed=2,radius=80,spacing=5,rocks=100", "toothpicks:seed=1,count=1600,density=uniform,frame=10"
