@@ -682,7 +682,9 @@ TEST(Isa, VertexCacheOnPackedPositionsWithThreadsGivesTheReferenceBits) {
 // The scene culler tests the objects left by its traversal in tasks of the job system (one-pass
 // and temporal, whose buffer no longer changes): the same answers, levels and counts as on one
 // thread, for boxes, parts and occludee triangles, with threads and in a shuffled task order.
-TEST(RenderThreads, SceneCullerObjectTestsInTasksAnswerAsOneThread) {
+// One-pass and temporal culls with a job system traverse the hierarchy in tasks: the same
+// answers, node tests and object tests as the front-to-back traversal on one thread.
+TEST(RenderThreads, SceneCullerTraversalInTasksAnswersAsOneThread) {
     CityOptions city;
     city.blocks = 5;
     const Scene scene = generate_city(city);
@@ -712,10 +714,15 @@ TEST(RenderThreads, SceneCullerObjectTestsInTasksAnswerAsOneThread) {
                 for (std::size_t id = 0; id < a.size(); ++id) {
                     ASSERT_EQ(a[id].visibility, b[id].visibility) << "object " << id;
                     ASSERT_EQ(a[id].level_of_visibility, b[id].level_of_visibility) << "object " << id;
+                    ASSERT_EQ(a[id].overlap_exit, b[id].overlap_exit) << "object " << id;
                     ASSERT_EQ(a[id].visibility, c[id].visibility) << "object " << id;
                     hidden += a[id].visibility == Visibility::occluded;
                 }
+                EXPECT_GT(serial.work().nodes_tested, 0u);
+                EXPECT_EQ(serial.work().nodes_tested, threaded.work().nodes_tested);
+                EXPECT_EQ(serial.work().nodes_tested, reordered.work().nodes_tested);
                 EXPECT_EQ(serial.work().objects_tested, threaded.work().objects_tested);
+                EXPECT_EQ(serial.work().objects_tested, reordered.work().objects_tested);
                 EXPECT_EQ(serial.work().occludee_parts_tested, threaded.work().occludee_parts_tested);
                 EXPECT_EQ(serial.work().occludee_parts_tested, reordered.work().occludee_parts_tested);
             }

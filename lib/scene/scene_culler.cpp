@@ -26,6 +26,21 @@ OcclusionMapsConfig maps_config(const SceneCullerConfig& c) {
     return m;
 }
 
+// The most edges from the root to a node (0 for a root alone or no nodes).
+std::size_t hierarchy_depth(const ObjectHierarchy& hierarchy) {
+    if (hierarchy.nodes.empty()) return 0;
+    std::size_t deepest = 0;
+    std::vector<std::pair<std::uint32_t, std::size_t>> stack{{0u, 0}};
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        deepest = std::max(deepest, depth);
+        const ObjectHierarchy::Node& node = hierarchy.nodes[index];
+        if (!node.leaf()) stack.insert(stack.end(), {{node.first_child, depth + 1}, {node.first_child + 1, depth + 1}});
+    }
+    return deepest;
+}
+
 }  // namespace
 
 int automatic_samples(Resolution display, Resolution buffer) {
@@ -120,8 +135,11 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     frame_shared_.reserve(occluders_.triangle_count());
     frame_apexes_.reserve(3 * occluders_.triangle_count());
     last_visibility_.assign(scene.objects.size(), Visibility::visible);
-    objects_to_test_.reserve(scene.objects.size());
     task_tallies_.resize(64);
+    subtrees_.reserve(hierarchy_.nodes.size());
+    next_subtrees_.reserve(hierarchy_.nodes.size());
+    task_stack_room_ = hierarchy_depth(hierarchy_) + 1;
+    task_stacks_.resize(task_tallies_.size() * task_stack_room_);
 
     // Approximate mode: each part would tolerate the holes again, so no parts.
     parts_.build(scene, config.maps.hole_pixels == 0.0 ? config.occludee_parts : 0, config.triangle_test_limit, anchor_);

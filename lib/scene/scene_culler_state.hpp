@@ -117,17 +117,23 @@ public:
     OccludeeAnswer box_answer(const Frame& frame, const Aabb& box) const;
     // What object tests count, per task when they run in parallel (then added to work_ and exits_).
     struct TestTally {
-        std::size_t objects = 0, parts = 0;
+        std::size_t nodes = 0, objects = 0, parts = 0;
         std::uint64_t exits[7] = {};
     };
     void add_tally(const TestTally& tally);
     // Thread-safe for distinct objects: it writes only their answers and caches.
     OccludeeAnswer test_object(const Frame& frame, std::uint32_t id, TestTally& tally);
-    // one_pass and temporal: the objects traversal left to test one by one, tested after it, in
-    // tasks of the caller's job system (the buffer does not change meanwhile).
-    std::vector<std::uint32_t> objects_to_test_;
+    // Whether a hierarchy node is tested and found hidden; its answer then goes to every object
+    // under it. Thread-safe for disjoint subtrees.
+    bool node_hidden(const Frame& frame, std::uint32_t node_index, std::vector<OccludeeAnswer>& answers, TestTally& tally) const;
+    // one_pass and temporal with a job system: the buffer does not change during the tests, so
+    // the hierarchy's subtrees are traversed in tasks (scene_traversal.cpp).
+    void traverse_in_tasks(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     std::vector<TestTally> task_tallies_;
-    void test_objects_in_tasks(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
+    std::vector<std::uint32_t> subtrees_, next_subtrees_;  // traverse_in_tasks' frontier
+    // Per task, room for a depth-first traversal's stack of nodes: the hierarchy's depth + 1.
+    std::size_t task_stack_room_ = 0;
+    std::vector<std::uint32_t> task_stacks_;
     // Occludee triangles in world space (transformed as ground truth transforms them) for the
     // samples test: object id -> its first vertex in occludee_positions_, or kNotGathered.
     static constexpr std::size_t kNotGathered = ~std::size_t(0);

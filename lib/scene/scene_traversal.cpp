@@ -9,6 +9,7 @@
 #include "scene/scene_culler_frame.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -30,14 +31,18 @@ float farthest_distance2(const glm::dvec3& eye, const Aabb& box) {
 }  // namespace
 
 // Nodes come out of a heap nearest first (Greene's front-to-back order, which progressive
-// culling needs so that near occluders are drawn before far nodes are tested). A node is
-// tested when the configuration asks for hierarchy tests and it holds more than one object;
-// if its box is outside the frustum or occluded, so is every object under it.
+// culling needs so that near occluders are drawn before far nodes are tested); a hidden node
+// answers for every object under it (node_hidden).
 void detail::SceneCullerState::traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     const auto start = std::chrono::steady_clock::now();
     const double flushes_before = timings_.render_ms + timings_.maps_ms;
     answers.assign(scene_->objects.size(), OccludeeAnswer{Visibility::view_culled, 0.0f, 0});
     const bool progressive = config_.strategy == CullStrategy::progressive;
+    if (!progressive && parallel.run != nullptr) {  // without progressive's draws the buffer is final
+        traverse_in_tasks(frame, answers, parallel);
+        timings_.test_ms = ms_since(start);
+        return;
+    }
     const std::size_t budget = config_.occluder_budget.triangles == 0 ? ~std::size_t(0) : config_.occluder_budget.triangles;
     const auto nearest_first = [](const std::pair<float, std::uint32_t>& a, const std::pair<float, std::uint32_t>& b) {
         return a.first > b.first;
@@ -49,10 +54,6 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
     float waiting_nearest_far = std::numeric_limits<float>::infinity();  // squared, of the waiting occluders
     node_heap_.clear();
     if (!hierarchy_.nodes.empty()) node_heap_.emplace_back(0.0f, 0u);
-    // Without progressive's draws the buffer is final: the objects are tested after the
-    // traversal, in tasks, when there is a job system.
-    const bool in_tasks = !progressive && parallel.run != nullptr;
-    objects_to_test_.clear();
     while (!node_heap_.empty()) {
         std::pop_heap(node_heap_.begin(), node_heap_.end(), nearest_first);
         const std::uint32_t node_index = node_heap_.back().second;
@@ -65,15 +66,10 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
             build_maps(frame);
             waiting_nearest_far = std::numeric_limits<float>::infinity();
         }
-        if (config_.hierarchy && node.end - node.begin > 1) {
-            const OccludeeAnswer a = box_answer(frame, node_boxes_[node_index]);
-            ++work_.nodes_tested;
-            if (a.visibility != Visibility::visible) {
-                for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
-                exits_.count[a.overlap_exit] += node.end - node.begin;
-                continue;
-            }
-        }
+        TestTally node_tally;
+        const bool hidden = node_hidden(frame, node_index, answers, node_tally);
+        add_tally(node_tally);
+        if (hidden) continue;
         if (!node.leaf()) {
             for (std::uint32_t c = node.first_child; c < node.first_child + 2; ++c) {
                 node_heap_.emplace_back(distance2_to_box(frame.camera->eye, hierarchy_.nodes[c].bounds), c);
@@ -83,10 +79,6 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
         }
         for (std::uint32_t i = node.begin; i < node.end; ++i) {
             const std::uint32_t id = hierarchy_.object_ids[i];
-            if (in_tasks) {
-                objects_to_test_.push_back(id);
-                continue;
-            }
             TestTally tally;
             answers[id] = test_object(frame, id, tally);
             add_tally(tally);
@@ -98,35 +90,89 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
             }
         }
     }
-    if (in_tasks) test_objects_in_tasks(frame, answers, parallel);
     timings_.test_ms = ms_since(start) - (timings_.render_ms + timings_.maps_ms - flushes_before);
 }
 
 void detail::SceneCullerState::add_tally(const TestTally& tally) {
+    work_.nodes_tested += tally.nodes;
     work_.objects_tested += tally.objects;
     work_.occludee_parts_tested += tally.parts;
     for (int e = 0; e < 7; ++e) exits_.count[e] += tally.exits[e];
 }
 
-// The objects in objects_to_test_, in as many tasks as task_tallies_ holds (a few per thread,
-// since objects differ widely in cost), each a contiguous run with its own tally.
-void detail::SceneCullerState::test_objects_in_tasks(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
-    const std::size_t n = objects_to_test_.size();
+// A node is tested when the configuration asks for hierarchy tests and it holds more than one
+// object; if its box is outside the frustum or occluded, so is every object under it.
+bool detail::SceneCullerState::node_hidden(const Frame& frame, std::uint32_t node_index, std::vector<OccludeeAnswer>& answers,
+                                           TestTally& tally) const {
+    const ObjectHierarchy::Node& node = hierarchy_.nodes[node_index];
+    if (!config_.hierarchy || node.end - node.begin <= 1) return false;
+    const OccludeeAnswer a = box_answer(frame, node_boxes_[node_index]);
+    ++tally.nodes;
+    if (a.visibility == Visibility::visible) return false;
+    for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
+    tally.exits[a.overlap_exit] += node.end - node.begin;
+    return true;
+}
+
+// With the buffer final, no answer depends on the order of the tests, and a node is tested
+// exactly when none of its ancestors was found hidden, in any order: so the answers and the
+// counts are those of the front-to-back traversal. The top of the hierarchy is split here,
+// level by level (testing the inner nodes it opens), until there are several subtrees per
+// thread or only leaves are left. Tasks then take the subtrees one at a time from a shared
+// counter (their costs differ widely: a hidden subtree costs one test) and traverse each depth
+// first, testing its nodes and objects with the task's own tally.
+void detail::SceneCullerState::traverse_in_tasks(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
     const std::size_t threads = parallel.threads == 0 ? 2 : parallel.threads;
-    const std::size_t tasks = std::min({task_tallies_.size(), 8 * threads, (n + 15) / 16});
+    subtrees_.clear();
+    if (!hierarchy_.nodes.empty()) subtrees_.push_back(0);
+    TestTally top;
+    bool opened = true;
+    while (opened && subtrees_.size() < 8 * threads) {
+        opened = false;
+        next_subtrees_.clear();
+        for (const std::uint32_t n : subtrees_) {
+            const ObjectHierarchy::Node& node = hierarchy_.nodes[n];
+            if (node.leaf()) {  // left for a task, untested
+                next_subtrees_.push_back(n);
+                continue;
+            }
+            opened = true;
+            if (!node_hidden(frame, n, answers, top)) next_subtrees_.insert(next_subtrees_.end(), {node.first_child, node.first_child + 1});
+        }
+        subtrees_.swap(next_subtrees_);
+    }
+    add_tally(top);
+
+    const std::size_t tasks = std::min({task_tallies_.size(), 2 * threads, subtrees_.size()});
     for (std::size_t k = 0; k < tasks; ++k) task_tallies_[k] = TestTally{};
     struct Job {
         SceneCullerState* self;
         const Frame* frame;
         std::vector<OccludeeAnswer>* answers;
-        std::size_t n, tasks;
-    } job{this, &frame, &answers, n, tasks};
+        std::atomic<std::size_t> next_subtree{0};
+    } job{this, &frame, &answers};
     run_tasks(parallel, tasks, [](void* data, std::size_t k) {
-        const Job& j = *static_cast<const Job*>(data);
-        TestTally& tally = j.self->task_tallies_[k];
-        for (std::size_t i = j.n * k / j.tasks; i < j.n * (k + 1) / j.tasks; ++i) {
-            const std::uint32_t id = j.self->objects_to_test_[i];
-            (*j.answers)[id] = j.self->test_object(*j.frame, id, tally);
+        Job& j = *static_cast<Job*>(data);
+        SceneCullerState& self = *j.self;
+        TestTally& tally = self.task_tallies_[k];
+        std::uint32_t* stack = self.task_stacks_.data() + k * self.task_stack_room_;
+        for (std::size_t s = j.next_subtree++; s < self.subtrees_.size(); s = j.next_subtree++) {
+            std::size_t depth = 0;  // depth first: at most the hierarchy's depth + 1 waiting
+            stack[depth++] = self.subtrees_[s];
+            while (depth > 0) {
+                const std::uint32_t index = stack[--depth];
+                if (self.node_hidden(*j.frame, index, *j.answers, tally)) continue;
+                const ObjectHierarchy::Node& node = self.hierarchy_.nodes[index];
+                if (!node.leaf()) {
+                    stack[depth++] = node.first_child + 1;
+                    stack[depth++] = node.first_child;
+                    continue;
+                }
+                for (std::uint32_t i = node.begin; i < node.end; ++i) {
+                    const std::uint32_t id = self.hierarchy_.object_ids[i];
+                    (*j.answers)[id] = self.test_object(*j.frame, id, tally);
+                }
+            }
         }
     }, &job);
     for (std::size_t k = 0; k < tasks; ++k) add_tally(task_tallies_[k]);

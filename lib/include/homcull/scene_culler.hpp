@@ -146,7 +146,9 @@ public:
     // overlap_exit is the deciding box test's (the object's own, or the hidden node's above
     // it); an object its triangles found hidden reports level of visibility 0. Throws
     // homcull::Error on an invalid or orthographic camera (validate_camera; the occlusion maps
-    // compare perspective depths).
+    // compare perspective depths). With a job system (`parallel`) the render runs in bands of
+    // rows and, for one_pass and temporal, the hierarchy is traversed and its nodes and objects
+    // tested in tasks; the answers are those of one thread.
     void cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
     // temporal: forget the last frame (after a camera cut), so that the next frame works as
     // one_pass.
