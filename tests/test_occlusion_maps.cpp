@@ -427,10 +427,13 @@ TEST(OcclusionMaps, ConservativeOverlapIsExactOnRandomInput) {
 // the same visibility as the overlap-then-depth test of maps that make them, and a visible
 // rectangle's level of visibility is its exact uncovered share (1 when all its samples are
 // covered). build_pyramid() then gives the full maps' answers, exits and estimates included.
-// On random triangles and rectangles, odd sizes and every sample count.
+// On random triangles and rectangles, odd sizes, every sample count and every instruction set
+// (the table's covered counts come from a kernel).
 TEST(OcclusionMaps, LazyMapsAnswerAsTheFullMapsWithoutThePyramids) {
-    std::mt19937 rng(5);
+    for (const std::string& isa : available_isas())
     for (int s : {1, 2, 4}) {
+        const test::ScopedIsa selected(isa);
+        std::mt19937 rng(5);
         const int width = 93, height = 67;
         OcclusionBuffer buffer(test::buffer_config(width, height, s, 0.5f));
         buffer.render(test::clip_space_input(test::random_clip_triangles(std::uint64_t(s) + 20, 500, 0.5f)));
@@ -462,7 +465,7 @@ TEST(OcclusionMaps, LazyMapsAnswerAsTheFullMapsWithoutThePyramids) {
             const ScreenRect r = pixel_rect(sw, sh, i0 + 0.25, j0 + 0.25, i1 + 0.75, j1 + 0.75, w_of(rng));
             rects.push_back(r);
             const OccludeeAnswer a = lazy.test_rect(r), b = full.test_rect(r);
-            const std::string what = "S " + std::to_string(s) + " samples [" + std::to_string(i0) + ", " + std::to_string(i1) + "] x [" +
+            const std::string what = isa + " S " + std::to_string(s) + " samples [" + std::to_string(i0) + ", " + std::to_string(i1) + "] x [" +
                                      std::to_string(j0) + ", " + std::to_string(j1) + "]";
             ASSERT_EQ(a.visibility, b.visibility) << what;
             ASSERT_EQ(exit_of(a), OverlapExit::not_run) << what;

@@ -6,6 +6,7 @@
 
 #include "buffer/buffer_state.hpp"
 #include "buffer/rect_queries.hpp"
+#include "hom/map_kernels.hpp"
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -15,21 +16,29 @@ namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 
+// The scalar choice's CoveredCountsKernel.
+void covered_counts_reference(const std::uint32_t* masks, int count, std::uint32_t* counts) {
+    for (int k = 0; k < count; ++k) counts[k] = detail::bit_count(masks[k]);
+}
+
 }  // namespace
 
 // One pass over the subtiles' coverage masks: a fortieth of the pyramids' work at one sample
-// per pixel (one 32-bit mask a subtile against a count, and depths, per pixel).
+// per pixel (one 32-bit mask a subtile against a count, and depths, per pixel). A row's counts
+// come from the instruction set's kernel (map_kernels.hpp), then are summed along the row.
 void detail::MapsState::sum_covered_samples() {
     const detail::BufferState& state = built_->state();
     const int tiles_x = sums_width_ - 1, tiles_y = int(covered_sums_.size() / std::size_t(sums_width_)) - 1;
+    const detail::CoveredCountsKernel count_row = built_with_->covered_counts ? built_with_->covered_counts : &covered_counts_reference;
     std::uint32_t* sums = covered_sums_.data();
+    std::uint32_t* counts = row_counts_.data();
     for (int ty = 0; ty < tiles_y; ++ty) {
         const std::uint32_t* above = sums + std::size_t(ty) * std::size_t(sums_width_);
         std::uint32_t* row = sums + std::size_t(ty + 1) * std::size_t(sums_width_);
-        const std::uint32_t* covered = state.covered_.data() + state.at(0, ty);
+        count_row(state.covered_.data() + state.at(0, ty), tiles_x, counts);
         std::uint32_t run = 0;  // this row's covered samples left of tx + 1
         for (int tx = 0; tx < tiles_x; ++tx) {
-            run += detail::bit_count(covered[tx]);
+            run += counts[tx];
             row[tx + 1] = above[tx + 1] + run;
         }
     }

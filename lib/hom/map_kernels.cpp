@@ -2,7 +2,16 @@
 #include "hom/map_kernels.hpp"
 
 namespace homcull::detail {
+namespace {
 
-const MapKernels& map_kernels(const IsaChoice& choice) { return kernel_table<MapKernels, &resolve_map_kernels>(choice); }
+MapKernels resolve_all(const IsaChoice& choice) {
+    MapKernels kernels = resolve_map_kernels(choice);
+    resolve_covered_counts_kernel(choice, kernels);
+    return kernels;
+}
+
+}  // namespace
+
+const MapKernels& map_kernels(const IsaChoice& choice) { return kernel_table<MapKernels, &resolve_all>(choice); }
 
 }  // namespace homcull::detail

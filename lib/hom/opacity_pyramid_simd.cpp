@@ -99,8 +99,11 @@ HWY_EXPORT(ReducePyramidRow);
 HWY_EXPORT(Level0SingleSample);
 
 MapKernels resolve_map_kernels(const IsaChoice& choice) {
-    if (choice.scalar) return {nullptr, nullptr};
-    return {HOMCULL_KERNEL_FOR(choice, Level0SingleSample), HOMCULL_KERNEL_FOR(choice, ReducePyramidRow)};
+    MapKernels kernels;
+    if (choice.scalar) return kernels;
+    kernels.level0 = HOMCULL_KERNEL_FOR(choice, Level0SingleSample);
+    kernels.reduce_row = HOMCULL_KERNEL_FOR(choice, ReducePyramidRow);
+    return kernels;
 }
 
 }  // namespace homcull::detail
