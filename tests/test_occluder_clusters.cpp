@@ -342,6 +342,53 @@ TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
     }
 }
 
+// ClusteredInput::backfaces: each cluster drawn with its own backface mode. All of them cw is
+// the draw's cw; a mix (cw for every other cluster listed) gives the same bits on every
+// instruction set, serial or in tasks, and culls fewer triangles than all cw and more than none.
+TEST(ClusteredRender, EachClusterTakesItsOwnBackfaceMode) {
+    const CastleOccluders* c = castle();
+    if (!c) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const OccluderClusters clusters = test::cluster_world(c->world);
+    const Camera& camera = c->views.frames[0];
+    const BufferConfig config = test::buffer_config(320, 180, 2, float(camera.near_plane));
+    const ClusteredInput whole{&clusters, clip_from_world(camera, 1280.0 / 720.0), Backface::cw};
+    std::vector<std::uint32_t> ids;  // every cluster, in reverse: backfaces follow the list, not the numbers
+    for (std::size_t k = clusters.clusters.size(); k-- > 0;) ids.push_back(std::uint32_t(k));
+    std::vector<Backface> all_cw(ids.size(), Backface::cw), mixed(ids.size(), Backface::none);
+    for (std::size_t n = 0; n < ids.size(); n += 2) mixed[n] = Backface::cw;
+    const test::ScopedIsa reference_isa("scalar");
+    OcclusionBuffer by_draw(config), by_cluster(config), reference(config), none(config);
+    by_draw.render_frame(whole);
+    ClusteredInput listed = whole;
+    listed.backface = Backface::none;  // overridden by every cluster's own
+    listed.cluster_ids = ids.data();
+    listed.cluster_count = ids.size();
+    listed.backfaces = all_cw.data();
+    by_cluster.render_frame(listed);
+    EXPECT_TRUE(test::same_subtiles(by_draw, by_cluster));
+    EXPECT_EQ(by_draw.stats().backface_culled, by_cluster.stats().backface_culled);
+    listed.backfaces = mixed.data();
+    reference.render_frame(listed);
+    listed.backfaces = nullptr;
+    none.render_frame(listed);
+    EXPECT_GT(reference.stats().backface_culled, 0u);
+    EXPECT_LT(reference.stats().backface_culled, by_draw.stats().backface_culled);
+    EXPECT_EQ(none.stats().backface_culled, 0u);
+    listed.backfaces = mixed.data();
+    std::mt19937_64 order_rng(7);
+    const ParallelFor tbb = test::parallel_jobs(), shuffled{test::run_shuffled, &order_rng};
+    for (const std::string& isa : available_isas())
+        for (const ParallelFor& parallel : {ParallelFor{}, tbb, shuffled}) {
+            const test::ScopedIsa selected(isa);
+            OcclusionBuffer buffer(config);
+            buffer.render_frame(listed, parallel);
+            const std::string what = isa + (parallel.run ? (parallel.user ? ", shuffled" : ", TBB") : ", serial");
+            EXPECT_TRUE(reference.stats() == buffer.stats()) << what;
+            EXPECT_TRUE(test::same_subtiles(reference, buffer)) << what;
+            EXPECT_TRUE(test::same_pyramid(reference, buffer)) << what;
+        }
+}
+
 // Runs a closed task list's tasks through a job system (the engine's side of the pull model).
 void run_task_list(OcclusionBuffer& buffer, const ParallelFor& jobs) {
     const std::size_t tasks = buffer.close_tasks();

@@ -176,7 +176,7 @@ public:
     Vector<std::uint8_t> band_ran_;     // per band: its task ran (finish_tasks checks them all)
     Vector<RasterTriangle> setup_triangles_;  // each ClusterSetup's room, one after the other
     // Where a cluster's box lands (in view, outside, or no triangles). In job-system tasks: noexcept.
-    void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
+    void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip, Backface backface,
                        ClusterPlace& out) const noexcept;
     // After the bands: the pyramid levels above those each band built (kBandPyramidLevels).
     void reduce_pyramid_above_bands();

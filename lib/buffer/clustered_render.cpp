@@ -26,7 +26,7 @@ using detail::kBandPyramidLevels;
 using detail::kBandSubtileRows;
 
 // A cluster as the triangle pipeline takes it: its own vertices, its local 16-bit indices.
-TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderCluster& c, const ClusteredInput& in) {
+TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderCluster& c, const ClusteredInput& in, Backface backface) {
     TriangleInput t;
     t.positions = clusters.positions.data() + 3 * std::size_t(c.first_vertex);
     t.position_components = 3;
@@ -36,7 +36,7 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
     t.indices_16bit = true;
     t.triangle_count = c.triangle_count;
     t.model_to_clip = in.model_to_clip;
-    t.backface = in.backface;
+    t.backface = backface;
     t.orthographic = in.orthographic;
     t.shared_edges = (in.shared_edges ? in.shared_edges : clusters.shared_edges.data()) + c.first_triangle;
     t.edge_apexes = (in.shared_edges ? in.edge_apexes : clusters.edge_apexes.data()) + 3 * std::size_t(c.first_triangle);
@@ -48,19 +48,19 @@ TriangleInput cluster_input(const OccluderClusters& clusters, const OccluderClus
 // Runs in job-system tasks, which must not throw: every check that can fail stays in
 // render_clusters' serial loop, before the tasks.
 void detail::BufferState::place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip,
-                                    ClusterPlace& out) const noexcept {
+                                    Backface backface, ClusterPlace& out) const noexcept {
     out.fate = ClusterPlace::kInView;
     if (c.triangle_count == 0) {
         out.fate = ClusterPlace::kEmpty;
         return;
     }
-    out.placed = {0.0f, number, 0, 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false};  // untestable: every sample, no test
+    out.placed = {0.0f, number, 0, 0, sample_width_ - 1, 0, sample_height_ - 1, 0.0f, false, backface};  // untestable: every sample, no test
     ScreenRect rect;
     Visibility decided = Visibility::visible;
     detail::RectQuery q;
     if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, model_to_clip, config_.near_w, config_.orthographic, rect, decided) &&
         prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
-        out.placed = {rect.w_min, number, 0, q.i0, q.i1, q.j0, q.j1, q.d_near, true};
+        out.placed = {rect.w_min, number, 0, q.i0, q.i1, q.j0, q.j1, q.d_near, true, backface};
     else if (decided != Visibility::visible)  // outside the view, or between sample centres
         out.fate = ClusterPlace::kOutside;
 }
@@ -112,7 +112,8 @@ std::size_t detail::BufferState::place_clusters(const ClusteredInput& in, const 
         const OccluderClusters& set = *j.in->clusters;
         for (std::size_t n = task * kClustersPerPlacementTask; n < std::min(j.count, (task + 1) * kClustersPerPlacementTask); ++n) {
             const std::size_t k = j.in->cluster_ids ? j.in->cluster_ids[n] : n;
-            j.self->place_cluster(set.clusters[k], std::uint32_t(k), j.in->model_to_clip, j.self->cluster_places_[n]);
+            j.self->place_cluster(set.clusters[k], std::uint32_t(k), j.in->model_to_clip, j.in->backfaces ? j.in->backfaces[n] : j.in->backface,
+                                  j.self->cluster_places_[n]);
         }
     };
     const std::size_t place_tasks = (count + kClustersPerPlacementTask - 1) / kClustersPerPlacementTask;
@@ -186,7 +187,7 @@ struct detail::BufferState::ClusterPass {
     template <typename Emit>
     void set_up(const PlacedCluster& p, const detail::VertexClip& cache, RasterStats& stats, Emit&& emit) const {
         const ClusteredInput& in = b.recorded_draws_[p.draw];
-        const TriangleInput t = cluster_input(*in.clusters, in.clusters->clusters[p.cluster], in);
+        const TriangleInput t = cluster_input(*in.clusters, in.clusters->clusters[p.cluster], in, p.backface);
         kernels.transform_vertices(t, double(b.config_.near_w), 0, t.vertex_count, cache);
         detail::setup_triangle_range(t, &cache, 0, t.triangle_count, b.config_.near_w, b.config_.edge_margin, b.sample_width_,
                                      b.sample_height_, nullptr, stats, kernels, emit);

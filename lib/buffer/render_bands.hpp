@@ -93,6 +93,7 @@ struct detail::BufferState::PlacedCluster {
     int i0, i1, j0, j1;
     float d_near;
     bool testable;
+    Backface backface;  // its triangles' (ClusteredInput::backfaces, or the draw's)
 };
 
 // Where a cluster's box lands this frame (detail::BufferState::place_cluster), one per cluster of

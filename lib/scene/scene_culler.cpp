@@ -182,6 +182,7 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_apexes_.clear();
     frame_rendered_ = 0;  // the buffer is cleared by the frame's first render (render_frame), or by build_maps
     frame_clusters_.clear();
+    frame_cluster_backfaces_.clear();
     frame_clusters_rendered_ = 0;
     frame_cluster_triangles_waiting_ = 0;
     frame_back_faces_waiting_ = 0;
@@ -301,17 +302,19 @@ void detail::SceneCullerState::build_clusters() {
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
     frame_clusters_.reserve(clusters_.clusters.size());
+    frame_cluster_backfaces_.reserve(clusters_.clusters.size());
 }
 
 // A candidate is closed when every edge of its triangles is shared within the object, in
 // opposite order (own_shared_edges_: all three bits), and it encloses a positive volume (the
 // divergence theorem over its triangles: the counter-clockwise normals point out of the solid,
-// so an eye in free space sees their front sides). Its triangles' front planes are kept for
-// the per-frame test.
+// so an eye in free space sees their front sides). Drawn as triangles, its triangles' front
+// planes are kept for the per-frame test; drawn as clusters, the rasterizer culls its back
+// faces (append_occluder).
 void detail::SceneCullerState::find_closed_candidates() {
     closed_.assign(occluder_ids_.size(), 0);
-    if (!config_.skip_closed_back_faces || config_.backface != Backface::none || config_.occluder_clusters) return;
-    front_planes_.assign(4 * occluders_.triangle_count(), 0.0f);
+    if (!config_.skip_closed_back_faces || config_.backface != Backface::none) return;
+    if (!config_.occluder_clusters) front_planes_.assign(4 * occluders_.triangle_count(), 0.0f);
     const auto vertex = [&](std::uint32_t v) {
         return glm::dvec3(occluders_.positions[3 * std::size_t(v)], occluders_.positions[3 * std::size_t(v) + 1],
                           occluders_.positions[3 * std::size_t(v) + 2]);
@@ -328,7 +331,7 @@ void detail::SceneCullerState::find_closed_candidates() {
         }
         if (!closed || !(volume > 0.0)) continue;
         closed_[k] = 1;
-        for (std::size_t t = first; t < last; ++t) {
+        for (std::size_t t = first; t < last && !config_.occluder_clusters; ++t) {
             const glm::dvec3 a = vertex(occluders_.indices[3 * t]), b = vertex(occluders_.indices[3 * t + 1]),
                              c = vertex(occluders_.indices[3 * t + 2]);
             const glm::dvec3 n = glm::cross(b - a, c - a);
@@ -357,7 +360,14 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& c
     work_.occluder_triangles += last - first;
     work_.occluder_lods += lod;
     if (config_.occluder_clusters && !lod) {
-        for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) frame_clusters_.push_back(c);
+        // A closed candidate's clusters without their back faces (find_closed_candidates): its
+        // triangles face out counter-clockwise in world space, so its front faces are
+        // counter-clockwise in the GL clip space (y up) the culler projects to.
+        const Backface backface = closed_[k] ? Backface::cw : config_.backface;
+        for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) {
+            frame_clusters_.push_back(c);
+            frame_cluster_backfaces_.push_back(backface);
+        }
         frame_cluster_triangles_waiting_ += last - first;
         return;
     }
@@ -437,6 +447,7 @@ void detail::SceneCullerState::render_pending(const Frame& frame, const Parallel
     if (clusters > 0) {
         ClusteredInput in{&clusters_, frame.clip, config_.backface};
         in.cluster_ids = frame_clusters_.data() + frame_clusters_rendered_;
+        in.backfaces = frame_cluster_backfaces_.data() + frame_clusters_rendered_;
         in.cluster_count = clusters;
         if (!frame_started_) buffer_.render_frame(in, parallel);
         else buffer_.render(in, parallel);

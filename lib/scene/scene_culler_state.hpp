@@ -82,6 +82,7 @@ public:
     std::vector<std::uint32_t> frame_apexes_;     // and the flags' apexes
     std::size_t frame_rendered_ = 0;              // triangles of frame_indices_ already rendered
     std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
+    std::vector<Backface> frame_cluster_backfaces_;  // each one's backface mode (closed candidates': cw)
     std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
     std::size_t frame_cluster_triangles_waiting_ = 0;
     // Closed candidates' back faces left out and not rendered yet: they count towards

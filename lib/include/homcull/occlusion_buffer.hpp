@@ -111,6 +111,11 @@ struct ClusteredInput {
     const std::uint8_t* shared_edges = nullptr;
     const std::uint32_t* edge_apexes = nullptr;
     bool orthographic = false;  // as TriangleInput::orthographic
+    // Optional: each drawn cluster's own backface mode instead of `backface`, one per cluster
+    // drawn (in cluster_ids' order, or per cluster of `clusters` when cluster_ids is null). For
+    // example, the back faces of closed meshes culled and the other meshes' kept
+    // (SceneCullerConfig::skip_closed_back_faces).
+    const Backface* backfaces = nullptr;
 };
 
 // A screen rectangle to test: NDC (y up) bounds and the occludee's nearest clip w. The layout

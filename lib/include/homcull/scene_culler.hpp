@@ -62,10 +62,11 @@ struct SceneCullerConfig {
     Backface backface = Backface::none;
     // With backface none: the occluders that are closed meshes enclosing a positive volume
     // (every edge shared by two triangles of the object, in opposite order) are drawn without
-    // the triangles that face away from the eye. From any eye outside the solid they lie behind
-    // the mesh's front faces, so the buffer loses nothing; leaving occluder triangles out can
-    // never hide what is visible. Clusters keep every triangle (docs/scene-culling.md,
-    // "Closed occluders", says why).
+    // the triangles that face away from the eye: left out when the frame's triangles are
+    // gathered, or, with occluder_clusters, culled by the rasterizer (Backface::cw on those
+    // clusters, ClusteredInput::backfaces). They lie behind the mesh's front faces, and leaving
+    // occluder triangles out can never hide what is visible (docs/scene-culling.md, "Closed
+    // occluders", has what it costs in culling).
     bool skip_closed_back_faces = true;
     // Occludee shape: the world box alone, or, where the box is found visible, the object's
     // triangles (much tighter for objects whose box reaches past what hides them, at the cost
@@ -121,7 +122,8 @@ struct SceneCullWork {
     std::size_t occluder_objects = 0;    // objects rendered into the buffer
     std::size_t occluder_triangles = 0;  // their triangles (as drawn: LODs' where used)
     // Of those, the closed meshes' triangles facing away from the eye, left out
-    // (skip_closed_back_faces; clusters keep every triangle).
+    // (skip_closed_back_faces; clusters' are culled by the rasterizer instead, and counted in
+    // the buffer's RasterStats::backface_culled).
     std::size_t back_faces_skipped = 0;
     std::size_t occluder_lods = 0;       // occluders drawn with their LOD
     std::size_t renders = 0;             // render calls (progressive: batches)
