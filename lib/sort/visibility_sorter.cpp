@@ -40,10 +40,6 @@ using sort_detail::PlacedHull;
 namespace {
 
 constexpr std::size_t kMaxPlanes = 16;
-// Hull points of a pair above which GJK on the bounding boxes comes before GJK on the hulls:
-// below, the box test saves less than it costs when it fails (the castle's hulls have 23
-// points on average, the toothpicks' 289).
-constexpr std::uint32_t kBoxesFirstAbove = 64;
 
 double now_ms() {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -65,7 +61,7 @@ struct Placed {
 // eye and back's bounding box, with more than `margin` between them: then front cannot hide
 // any of back. The axes: the boxes' face normals (cross products of their half axes, so that
 // sheared boxes are right too) and the line between their centres. Cheap, and it settles most
-// pairs where front lies behind back; the GJK tests take the rest.
+// pairs where front lies behind back; GJK on the hulls takes the rest.
 bool parted_on_box_axes(const Placed& front, const Placed& back, const glm::vec3& eye, float margin) {
     const glm::vec3* f = front.half_axis;
     const glm::vec3* b = back.half_axis;
@@ -96,7 +92,6 @@ struct VisibilitySorter::State {
     detail::Vector<glm::vec3> shape_centre;  // of the points' bounding box
     detail::Vector<glm::vec3> shape_half;    // half the box's sides
     detail::Vector<float> shape_radius;      // of the bounding sphere about the box's centre
-    detail::Vector<float> box_x, box_y, box_z;  // the box's eight corners, per shape
     detail::Vector<std::uint32_t> object_shape;
 
     // What stands still: each object's last transform, how often it moved, whether it moved
@@ -140,18 +135,6 @@ struct VisibilitySorter::State {
     bool has_last_order = false;
     VisibilitySort result;
 
-    // The object's bounding box as a hull of eight points: the cheap test before the hull's.
-    PlacedHull box(std::uint32_t object) const {
-        const std::uint32_t s = object_shape[object];
-        PlacedHull h;
-        h.x = box_x.data() + 8 * s;
-        h.y = box_y.data() + 8 * s;
-        h.z = box_z.data() + 8 * s;
-        h.count = 8;
-        h.transform = transforms[object];
-        h.scan = scan;
-        return h;
-    }
 
     PlacedHull hull(std::uint32_t object) const {
         const std::uint32_t s = object_shape[object];
@@ -369,7 +352,7 @@ void VisibilitySorter::State::collect_candidates(std::uint32_t object) {
 }
 
 // Whether `front` may hide part of `back`: the spheres' cones, the boxes' axes, what is known of
-// a still pair, GJK on the boxes (large hulls only), then GJK on the hulls.
+// a still pair, then GJK on the hulls.
 bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) {
     const Placed& f = placed[front];
     const Placed& b = placed[back];
@@ -403,14 +386,10 @@ bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) 
         }
     }
     const glm::dvec3 start = glm::dvec3(f.centre) - glm::dvec3(b.centre);
-    const PlacedHull front_hull = hull(front), back_hull = hull(back);
-    // The boxes first where they are much cheaper than the hulls (eight points each).
-    if (front_hull.count + back_hull.count > kBoxesFirstAbove) {
-        ++result.stats.box_tests;
-        if (!sort_detail::may_occlude(box(front), box(back), eye, margin, start)) return false;
-    }
+    // No GJK on the bounding boxes first: of the pairs the tests above leave, it settled about
+    // a quarter (200 toothpicks: 80 of 287 a frame) and cost more than it saved.
     ++result.stats.hull_tests;
-    return sort_detail::may_occlude(front_hull, back_hull, eye, margin, start);
+    return sort_detail::may_occlude(hull(front), hull(back), eye, margin, start);
 }
 
 void VisibilitySorter::State::emit_component(std::uint32_t root) {
@@ -571,11 +550,6 @@ VisibilitySorter::VisibilitySorter(const HullPoints* shapes, std::size_t shape_c
         }
         s.shape_centre.push_back(centre);
         s.shape_half.push_back(0.5f * (hi - lo));
-        for (int corner = 0; corner < 8; ++corner) {
-            s.box_x.push_back((corner & 1) ? hi.x : lo.x);
-            s.box_y.push_back((corner & 2) ? hi.y : lo.y);
-            s.box_z.push_back((corner & 4) ? hi.z : lo.z);
-        }
         s.shape_radius.push_back(radius * (1.0f + 1e-6f));
     }
     for (std::size_t i = 0; i < object_count; ++i) {

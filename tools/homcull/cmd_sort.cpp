@@ -206,7 +206,6 @@ void run_sort(const SortCommandOptions& o) {
                                 {"layers", r.layers},
                                 {"cycles", r.cycles},
                                 {"candidates", r.stats.candidates},
-                                {"box_tests", r.stats.box_tests},
                                 {"hull_tests", r.stats.hull_tests},
                                 {"remembered", r.stats.remembered},
                                 {"occlusions", r.stats.occlusions},

@@ -62,7 +62,6 @@ struct VisibilitySortStats {
     std::uint32_t objects_in_cycles = 0;  // objects in those layers
     std::uint32_t largest_cycle = 0;      // objects in the largest layer
     std::uint64_t candidates = 0;         // pairs the extent tree returned
-    std::uint64_t box_tests = 0;          // pairs tested on their bounding boxes (after the spheres)
     std::uint64_t hull_tests = 0;         // GJK runs on hulls (the full test, or two still objects')
     std::uint64_t remembered = 0;         // pairs of still objects answered from an earlier frame's test
     std::uint64_t occlusions = 0;         // pairs that test found occluding (the pairs listed)
