@@ -4,6 +4,8 @@
 #include "support.hpp"
 
 #include "common/isa_choice.hpp"
+#include "sort/hull_occlusion.hpp"
+#include "sort/pair_cache.hpp"
 #include "sort/support_scan.hpp"
 
 #include <homcull/error.hpp>
@@ -201,6 +203,7 @@ TEST(VisibilitySort, ThreeOverlappingSticksAreOneLayer) {
     EXPECT_EQ(sort.layers[1].count, 3u);
     EXPECT_EQ(sort.stats.cycles, 1u);
     EXPECT_EQ(sort.stats.objects_in_cycles, 3u);
+    EXPECT_EQ(sort.stats.core_crossings, 3u);  // each stick's core crosses the next one's seen from the eye
     EXPECT_EQ(sort.stats.left_out, 0u);
     expect_pairs_respected(sort, scene.objects.size());
 
@@ -365,6 +368,78 @@ TEST(VisibilitySort, SupportScanKernelsGiveTheReferenceAnswer) {
                     << isa << ", " << count << " points";
             }
         }
+    }
+}
+
+// A hint moves where GJK starts, never what it answers: toothpicks tumbling frame after frame,
+// each ordered pair tested with its own hint (carried from frame to frame) and without, from
+// an eye outside the cube. Testing a frame twice shows what the hint keeps: an apart pair
+// settles in one step, and a pair whose GJK ended enclosing the origin in none.
+TEST(VisibilitySort, GjkHintsChangeTheStepsNotTheAnswers) {
+    ToothpickOptions options;
+    options.count = 40;
+    options.cube = 4.0;  // crowded: many pairs meet
+    const Scene scene = generate_toothpicks(options, 0);
+    const Mesh& mesh = scene.meshes[scene.objects[0].mesh];
+    const detail::Vector<glm::vec3> hull = convex_hull_points(mesh.positions.data(), mesh.positions.size());
+    std::vector<float> x, y, z;
+    for (const glm::vec3& p : hull) x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
+    const std::size_t n = std::size_t(options.count);
+    std::vector<sort_detail::GjkHint> hints(n * n);
+    const glm::dvec3 eye(0.5, 1.0, 9.0);
+    std::size_t apart = 0, meet = 0, steps_with = 0, steps_without = 0;
+    for (int frame = 0; frame < 8; ++frame) {
+        std::vector<sort_detail::PlacedHull> placed(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            sort_detail::PlacedHull& h = placed[i];
+            h.x = x.data(), h.y = y.data(), h.z = z.data(), h.count = std::uint32_t(x.size());
+            h.transform = glm::mat4(toothpick_transform(options, int(i), frame));
+        }
+        for (std::size_t f = 0; f < n; ++f) {
+            for (std::size_t b = 0; b < n; ++b) {
+                if (f == b) continue;
+                const glm::dvec3 start = glm::dvec3(placed[f].transform[3]) - glm::dvec3(placed[b].transform[3]);
+                sort_detail::GjkWork cold, warm, again;
+                sort_detail::GjkHint& hint = hints[f * n + b];
+                const bool answer = sort_detail::may_occlude(placed[f], placed[b], eye, 1e-5, start, nullptr, &cold);
+                ASSERT_EQ(sort_detail::may_occlude(placed[f], placed[b], eye, 1e-5, start, &hint, &warm), answer)
+                    << "frame " << frame << ", " << f << " over " << b;
+                steps_with += warm.iterations, steps_without += cold.iterations;
+                const bool enclosed = hint.corners == 4;
+                ASSERT_EQ(sort_detail::may_occlude(placed[f], placed[b], eye, 1e-5, start, &hint, &again), answer);
+                if (!answer) {
+                    EXPECT_EQ(again.iterations, 1u);
+                    ++apart;
+                }
+                if (enclosed) {
+                    EXPECT_EQ(again.iterations, 0u);
+                    ++meet;
+                }
+                EXPECT_EQ(again.scans, 2 * again.iterations);
+            }
+        }
+    }
+    EXPECT_GT(apart, 1000u);
+    EXPECT_GT(meet, 100u);
+    EXPECT_LT(steps_with, steps_without);
+    std::printf("[ stats    ] GJK steps over 8 frames: %zu with hints, %zu without\n", steps_with, steps_without);
+}
+
+// The pair tables' slots spread pairs that share either object (Fibonacci hashing over the
+// whole key): pairs (a, 7) and (7, b) for 256 values each land on most of 1,024 slots.
+TEST(VisibilitySort, PairSlotsSpreadPairsSharingAnObject) {
+    struct Entry {
+        std::uint64_t key = 0;
+    };
+    sort_detail::PairSlots<Entry> slots;
+    slots.reset(64, 16);
+    for (const bool first_varies : {true, false}) {
+        std::set<const Entry*> used;
+        for (std::uint32_t v = 0; v < 256; ++v) {
+            const std::uint64_t key = first_varies ? slots.key_of(v, 7) : slots.key_of(7, v);
+            used.insert(&slots[key]);
+        }
+        EXPECT_GT(used.size(), 200u) << (first_varies ? "first id varying" : "second id varying");
     }
 }
 

@@ -33,10 +33,33 @@ struct PlacedHull {
 // The world point of the hull farthest along world direction d.
 glm::dvec3 support_point(const PlacedHull& hull, const glm::dvec3& d);
 
+// What one test of a pair leaves for the same pair's test in the next frame: Snyder and
+// Lengyel's temporal coherence in GJK's terms (warm starting, as in Cameron, "Enhancing GJK:
+// computing minimum and penetration distances between convex polyhedra", ICRA 1997). Objects
+// move little between frames, so the last search direction still parts most apart pairs in
+// one step, and the last enclosing tetrahedron, its corners moved with the objects, still
+// encloses the origin for most pairs that meet, without a single scan. A hint only decides
+// where GJK starts: "apart" still needs this frame's certificate, and "may occlude" is the
+// conservative answer, so a stale or foreign hint costs time, never correctness.
+struct GjkHint {
+    static constexpr std::uint32_t kEye = 0xffffffffu;  // a corner's back point that is the eye
+    glm::vec3 direction{0.0f};  // the last search direction (zero: none)
+    std::uint8_t corners = 0;   // 4 when the indices below name an enclosing tetrahedron
+    std::uint32_t back[4] = {}, front[4] = {};  // each corner: back's point (or kEye) - front's
+};
+
+// What one test cost: GJK's steps and the hull scans they made.
+struct GjkWork {
+    std::uint32_t iterations = 0;
+    std::uint32_t scans = 0;
+};
+
 // Whether `front` may hide part of `back` seen from `eye`: whether front's hull meets the hull
 // of the eye and back's hull, both grown by `margin` (world units). `start` is the first
-// direction GJK tries (any non-zero vector; the one from back towards front converges fast).
-bool may_occlude(const PlacedHull& front, const PlacedHull& back, const glm::dvec3& eye, double margin, const glm::dvec3& start);
+// direction GJK tries when the hint has none (any non-zero vector; the one from back towards
+// front converges fast). `hint` (optional) is read and then rewritten for the next frame.
+bool may_occlude(const PlacedHull& front, const PlacedHull& back, const glm::dvec3& eye, double margin, const glm::dvec3& start,
+                 GjkHint* hint = nullptr, GjkWork* work = nullptr);
 
 // Two hulls on their own, without the eye: apart (with the direction of a plane between them,
 // from `first` towards `second`), meeting (GJK enclosed the origin, or its simplex collapsed

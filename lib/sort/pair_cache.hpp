@@ -9,16 +9,46 @@
 // answer; later frames answer from it in a few operations, or fall back to the full test (an
 // eye on the near side, or GJK not settled).
 //
-// A direct-mapped table of fixed size, made with the sorter: a pair's entry is overwritten by
-// any other pair landing on its slot, and holds the objects' move counts, so a moved object
-// makes its entries stale. No allocation after construction.
+// A PairSlots table made with the sorter; an entry holds the objects' move counts, so a moved
+// object makes its entries stale.
 #include <homcull/detail/memory.hpp>
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cstdint>
 
 namespace homcull::sort_detail {
+
+// A direct-mapped table of fixed size keyed by pairs of objects: an entry is overwritten by any
+// other pair landing on its slot. `Entry` has a `std::uint64_t key`, 0 when empty. No
+// allocation after reset().
+template <class Entry>
+class PairSlots {
+public:
+    // `per_object` slots per object, from 1,024 to 2^20 (a power of two).
+    void reset(std::size_t objects, std::size_t per_object) {
+        std::size_t size = 1024;
+        while (size < per_object * objects && size < (std::size_t(1) << 20)) size *= 2;
+        entries_.assign(size, Entry{});
+        shift_ = 64;
+        for (std::size_t s = size; s > 1; s /= 2) --shift_;
+    }
+    void clear() { std::fill(entries_.begin(), entries_.end(), Entry{}); }
+    bool empty() const { return entries_.empty(); }
+    // The key of the ordered pair (first, second); never 0.
+    static std::uint64_t key_of(std::uint32_t first, std::uint32_t second) { return (std::uint64_t(first) << 32 | second) + 1; }
+    // The slot a key lands on (holding that key's entry, another's or none).
+    Entry& operator[](std::uint64_t key) { return entries_[index_of(key)]; }
+    const Entry& operator[](std::uint64_t key) const { return entries_[index_of(key)]; }
+
+private:
+    // Fibonacci hashing (Knuth, TAOCP vol. 3, 6.4): the top bits of the product, which every
+    // bit of the key reaches. (Lower bits miss the first id of the pair: its bits start at 32.)
+    std::size_t index_of(std::uint64_t key) const { return std::size_t((key * 0x9E3779B97F4A7C15ull) >> shift_); }
+    detail::Vector<Entry> entries_;
+    int shift_ = 64;
+};
 
 struct PairContact {
     std::uint64_t key = 0;  // 0: empty
@@ -39,10 +69,7 @@ public:
     void clear();
 
 private:
-    static std::uint64_t key_of(std::uint32_t low, std::uint32_t high) { return (std::uint64_t(low) << 32 | high) + 1; }
-    std::size_t index_of(std::uint64_t key) const { return std::size_t((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_; }
-    detail::Vector<PairContact> entries_;
-    std::size_t mask_ = 0;
+    PairSlots<PairContact> slots_;  // keyed by (lower id, higher id)
 };
 
 }  // namespace homcull::sort_detail

@@ -208,6 +208,9 @@ void run_sort(const SortCommandOptions& o) {
                                 {"candidates", r.stats.candidates},
                                 {"hull_tests", r.stats.hull_tests},
                                 {"remembered", r.stats.remembered},
+                                {"core_crossings", r.stats.core_crossings},
+                                {"gjk_iterations", r.stats.gjk_iterations},
+                                {"support_scans", r.stats.support_scans},
                                 {"occlusions", r.stats.occlusions},
                                 {"kept_last_order", r.stats.kept_last_order}};
             if (r.check)

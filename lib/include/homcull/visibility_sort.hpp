@@ -64,6 +64,10 @@ struct VisibilitySortStats {
     std::uint64_t candidates = 0;         // pairs the extent tree returned
     std::uint64_t hull_tests = 0;         // GJK runs on hulls (the full test, or two still objects')
     std::uint64_t remembered = 0;         // pairs of still objects answered from an earlier frame's test
+    std::uint64_t core_crossings = 0;     // pairs found occluding by their core segments, without GJK
+    std::uint64_t gjk_iterations = 0;     // GJK's steps in the full tests (0 when the last frame's
+                                          // enclosing tetrahedron still encloses the origin)
+    std::uint64_t support_scans = 0;      // hull scans those steps made (two a step)
     std::uint64_t occlusions = 0;         // pairs that test found occluding (the pairs listed)
     bool kept_last_order = false;         // the last frame's order held: the sort changed nothing
     // Stage times, milliseconds (steady clock): the objects' bounds and extents, the extent
@@ -129,8 +133,8 @@ public:
     const VisibilitySort& sort(const SortFrame& frame);
     // The last answer.
     const VisibilitySort& last() const;
-    // Forgets the last order and what was learned about still objects: the next sort starts
-    // from scratch.
+    // Forgets the last order, what was learned about still objects and where each pair's last
+    // test left GJK: the next sort starts from scratch.
     void forget_order();
 
 private:
