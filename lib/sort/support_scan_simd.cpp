@@ -8,6 +8,8 @@
 
 #include "sort/support_scan.hpp"
 
+#include <cstdint>
+
 HWY_BEFORE_NAMESPACE();
 namespace homcull::sort_detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -54,15 +56,11 @@ std::uint32_t SupportScanKernel(const float* x, const float* y, const float* z, 
         merge(dot0, at0, dot1, at1);
         merge(dot2, at2, dot3, at3);
         merge(dot0, at0, dot2, at2);
-        HWY_ALIGN float dots[hn::MaxLanes(df)];
-        HWY_ALIGN std::int32_t indices[hn::MaxLanes(di)];
-        hn::Store(dot0, df, dots);
-        hn::Store(at0, di, indices);
-        best_dot = dots[0], best = std::uint32_t(indices[0]);
-        for (std::uint32_t j = 1; j < lanes; ++j) {
-            const std::uint32_t at = std::uint32_t(indices[j]);
-            if (dots[j] > best_dot || (dots[j] == best_dot && at < best)) best_dot = dots[j], best = at;
-        }
+        // Across the lanes: the largest dot, then the lowest index among the lanes holding it.
+        const auto largest = hn::MaxOfLanes(df, dot0);
+        const auto holders = hn::IfThenElse(hn::RebindMask(di, hn::Eq(dot0, largest)), at0, hn::Set(di, INT32_MAX));
+        best_dot = hn::GetLane(largest);
+        best = std::uint32_t(hn::GetLane(hn::MinOfLanes(di, holders)));
     }
     for (; i < count; ++i) {  // the tail after the last whole vector: higher indices, strictly better only
         const float dot = (x[i] * dx + y[i] * dy) + z[i] * dz;
