@@ -22,7 +22,6 @@ void grow(Extent& into, const Extent& e) {
 }  // namespace
 
 void ExtentTree::build(const detail::Vector<Extent>& extents, const detail::Vector<std::uint32_t>& ids) {
-    extents_ = &extents;
     objects_.assign(ids.begin(), ids.end());
     nodes_.clear();
     work_.clear();
@@ -68,26 +67,29 @@ void ExtentTree::build(const detail::Vector<Extent>& extents, const detail::Vect
         work_.push_back({left, r.first, half});
         work_.push_back({right, r.first + half, r.count - half});
     }
+    leaf_extents_.resize(objects_.size());
+    for (std::size_t k = 0; k < objects_.size(); ++k) leaf_extents_[k] = extents[objects_[k]];
 }
 
 void ExtentTree::query(const Extent& box, float farthest, detail::Vector<std::uint32_t>& out) const {
     if (nodes_.empty()) return;
-    stack_.clear();
-    stack_.push_back(0);
-    while (!stack_.empty()) {
-        const Node& node = nodes_[stack_.back()];
-        stack_.pop_back();
-        if (!(node.bounds.nearest < farthest) || !boxes_overlap(node.bounds, box)) continue;
+    const auto overlaps = [&](const Extent& e) { return e.nearest < farthest && boxes_overlap(e, box); };
+    if (!overlaps(nodes_[0].bounds)) return;
+    // Depth first, right child first, each child tested before it is pushed; the stack holds
+    // at most one node a level and the one being opened.
+    std::uint32_t stack[kMaxDepth + 2];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const Node& node = nodes_[stack[--top]];
         if (node.count == 0) {
-            stack_.push_back(node.first - 1);  // left child
-            stack_.push_back(node.first);      // right child
+            const std::uint32_t right = node.first, left = right - 1;
+            if (overlaps(nodes_[left].bounds)) stack[top++] = left;
+            if (overlaps(nodes_[right].bounds)) stack[top++] = right;  // opened first
             continue;
         }
-        for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-            const std::uint32_t id = objects_[k];
-            const Extent& e = (*extents_)[id];
-            if (e.nearest < farthest && boxes_overlap(e, box)) out.push_back(id);
-        }
+        for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+            if (overlaps(leaf_extents_[k])) out.push_back(objects_[k]);
     }
 }
 

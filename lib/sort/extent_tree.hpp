@@ -40,15 +40,16 @@ private:
         std::uint32_t first = 0; // leaf: objects_[first, first + count); inner: first = right child
         std::uint32_t count = 0; // 0 for an inner node (its left child follows it)
     };
-    const detail::Vector<Extent>* extents_ = nullptr;
+    // Median splits halve the objects at each level: 2^32 objects need fewer levels than this.
+    static constexpr int kMaxDepth = 40;
     detail::Vector<Node> nodes_;
     detail::Vector<std::uint32_t> objects_;
+    detail::Vector<Extent> leaf_extents_;  // objects_[k]'s extent at k: the leaves read them in order
     detail::Vector<float> keys_;  // build scratch: the split axis' centres
     struct Range {
         std::uint32_t node, first, count;
     };
-    detail::Vector<Range> work_;           // build scratch
-    mutable detail::Vector<std::uint32_t> stack_;  // query scratch
+    detail::Vector<Range> work_;  // build scratch
 };
 
 }  // namespace homcull::sort_detail

@@ -53,7 +53,7 @@ struct Placed {
     float sine = 1, cosine = 0;  // of the sphere's half-angle seen from the eye
     float farthest = 0;         // distance from the eye to the sphere's far side
     glm::vec3 half_axis[3];     // the bounding box about `centre`: centre +- each half axis
-    glm::vec3 core[2];          // the shape's core segment's ends, in the world
+    glm::vec3 core[2];          // the core segment's ends (two hull points), in the world
     bool surrounds_eye = false;
     bool active = false;
 };
@@ -115,7 +115,7 @@ struct VisibilitySorter::State {
     detail::Vector<glm::vec3> shape_centre;  // of the points' bounding box
     detail::Vector<glm::vec3> shape_half;    // half the box's sides
     detail::Vector<float> shape_radius;      // of the bounding sphere about the box's centre
-    detail::Vector<glm::vec3> shape_core;    // two points of the shape a long way apart (2 a shape)
+    detail::Vector<glm::vec3> shape_core;    // the lowest and highest point along each model axis (6 a shape)
     detail::Vector<std::uint32_t> object_shape;
 
     // What stands still: each object's last transform, how often it moved, whether it moved
@@ -260,7 +260,13 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
         const float distance = glm::length(offset);
         const float tolerance = 1e-6f * (glm::length(p.centre) + glm::length(e) + p.radius);
         const glm::vec3& half = shape_half[s];
-        for (int k = 0; k < 2; ++k) p.core[k] = glm::vec3(m * glm::vec4(shape_core[2 * s + k], 1.0f));
+        float core_length = -1.0f;
+        for (int axis = 0; axis < 3; ++axis) {
+            const glm::vec3 lowest_end = glm::vec3(m * glm::vec4(shape_core[6 * s + 2 * axis], 1.0f));
+            const glm::vec3 highest_end = glm::vec3(m * glm::vec4(shape_core[6 * s + 2 * axis + 1], 1.0f));
+            const float length = glm::length(highest_end - lowest_end);
+            if (length > core_length) core_length = length, p.core[0] = lowest_end, p.core[1] = highest_end;
+        }
         p.half_axis[0] = glm::vec3(m[0]) * half.x, p.half_axis[1] = glm::vec3(m[1]) * half.y, p.half_axis[2] = glm::vec3(m[2]) * half.z;
         const DistanceRange to_box = box_distances(p.half_axis, p.centre, e);
         p.farthest = std::min(distance + p.radius, to_box.farthest + tolerance);
@@ -591,16 +597,18 @@ VisibilitySorter::VisibilitySorter(const HullPoints* shapes, std::size_t shape_c
             s.x.push_back(p.x), s.y.push_back(p.y), s.z.push_back(p.z);
         }
         s.shape_centre.push_back(centre);
-        // The core segment: an approximate diameter (the point farthest from the box's centre,
-        // then the point farthest from that one). Any two of the points would be correct: the
-        // segment between them lies in the hull.
-        std::size_t first = 0, second = 0;
-        for (std::size_t i = 1; i < count; ++i)
-            if (glm::length(points[i] - centre) > glm::length(points[first] - centre)) first = i;
-        for (std::size_t i = 1; i < count; ++i)
-            if (glm::length(points[i] - points[first]) > glm::length(points[second] - points[first])) second = i;
-        s.shape_core.push_back(points[first]);
-        s.shape_core.push_back(points[second]);
+        // The core segments: along each model axis, the lowest and the highest point. Any two
+        // of the points would be correct (the segment between them lies in the hull); each
+        // frame takes the one the object's transform makes longest.
+        for (int axis = 0; axis < 3; ++axis) {
+            std::size_t lowest = 0, highest = 0;
+            for (std::size_t i = 1; i < count; ++i) {
+                if (points[i][axis] < points[lowest][axis]) lowest = i;
+                if (points[i][axis] > points[highest][axis]) highest = i;
+            }
+            s.shape_core.push_back(points[lowest]);
+            s.shape_core.push_back(points[highest]);
+        }
         s.shape_half.push_back(0.5f * (hi - lo));
         s.shape_radius.push_back(radius * (1.0f + 1e-6f));
     }
