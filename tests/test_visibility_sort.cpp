@@ -4,6 +4,7 @@
 #include "support.hpp"
 
 #include "common/isa_choice.hpp"
+#include "sort/extent_tree.hpp"
 #include "sort/hull_occlusion.hpp"
 #include "sort/pair_cache.hpp"
 #include "sort/support_scan.hpp"
@@ -441,6 +442,66 @@ TEST(VisibilitySort, PairSlotsSpreadPairsSharingAnObject) {
         }
         EXPECT_GT(used.size(), 200u) << (first_varies ? "first id varying" : "second id varying");
     }
+}
+
+// The extent scan's kernels give the reference's ids in the reference's order, for every
+// count and start (boxes on a coarse grid: many equal bounds), and the extent trees built
+// with them answer every query with exactly the objects a test of each extent finds.
+TEST(VisibilitySort, ExtentScansAndTreesFindWhatEachExtentsTestFinds) {
+    std::uint64_t state = 5;
+    const auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return float(std::int32_t(state >> 59) - 16) / 16.0f;  // -1 to 0.94 in steps of 1/16
+    };
+    const auto random_extent = [&] {
+        sort_detail::Extent e;
+        for (int a = 0; a < 3; ++a) {
+            const float u = next(), v = next();
+            e.lo[a] = std::min(u, v), e.hi[a] = std::max(u, v);
+        }
+        e.nearest = next() + 1.0f;
+        return e;
+    };
+    const std::uint32_t n = 700;
+    detail::Vector<sort_detail::Extent> extents(n);
+    for (auto& e : extents) e = random_extent();
+    std::vector<float> lo[3], hi[3], nearest;
+    std::vector<std::uint32_t> ids;
+    for (std::uint32_t i = 0; i < n + sort_detail::kExtentColumnPadding; ++i) {
+        const sort_detail::Extent& e = extents[i % n];
+        for (int a = 0; a < 3; ++a) lo[a].push_back(e.lo[a]), hi[a].push_back(e.hi[a]);
+        nearest.push_back(e.nearest), ids.push_back(1000 + i);
+    }
+    const sort_detail::ExtentColumns columns{{lo[0].data(), lo[1].data(), lo[2].data()}, {hi[0].data(), hi[1].data(), hi[2].data()},
+                                             nearest.data(), ids.data()};
+    detail::Vector<std::uint32_t> held;  // every third object
+    for (std::uint32_t i = 0; i < n; i += 3) held.push_back(i);
+    std::size_t total_found = 0;
+    for (const std::string& isa : available_isas()) {
+        const sort_detail::ExtentScan scan = sort_detail::extent_scan_for(detail::isa_choice(isa));
+        sort_detail::ExtentTree tree;
+        tree.use(scan);
+        tree.build(extents, held);
+        for (int trial = 0; trial < 200; ++trial) {
+            const sort_detail::Extent box = random_extent();
+            const float farthest = next() + 1.5f;
+            const std::uint32_t first = std::uint32_t(trial * 7) % 97, count = std::uint32_t(trial * 13) % 300;
+            std::vector<std::uint32_t> got(count + sort_detail::kExtentColumnPadding), want(count + sort_detail::kExtentColumnPadding);
+            got.resize(scan(columns, first, count, box, farthest, got.data()));
+            want.resize(sort_detail::extent_scan_reference(columns, first, count, box, farthest, want.data()));
+            EXPECT_EQ(got, want) << isa << ", " << count << " extents from " << first;
+
+            detail::Vector<std::uint32_t> found;
+            tree.query(box, farthest, found);
+            std::vector<std::uint32_t> tree_ids(found.begin(), found.end()), brute;
+            std::sort(tree_ids.begin(), tree_ids.end());
+            for (std::uint32_t i : held)
+                if (extents[i].nearest < farthest && sort_detail::boxes_overlap(extents[i], box)) brute.push_back(i);
+            EXPECT_EQ(tree_ids, brute) << isa << ", query " << trial;
+            total_found += brute.size() + want.size();
+        }
+    }
+    EXPECT_GT(total_found, 1000u);
 }
 
 // Every instruction set gives the same sort (the support scan is the only SIMD kernel, and

@@ -5,8 +5,6 @@
 namespace homcull::sort_detail {
 namespace {
 
-constexpr std::uint32_t kLeafSize = 4;
-
 Extent empty_extent() {
     Extent e;
     for (int k = 0; k < 3; ++k) e.lo[k] = 2.0f, e.hi[k] = -2.0f;
@@ -67,14 +65,31 @@ void ExtentTree::build(const detail::Vector<Extent>& extents, const detail::Vect
         work_.push_back({left, r.first, half});
         work_.push_back({right, r.first + half, r.count - half});
     }
-    leaf_extents_.resize(objects_.size());
-    for (std::size_t k = 0; k < objects_.size(); ++k) leaf_extents_[k] = extents[objects_[k]];
+    // The columns, padded with extents that match nothing (a kernel masks them off anyway).
+    const std::size_t held = objects_.size(), padded = held + kExtentColumnPadding;
+    for (int a = 0; a < 3; ++a) lo_[a].resize(padded), hi_[a].resize(padded);
+    nearest_.resize(padded);
+    for (std::size_t k = 0; k < held; ++k) {
+        const Extent& e = extents[objects_[k]];
+        for (int a = 0; a < 3; ++a) lo_[a][k] = e.lo[a], hi_[a][k] = e.hi[a];
+        nearest_[k] = e.nearest;
+    }
+    for (std::size_t k = held; k < padded; ++k) {
+        for (int a = 0; a < 3; ++a) lo_[a][k] = 2.0f, hi_[a][k] = -2.0f;
+        nearest_[k] = 3.4e38f;
+    }
+    objects_.resize(padded, 0u);
 }
 
 void ExtentTree::query(const Extent& box, float farthest, detail::Vector<std::uint32_t>& out) const {
     if (nodes_.empty()) return;
     const auto overlaps = [&](const Extent& e) { return e.nearest < farthest && boxes_overlap(e, box); };
     if (!overlaps(nodes_[0].bounds)) return;
+    const ExtentColumns columns{{lo_[0].data(), lo_[1].data(), lo_[2].data()},
+                                {hi_[0].data(), hi_[1].data(), hi_[2].data()},
+                                nearest_.data(),
+                                objects_.data()};
+    std::uint32_t hits[kLeafSize + kExtentColumnPadding];
     // Depth first, right child first, each child tested before it is pushed; the stack holds
     // at most one node a level and the one being opened.
     std::uint32_t stack[kMaxDepth + 2];
@@ -88,8 +103,8 @@ void ExtentTree::query(const Extent& box, float farthest, detail::Vector<std::ui
             if (overlaps(nodes_[right].bounds)) stack[top++] = right;  // opened first
             continue;
         }
-        for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-            if (overlaps(leaf_extents_[k])) out.push_back(objects_[k]);
+        const std::uint32_t found = scan_(columns, node.first, node.count, box, farthest, hits);
+        out.insert(out.end(), hits, hits + found);
     }
 }
 

@@ -10,29 +10,24 @@
 // it has held its largest frame: median splits on the widest axis of the boxes' centres.
 #include <homcull/detail/memory.hpp>
 
+#include "sort/extent_scan.hpp"
+
 #include <cstdint>
 
 namespace homcull::sort_detail {
 
-struct Extent {
-    float lo[3], hi[3];  // the direction box: components of the unit directions to the object
-    float nearest = 0;   // distance from the eye to the bounding sphere (0 when it holds the eye)
-};
-
-// Whether two extents' boxes overlap (the nearest distances aside).
-inline bool boxes_overlap(const Extent& a, const Extent& b) {
-    for (int k = 0; k < 3; ++k)
-        if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
-    return true;
-}
-
 class ExtentTree {
 public:
+    // The leaves' scan of an instruction set (extent_scan.hpp); the reference until set.
+    void use(ExtentScan scan) { scan_ = scan; }
     // A tree over extents[ids[k]] (ids: the objects to hold; extents indexed by object).
     void build(const detail::Vector<Extent>& extents, const detail::Vector<std::uint32_t>& ids);
     // Appends to `out` every object held whose direction box overlaps `box` and whose nearest
     // distance is below `farthest`.
     void query(const Extent& box, float farthest, detail::Vector<std::uint32_t>& out) const;
+
+    // Objects a leaf holds at most: the scan tests them a vector at a time.
+    static constexpr std::uint32_t kLeafSize = 128;
 
 private:
     struct Node {
@@ -42,10 +37,12 @@ private:
     };
     // Median splits halve the objects at each level: 2^32 objects need fewer levels than this.
     static constexpr int kMaxDepth = 40;
+    ExtentScan scan_ = &extent_scan_reference;
     detail::Vector<Node> nodes_;
+    // The held objects in the leaves' order, and their extents as columns in that order (both
+    // padded for the scan, extent_scan.hpp).
     detail::Vector<std::uint32_t> objects_;
-    detail::Vector<Extent> leaf_extents_;  // objects_[k]'s extent at k: the leaves read them in order
-    detail::Vector<float> keys_;  // build scratch: the split axis' centres
+    detail::Vector<float> lo_[3], hi_[3], nearest_;
     struct Range {
         std::uint32_t node, first, count;
     };

@@ -160,6 +160,7 @@ struct VisibilitySorter::State {
     };
     detail::Vector<Frame> frames;
     detail::Vector<std::uint32_t> candidates;
+    detail::Vector<std::uint32_t> unvisited_candidates;  // order_candidates' scratch
 
     detail::Vector<std::uint32_t> last_order;
     bool has_last_order = false;
@@ -182,6 +183,7 @@ struct VisibilitySorter::State {
     void project(const glm::vec3& from);  // the eye, in float
     const sort_detail::PairContact& learn_contact(std::uint32_t a, std::uint32_t b, double margin);
     void collect_candidates(std::uint32_t object);
+    void order_candidates(std::uint32_t object, std::uint32_t begin);
     bool may_hide(std::uint32_t front, std::uint32_t back);
     void visit_from(std::uint32_t root);
     void emit_component(std::uint32_t root);
@@ -388,6 +390,28 @@ void VisibilitySorter::State::collect_candidates(std::uint32_t object) {
     for (std::uint32_t w : surrounding) candidates.push_back(w);
 }
 
+// The order in which an object's candidates [begin, end of `candidates`) are tested. Those
+// already emitted go (they are never tested); those on the stack come first, lowest index
+// first, then the unvisited ones as collected. Only an edge to an on-stack object with an
+// index below the visited object's low link is tested, so the first such edge found with the
+// lowest index skips the tests of all the others: inside the shared scenes' large cycles this
+// halves the tests (crytek_sponza walk: 1,309 -> 536 GJK runs a frame). The layers do not
+// depend on the order.
+void VisibilitySorter::State::order_candidates(std::uint32_t object, std::uint32_t begin) {
+    std::uint32_t on_stack_end = begin;
+    unvisited_candidates.clear();
+    for (std::size_t k = begin; k < candidates.size(); ++k) {
+        const std::uint32_t w = candidates[k];
+        if (w == object || visit[w] == kDone) continue;
+        if (visit[w] == kOnStack) candidates[on_stack_end++] = w;
+        else unvisited_candidates.push_back(w);
+    }
+    std::sort(candidates.begin() + begin, candidates.begin() + on_stack_end,
+              [&](std::uint32_t a, std::uint32_t b) { return index[a] < index[b]; });
+    candidates.resize(on_stack_end);
+    candidates.insert(candidates.end(), unvisited_candidates.begin(), unvisited_candidates.end());
+}
+
 // Whether `front` may hide part of `back`: the spheres' cones, the boxes' axes, what is known of
 // a still pair, then GJK on the hulls.
 bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) {
@@ -464,6 +488,7 @@ void VisibilitySorter::State::visit_from(std::uint32_t root) {
         const std::uint32_t begin = std::uint32_t(candidates.size());
         collect_candidates(v);
         result.stats.candidates += candidates.size() - begin;
+        order_candidates(v, begin);
         frames.push_back({v, begin, begin, std::uint32_t(candidates.size())});
     };
     enter(root);
@@ -576,7 +601,10 @@ VisibilitySorter::VisibilitySorter(const HullPoints* shapes, std::size_t shape_c
     if (object_count >= std::size_t(UINT32_MAX)) throw Error("VisibilitySorter: more than 2^32 - 1 objects");
     State& s = *state_;
     // The instruction set of buffers made now (select_isa's default): the same answers on all.
-    s.scan = sort_detail::support_scan_for(detail::default_isa_choice());
+    const detail::IsaChoice isa = detail::default_isa_choice();
+    s.scan = sort_detail::support_scan_for(isa);
+    s.tree.use(sort_detail::extent_scan_for(isa));
+    s.image_tree.use(sort_detail::extent_scan_for(isa));
     for (std::size_t k = 0; k < shape_count; ++k) {
         const glm::vec3* points = shapes[k].points;
         const std::size_t count = shapes[k].count;
