@@ -6,6 +6,7 @@
 #include "common/isa_choice.hpp"
 #include "sort/extent_tree.hpp"
 #include "sort/hull_occlusion.hpp"
+#include "sort/image_outline.hpp"
 #include "sort/pair_cache.hpp"
 #include "sort/support_scan.hpp"
 
@@ -424,6 +425,29 @@ TEST(VisibilitySort, GjkHintsChangeTheStepsNotTheAnswers) {
     EXPECT_GT(meet, 100u);
     EXPECT_LT(steps_with, steps_without);
     std::printf("[ stats    ] GJK steps over 8 frames: %zu with hints, %zu without\n", steps_with, steps_without);
+}
+
+// Outlines on screen: two parallel thin diagonal sticks, whose bounding rectangles overlap, are
+// parted by a line along them; moved together until their gap is within the pads, or crossed,
+// they are not.
+TEST(VisibilitySort, OutlinesOfThinSticksSideBySideAreApart) {
+    // A stick from (0, 0) to (1, 1), 0.02 wide, as a flat box's corners (the third axis: none).
+    const auto stick = [](glm::vec2 from, glm::vec2 to, float pad) {
+        sort_detail::ImageOutline o;
+        const glm::vec2 along = to - from, side = 0.01f * glm::normalize(glm::vec2(-along.y, along.x));
+        for (int c = 0; c < 8; ++c) o.corners[c] = ((c & 1) ? to : from) + ((c & 2) ? side : -side);
+        const glm::vec2 longest = o.corners[1] - o.corners[0];
+        o.across = glm::vec2(longest.y, -longest.x);
+        o.pad = pad;
+        return o;
+    };
+    const sort_detail::ImageOutline a = stick({0, 0}, {1, 1}, 1e-4f);
+    EXPECT_TRUE(sort_detail::outlines_apart(a, stick({0.1f, 0}, {1.1f, 1}, 1e-4f)));   // 0.05 apart across
+    EXPECT_TRUE(sort_detail::outlines_apart(stick({0.1f, 0}, {1.1f, 1}, 1e-4f), a));   // either way round
+    EXPECT_TRUE(sort_detail::outlines_apart(a, stick({0.03f, 0}, {1.03f, 1}, 1e-4f)));   // 0.001 apart
+    EXPECT_FALSE(sort_detail::outlines_apart(a, stick({0.02f, 0}, {1.02f, 1}, 1e-4f)));  // overlapping
+    EXPECT_FALSE(sort_detail::outlines_apart(stick({0, 0}, {1, 1}, 0.03f), stick({0.1f, 0}, {1.1f, 1}, 0.03f)));  // within the pads
+    EXPECT_FALSE(sort_detail::outlines_apart(a, stick({0, 1}, {1, 0}, 1e-4f)));          // crossing
 }
 
 // The pair tables' slots spread pairs that share either object (Fibonacci hashing over the

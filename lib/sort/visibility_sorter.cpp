@@ -23,6 +23,7 @@
 #include "common/isa_choice.hpp"
 #include "extent_tree.hpp"
 #include "hull_occlusion.hpp"
+#include "image_outline.hpp"
 #include "pair_cache.hpp"
 
 #include <algorithm>
@@ -141,6 +142,7 @@ struct VisibilitySorter::State {
     // ("wide") keep their direction boxes only.
     detail::Vector<Extent> image;
     detail::Vector<std::uint8_t> projected;
+    detail::Vector<sort_detail::ImageOutline> outlines;  // of the projected objects
     detail::Vector<std::uint32_t> in_image_tree, wide;
     ExtentTree image_tree;
     ExtentTree tree;
@@ -331,11 +333,13 @@ void VisibilitySorter::State::project(const glm::vec3& from) {
         box.nearest = extents[i].nearest;
         bool in_front = true;
         float least_depth = 3.4e38f;
+        glm::vec2 corners[8];
         for (int corner = 0; corner < 8 && in_front; ++corner) {
             const glm::vec3 c = centre + ((corner & 1) ? h[0] : -h[0]) + ((corner & 2) ? h[1] : -h[1]) + ((corner & 4) ? h[2] : -h[2]);
             const float depth = glm::dot(c, axis);
             in_front = depth > 0.25f * glm::length(c) + 2.0f * slack;
             const float across = glm::dot(c, right) / depth, upward = glm::dot(c, up) / depth;
+            corners[corner] = glm::vec2(across, upward);
             box.lo[0] = std::min(box.lo[0], across), box.hi[0] = std::max(box.hi[0], across);
             box.lo[1] = std::min(box.lo[1], upward), box.hi[1] = std::max(box.hi[1], upward);
             least_depth = std::min(least_depth, depth);
@@ -347,10 +351,21 @@ void VisibilitySorter::State::project(const glm::vec3& from) {
         }
         // Widened for the roundings: a part in 10^6 of the scene's reach, seen at the nearest
         // corner's depth, and of the coordinates themselves.
+        float outline_pad = 0;
         for (int k = 0; k < 2; ++k) {
             const float pad = slack / least_depth + 1e-6f * std::max(std::abs(box.lo[k]), std::abs(box.hi[k]));
             box.lo[k] -= pad, box.hi[k] += pad;
+            outline_pad = std::max(outline_pad, pad);
         }
+        sort_detail::ImageOutline& outline = outlines[i];
+        std::copy(corners, corners + 8, outline.corners);
+        outline.pad = outline_pad;
+        // The longest box axis on screen: between the corners that differ in that axis only.
+        int longest = 0;
+        for (int k = 1; k < 3; ++k)
+            if (glm::dot(h[k], h[k]) > glm::dot(h[longest], h[longest])) longest = k;
+        const glm::vec2 along = corners[1 << longest] - corners[0];
+        outline.across = glm::vec2(along.y, -along.x);
         image[i] = box;
         in_image_tree.push_back(i);
     }
@@ -426,6 +441,8 @@ bool VisibilitySorter::State::may_hide(std::uint32_t front, std::uint32_t back) 
     // here and of the ground truth's (which places vertices in double, then rounds).
     const double margin = 1e-6 * margin_scale;
     if (parted_on_box_axes(f, b, glm::vec3(eye), float(margin))) return false;
+    // Objects side by side on screen: a line parts their outlines (image_outline.hpp).
+    if (projected[front] && projected[back] && sort_detail::outlines_apart(outlines[front], outlines[back])) return false;
     if (still[front] && still[back]) {
         const sort_detail::PairContact* known = contacts.find(front, back, moves[front], moves[back]);
         if (!known) known = &learn_contact(front, back, margin);
@@ -656,6 +673,7 @@ VisibilitySorter::VisibilitySorter(const HullPoints* shapes, std::size_t shape_c
     s.placed.resize(object_count);
     s.image.resize(object_count);
     s.projected.resize(object_count);
+    s.outlines.resize(object_count);
     s.extents.resize(object_count);
     s.index.resize(object_count);
     s.low.resize(object_count);
