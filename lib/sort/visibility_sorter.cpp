@@ -46,6 +46,14 @@ double now_ms() {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// A face normal of an object's bounding box (unit; cross products of the half axes, so that
+// sheared boxes are right too), with the box's centre and reach along it and the eye's place.
+struct BoxFace {
+    glm::vec3 normal{0.0f};
+    float at_centre = 0, reach = 0, at_eye = 0;
+    bool usable = false;  // false for a flat box's degenerate normal
+};
+
 // An object as this frame sees it: its bounding sphere about the eye.
 struct Placed {
     glm::vec3 centre{0.0f};
@@ -55,6 +63,7 @@ struct Placed {
     float farthest = 0;         // distance from the eye to the sphere's far side
     glm::vec3 half_axis[3];     // the bounding box about `centre`: centre +- each half axis
     glm::vec3 core[2];          // the core segment's ends (two hull points), in the world
+    BoxFace faces[3];
     bool surrounds_eye = false;
     bool active = false;
 };
@@ -65,22 +74,33 @@ struct Placed {
 // sheared boxes are right too) and the line between their centres. Cheap, and it settles most
 // pairs where front lies behind back; GJK on the hulls takes the rest.
 bool parted_on_box_axes(const Placed& front, const Placed& back, const glm::vec3& eye, float margin) {
-    const glm::vec3* f = front.half_axis;
-    const glm::vec3* b = back.half_axis;
-    const glm::vec3 axes[7] = {glm::cross(f[1], f[2]), glm::cross(f[2], f[0]), glm::cross(f[0], f[1]),
-                               glm::cross(b[1], b[2]), glm::cross(b[2], b[0]), glm::cross(b[0], b[1]),
-                               front.centre - back.centre};
-    for (const glm::vec3& n : axes) {
-        const float length = glm::length(n);
-        if (!(length > 0.0f)) continue;
-        const float reach_f = std::abs(glm::dot(n, f[0])) + std::abs(glm::dot(n, f[1])) + std::abs(glm::dot(n, f[2]));
-        const float reach_b = std::abs(glm::dot(n, b[0])) + std::abs(glm::dot(n, b[1])) + std::abs(glm::dot(n, b[2]));
-        const float at_f = glm::dot(n, front.centre), at_b = glm::dot(n, back.centre), at_eye = glm::dot(n, eye);
+    // Along n: whether back's box, spanning at_b +- reach_b, and the eye lie wholly on one side
+    // of front's box, spanning at_f +- reach_f, with more than the margin between.
+    const auto parted = [&](float at_f, float reach_f, float at_b, float reach_b, float at_eye, float gap) {
         const float low_b = std::min(at_b - reach_b, at_eye), high_b = std::max(at_b + reach_b, at_eye);
-        const float gap = margin * length;
-        if (high_b < at_f - reach_f - gap || at_f + reach_f < low_b - gap) return true;
+        return high_b < at_f - reach_f - gap || at_f + reach_f < low_b - gap;
+    };
+    const auto reach = [](const glm::vec3& n, const glm::vec3 (&h)[3]) {
+        return std::abs(glm::dot(n, h[0])) + std::abs(glm::dot(n, h[1])) + std::abs(glm::dot(n, h[2]));
+    };
+    // The face normals, with what place() worked out along them for their own box and the eye.
+    for (int k = 0; k < 3; ++k) {
+        const BoxFace& face = front.faces[k];
+        if (face.usable && parted(face.at_centre, face.reach, glm::dot(face.normal, back.centre), reach(face.normal, back.half_axis),
+                                  face.at_eye, margin))
+            return true;
     }
-    return false;
+    for (int k = 0; k < 3; ++k) {
+        const BoxFace& face = back.faces[k];
+        if (face.usable && parted(glm::dot(face.normal, front.centre), reach(face.normal, front.half_axis), face.at_centre, face.reach,
+                                  face.at_eye, margin))
+            return true;
+    }
+    const glm::vec3 n = front.centre - back.centre;
+    const float length = glm::length(n);
+    if (!(length > 0.0f)) return false;
+    return parted(glm::dot(n, front.centre), reach(n, front.half_axis), glm::dot(n, back.centre), reach(n, back.half_axis), glm::dot(n, eye),
+                  margin * length);
 }
 
 // Six times the signed volume of the tetrahedron abcd: positive when d lies on the side of the
@@ -214,20 +234,17 @@ struct DistanceRange {
 // farthest corner exactly, and for the nearest a lower bound, the largest distance to one of
 // the box's three slabs (the box is their intersection). Tighter than the bounding sphere's
 // for long thin objects.
-DistanceRange box_distances(const glm::vec3 (&axis)[3], const glm::vec3& centre, const glm::vec3& eye) {
+DistanceRange box_distances(const glm::vec3 (&axis)[3], const BoxFace (&faces)[3], const glm::vec3& centre, const glm::vec3& eye) {
     const glm::vec3 to_eye = eye - centre;
     DistanceRange r{0.0f, 0.0f};
+    float farthest_squared = 0.0f;  // one square root for the eight (it keeps the order)
     for (int corner = 0; corner < 8; ++corner) {
         const glm::vec3 c = ((corner & 1) ? axis[0] : -axis[0]) + ((corner & 2) ? axis[1] : -axis[1]) + ((corner & 4) ? axis[2] : -axis[2]);
-        r.farthest = std::max(r.farthest, glm::length(c - to_eye));
+        farthest_squared = std::max(farthest_squared, glm::dot(c - to_eye, c - to_eye));
     }
-    for (int k = 0; k < 3; ++k) {
-        const glm::vec3 normal = glm::cross(axis[(k + 1) % 3], axis[(k + 2) % 3]);
-        const float length = glm::length(normal);
-        if (!(length > 0.0f)) continue;
-        const glm::vec3 n = normal / length;
-        r.nearest = std::max(r.nearest, std::abs(glm::dot(n, to_eye)) - std::abs(glm::dot(n, axis[k])));
-    }
+    r.farthest = std::sqrt(farthest_squared);
+    for (const BoxFace& face : faces)
+        if (face.usable) r.nearest = std::max(r.nearest, std::abs(face.at_eye - face.at_centre) - face.reach);
     return r;
 }
 
@@ -264,15 +281,27 @@ void VisibilitySorter::State::place(const SortFrame& frame) {
         const float distance = glm::length(offset);
         const float tolerance = 1e-6f * (glm::length(p.centre) + glm::length(e) + p.radius);
         const glm::vec3& half = shape_half[s];
-        float core_length = -1.0f;
+        float core_length_squared = -1.0f;
         for (int axis = 0; axis < 3; ++axis) {
             const glm::vec3 lowest_end = glm::vec3(m * glm::vec4(shape_core[6 * s + 2 * axis], 1.0f));
             const glm::vec3 highest_end = glm::vec3(m * glm::vec4(shape_core[6 * s + 2 * axis + 1], 1.0f));
-            const float length = glm::length(highest_end - lowest_end);
-            if (length > core_length) core_length = length, p.core[0] = lowest_end, p.core[1] = highest_end;
+            const float length_squared = glm::dot(highest_end - lowest_end, highest_end - lowest_end);
+            if (length_squared > core_length_squared) core_length_squared = length_squared, p.core[0] = lowest_end, p.core[1] = highest_end;
         }
         p.half_axis[0] = glm::vec3(m[0]) * half.x, p.half_axis[1] = glm::vec3(m[1]) * half.y, p.half_axis[2] = glm::vec3(m[2]) * half.z;
-        const DistanceRange to_box = box_distances(p.half_axis, p.centre, e);
+        for (int k = 0; k < 3; ++k) {
+            BoxFace& face = p.faces[k];
+            const glm::vec3 normal = glm::cross(p.half_axis[(k + 1) % 3], p.half_axis[(k + 2) % 3]);
+            const float normal_length = glm::length(normal);
+            face.usable = normal_length > 0.0f && std::isfinite(normal_length);
+            if (!face.usable) continue;
+            face.normal = normal / normal_length;
+            face.at_centre = glm::dot(face.normal, p.centre);
+            face.reach = std::abs(glm::dot(face.normal, p.half_axis[0])) + std::abs(glm::dot(face.normal, p.half_axis[1])) +
+                         std::abs(glm::dot(face.normal, p.half_axis[2]));
+            face.at_eye = glm::dot(face.normal, e);
+        }
+        const DistanceRange to_box = box_distances(p.half_axis, p.faces, p.centre, e);
         p.farthest = std::min(distance + p.radius, to_box.farthest + tolerance);
         Extent& box = extents[i];
         p.surrounds_eye = !(distance > p.radius);
