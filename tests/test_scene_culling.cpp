@@ -455,6 +455,37 @@ TEST(SceneCulling, ClosedOccludersAreDrawnWithoutTheirBackFaces) {
     }
 }
 
+// A wall made of two objects that meet along the view's middle column of sample centres (a
+// hair beside them), and a stick behind that column alone. Drawing every candidate in the frustum (one-pass, no budget),
+// the edge the two objects share goes without its coverage margin, as triangles and as
+// clusters alike, and the wall hides the stick; with a budget, flags within each object only:
+// the margin opens a leak one sample wide along the seam, and the stick shows through it.
+TEST(SceneCulling, EdgesSharedAcrossObjectsCloseTheSeamAsTrianglesAndAsClusters) {
+    // The seam 2^-12 sample right of the column's centres: inside the left half by less than the
+    // margin (2^-10 sample). (A sample centre exactly on a shared edge is covered by neither side.)
+    const float seam = 5.0f * (65.0f / 33.0f) * (2.0f / 65.0f) * 0x1.0p-12f;
+    Scene scene;
+    const std::uint32_t left = test::add_quad(scene, "left half", {-10, -10, -5}, {seam, -10, -5}, {seam, 10, -5}, {-10, 10, -5});
+    const std::uint32_t right = test::add_quad(scene, "right half", {seam, -10, -5}, {10, -10, -5}, {10, 10, -5}, {seam, 10, -5});
+    const std::uint32_t stick = test::add_box(scene, "stick behind the seam", {-1e-4f, -1, -10}, {1e-4f, 1, -9});
+    scene.finalize();
+    const Camera camera = test::camera_down_minus_z(90.0);
+    for (const bool clusters : {false, true}) {
+        for (const bool budget : {false, true}) {
+            SceneCullerConfig config;
+            config.display = {65, 33};  // odd: sample column 32's centres lie at NDC x = 0
+            config.occluder_clusters = clusters;
+            if (budget) config.occluder_budget.triangles = 100;  // room for both, but own flags
+            SceneCuller culler(scene, {left, right}, config);
+            std::vector<OccludeeAnswer> answers;
+            culler.cull(camera, answers);
+            EXPECT_EQ(culler.work().occluder_objects, 2u);
+            EXPECT_EQ(answers[stick].visibility, budget ? Visibility::visible : Visibility::occluded)
+                << (clusters ? "clusters" : "triangles") << (budget ? ", budget" : ", every candidate");
+        }
+    }
+}
+
 // An orthographic camera is refused with an error that names it, not answered as a perspective
 // one (its w = 1 everywhere would cull nothing, silently); the culler stays usable.
 TEST(SceneCulling, OrthographicCamerasAreRefused) {

@@ -184,6 +184,7 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_clusters_.clear();
     frame_cluster_backfaces_.clear();
     frame_clusters_rendered_ = 0;
+    frame_clusters_cross_ = false;
     frame_cluster_triangles_waiting_ = 0;
     frame_back_faces_waiting_ = 0;
     frame_started_ = false;
@@ -268,8 +269,9 @@ void detail::SceneCullerState::gather_lods() {
 
 // config_.occluder_clusters: each candidate's triangles split into clusters of their own (so
 // that a frame draws the clusters of the candidates it picks), one after the other in clusters_,
-// with the flags within each object (own_shared_edges_): a cluster's apexes are then among its
-// candidate's vertices, so right whichever candidates a frame draws.
+// with the flags within each object (own_shared_edges_), right whichever candidates a frame
+// draws, and beside them the flags across objects, for frames that draw every candidate in the
+// frustum (add_candidate_clusters).
 void detail::SceneCullerState::build_clusters() {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
@@ -287,22 +289,59 @@ void detail::SceneCullerState::build_clusters() {
         const OccluderClusters part = build_occluder_clusters(occluders_.positions.data() + 3 * std::size_t(base), 3 * sizeof(float),
                                                               count ? std::size_t(top - base) + 1 : 0, local.data(), count,
                                                               own_shared_edges_.data() + first, local_apexes.data());
-        const auto vertex_base = std::uint32_t(clusters_.positions.size() / 3), triangle_base = std::uint32_t(clusters_.shared_edges.size());
-        for (OccluderCluster c : part.clusters) {
-            c.first_vertex += vertex_base;
-            c.first_triangle += triangle_base;
-            clusters_.clusters.push_back(c);
-        }
-        clusters_.positions.insert(clusters_.positions.end(), part.positions.begin(), part.positions.end());
-        clusters_.indices.insert(clusters_.indices.end(), part.indices.begin(), part.indices.end());
-        clusters_.shared_edges.insert(clusters_.shared_edges.end(), part.shared_edges.begin(), part.shared_edges.end());
-        clusters_.edge_apexes.insert(clusters_.edge_apexes.end(), part.edge_apexes.begin(), part.edge_apexes.end());
-        for (const std::uint32_t t : part.source_triangles) clusters_.source_triangles.push_back(std::uint32_t(first) + t);
-        clusters_.max_cluster_vertices = std::max(clusters_.max_cluster_vertices, part.max_cluster_vertices);
+        add_candidate_clusters(k, part);
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
     frame_clusters_.reserve(clusters_.clusters.size());
     frame_cluster_backfaces_.reserve(clusters_.clusters.size());
+}
+
+// Candidate k's clusters (built with its own flags) appended to clusters_, each with the
+// cross-object flags of its triangles beside them. An apex the own flags already name keeps its
+// cluster vertex; an apex in another object becomes a vertex of the cluster (found among its
+// vertices by position, or a copy appended), so that either set of flags names apexes among
+// the cluster's own vertices, as the render requires.
+void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const OccluderClusters& part) {
+    const std::size_t first = first_triangle_[k];
+    const auto triangle_base = std::uint32_t(clusters_.shared_edges.size());
+    const std::size_t occluder_vertices = occluders_.positions.size() / 3;
+    for (OccluderCluster c : part.clusters) {
+        const std::uint32_t part_first_vertex = c.first_vertex;
+        c.first_vertex = std::uint32_t(clusters_.positions.size() / 3);
+        c.first_triangle += triangle_base;
+        const auto own_positions = part.positions.begin() + 3 * std::ptrdiff_t(part_first_vertex);
+        clusters_.positions.insert(clusters_.positions.end(), own_positions, own_positions + 3 * std::ptrdiff_t(c.vertex_count));
+        for (std::uint32_t i = 0; i < c.triangle_count; ++i) {
+            const std::size_t local = std::size_t(c.first_triangle - triangle_base) + i;  // within part
+            const std::size_t source = first + part.source_triangles[local];
+            const std::uint8_t flags = occluders_.shared_edges[source];
+            cluster_cross_shared_edges_.push_back(flags);
+            for (std::size_t e = 0; e < 3; ++e) {
+                const std::uint32_t apex = (flags >> e) & 1u ? occluders_.edge_apexes[3 * source + e] : kNoApex;
+                if (apex >= occluder_vertices) {  // none (the render drops a flag without an apex)
+                    cluster_cross_edge_apexes_.push_back(kNoApex);
+                } else if ((own_shared_edges_[source] >> e) & 1u && own_edge_apexes_[3 * source + e] == apex &&
+                           part.edge_apexes[3 * local + e] != kNoApex) {
+                    cluster_cross_edge_apexes_.push_back(part.edge_apexes[3 * local + e]);
+                } else {
+                    const float* p = occluders_.positions.data() + 3 * std::size_t(apex);
+                    const std::size_t begin = 3 * std::size_t(c.first_vertex), end = clusters_.positions.size();
+                    std::size_t at = begin;
+                    while (at < end && !(clusters_.positions[at] == p[0] && clusters_.positions[at + 1] == p[1] && clusters_.positions[at + 2] == p[2]))
+                        at += 3;
+                    if (at == end) clusters_.positions.insert(clusters_.positions.end(), p, p + 3);
+                    cluster_cross_edge_apexes_.push_back(std::uint32_t((at - begin) / 3));
+                }
+            }
+        }
+        c.vertex_count = std::uint32_t(clusters_.positions.size() / 3 - c.first_vertex);
+        clusters_.max_cluster_vertices = std::max(clusters_.max_cluster_vertices, c.vertex_count);
+        clusters_.clusters.push_back(c);
+    }
+    clusters_.indices.insert(clusters_.indices.end(), part.indices.begin(), part.indices.end());
+    clusters_.shared_edges.insert(clusters_.shared_edges.end(), part.shared_edges.begin(), part.shared_edges.end());
+    clusters_.edge_apexes.insert(clusters_.edge_apexes.end(), part.edge_apexes.begin(), part.edge_apexes.end());
+    for (const std::uint32_t t : part.source_triangles) clusters_.source_triangles.push_back(std::uint32_t(first) + t);
 }
 
 // A candidate is closed when every edge of its triangles is shared within the object, in
@@ -364,6 +403,8 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& c
         // triangles face out counter-clockwise in world space, so its front faces are
         // counter-clockwise in the GL clip space (y up) the culler projects to.
         const Backface backface = closed_[k] ? Backface::cw : config_.backface;
+        // A batch not rendered yet takes the cross-object flags only if all its clusters may.
+        frame_clusters_cross_ = (frame_clusters_.size() == frame_clusters_rendered_ || frame_clusters_cross_) && !own;
         for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) {
             frame_clusters_.push_back(c);
             frame_cluster_backfaces_.push_back(backface);
@@ -449,6 +490,10 @@ void detail::SceneCullerState::render_pending(const Frame& frame, const Parallel
         in.cluster_ids = frame_clusters_.data() + frame_clusters_rendered_;
         in.backfaces = frame_cluster_backfaces_.data() + frame_clusters_rendered_;
         in.cluster_count = clusters;
+        if (frame_clusters_cross_) {  // every candidate in the frustum is drawn (select_occluders)
+            in.shared_edges = cluster_cross_shared_edges_.data();
+            in.edge_apexes = cluster_cross_edge_apexes_.data();
+        }
         if (!frame_started_) buffer_.render_frame(in, parallel);
         else buffer_.render(in, parallel);
         frame_started_ = true;

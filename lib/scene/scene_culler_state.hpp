@@ -67,6 +67,12 @@ public:
     // of clusters_, whose flags are own_shared_edges_' (a cluster's apexes are in its own vertices).
     OccluderClusters clusters_;
     std::vector<std::uint32_t> cluster_first_;
+    // The same clustered triangles' flags across the whole candidate set (occluders_'), for the
+    // frames that may use them (EdgeFlags::across_objects); an apex from another object is a
+    // copy among the cluster's vertices, after those of its own triangles and own apexes.
+    std::vector<std::uint8_t> cluster_cross_shared_edges_;
+    std::vector<std::uint32_t> cluster_cross_edge_apexes_;
+    void add_candidate_clusters(std::size_t k, const OccluderClusters& part);
     ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
@@ -84,6 +90,7 @@ public:
     std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
     std::vector<Backface> frame_cluster_backfaces_;  // each one's backface mode (closed candidates': cw)
     std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
+    bool frame_clusters_cross_ = false;           // those not rendered yet all take the cross-object flags
     std::size_t frame_cluster_triangles_waiting_ = 0;
     // Closed candidates' back faces left out and not rendered yet: they count towards
     // progressive's batches as if drawn, so that skipping them does not delay a batch.
