@@ -29,9 +29,9 @@ mkdir -p "$OUT"
 configs=(
   "boxes, clusters|--occludees box --clusters 124"
   "boxes, clusters, 32 parts|--occludees box --clusters 124 --occludee-parts 32"
-  "boxes|--occludees box"
-  "triangles, clusters|--clusters 124"
-  "triangles (default)|"
+  "boxes|--occludees box --clusters 0"
+  "triangles, clusters (default)|"
+  "triangles|--clusters 0"
 )
 for c in "${configs[@]}"; do
   name=${c%%|*}

@@ -31,6 +31,7 @@ struct BenchOptions {
     std::string workload = "s1", resolution, isa = "best";  // resolution: 1920x1080 (s1, castle) or 1280x720 (frame)
     std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views;
     int samples = 1, threads = 1, repeat = 0, clusters = 0;
+    bool clusters_given = false;  // frame: without --clusters, the culler's default (clusters)
     bool json = false, sample_depth = false, vs_scalar = false;
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
@@ -55,7 +56,7 @@ void run_frame_workload(const BenchOptions& o) {
     f.cull.resolution = o.resolution.empty() ? "1280x720" : o.resolution;
     f.cull.samples = o.samples;
     f.cull.occludees = o.occludees;
-    f.cull.clusters = o.clusters > 0 ? "on" : "off";
+    if (o.clusters_given) f.cull.clusters = o.clusters > 0 ? "on" : "off";
     f.cull.closed_back_faces = o.closed_back_faces;
     f.cull.pyramid = o.pyramid;
     f.cull.occludee_parts = o.occludee_parts;
@@ -266,8 +267,9 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--clusters", o->clusters,
                     "castle: split the occluders into clusters of at most N triangles (a multiple of 4, <= 512) and render those "
                     "(OccluderClusters); 0 = the triangles as one input. frame: N > 0 draws the occluders as clusters (cull "
-                    "--clusters on)")
-        ->capture_default_str();
+                    "--clusters on, the default there), 0 every triangle (cull --clusters off)")
+        ->capture_default_str()
+        ->each([o](const std::string&) { o->clusters_given = true; });
     cmd->add_option("--views", o->views, "Camera path with the views for --workload castle and frame (default data/views/castle.json)");
     cmd->add_option("--walk", o->walk, "frame: a walk of N frames through the scene instead of --views (walk_path)")->check(CLI::Range(1, 100000));
     cmd->add_option("--random", o->random, "frame: N random viewpoints in the scene's free space instead of --views (random_views)")
