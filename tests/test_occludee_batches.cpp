@@ -2,6 +2,7 @@
 // batches of boxes all give the answers of the exhaustive scalar definition, including for
 // invalid, huge, inverted and off-screen input.
 #include "buffer/min_pyramid.hpp"
+#include "buffer/rect_queries.hpp"
 #include "support.hpp"
 
 #include <homcull/occlusion_buffer.hpp>
@@ -9,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -36,6 +39,8 @@ std::vector<ScreenRect> random_rects(std::uint64_t seed, int count) {
     rects.push_back({0, 0, 0.5f, 0.5f, 0.25f});
     rects.push_back({0.1f, 0.1f, 0.1f, 0.1f, 60});
     rects.push_back({-1, -1, 1, 1, 3.0e38f});
+    rects.push_back({-1, -1, 1, 1, std::numeric_limits<float>::max()});  // 1/w below float's normal range
+    rects.push_back({-0.5f, -0.5f, 0.5f, 0.5f, 1.0f});                   // at the near plane
     return rects;
 }
 
@@ -91,6 +96,28 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
             EXPECT_EQ(box_wrong, 0u) << isa << ", samples " << samples;
         }
     }
+}
+
+// prepare_rect rounds 1/w_min up without float_up's branches; over w_min from the smallest
+// near_w to the largest float (1/w in float's normal and subnormal ranges, exact or not), it
+// gives float_up's bound.
+TEST(OccludeeBatches, NearestDepthIsOneOverWRoundedUp) {
+    std::mt19937_64 rng(23);
+    std::uniform_int_distribution<std::uint32_t> bits(0x00800000u, 0x7F7FFFFFu);  // 2^-126 .. FLT_MAX
+    const detail::CoarseRectView view{nullptr, nullptr, nullptr, 0, 64, 32, 0x1.0p-126f};
+    std::size_t differing = 0, checked = 0;
+    for (int k = 0; k < 200000; ++k) {
+        std::uint32_t b = bits(rng);
+        if (k < 64) b = 0x00800000u + std::uint32_t(k) * 0x01000000u;  // powers of two: 1/w exact
+        float w;
+        std::memcpy(&w, &b, sizeof w);
+        detail::RectQuery q;
+        Visibility decided;
+        ASSERT_TRUE(detail::prepare_rect(view, {-0.5f, -0.5f, 0.5f, 0.5f, w}, q, decided)) << w;
+        differing += q.d_near != detail::float_up(1.0 / double(w)) * (1.0f + 0x1.0p-20f);
+        ++checked;
+    }
+    EXPECT_EQ(differing, 0u) << "of " << checked;
 }
 
 TEST(OccludeeBatches, EmptyBatchesAndBlockBoundaries) {

@@ -15,6 +15,7 @@ struct BufferKernels {
     OccludeeRowKernel occludee_row;  // occludee_depth.hpp
     RectScanKernel rect_scan;        // rect_queries.hpp
     RectBlockKernel rect_block;
+    RectOneKernel rect_one;
 };
 
 const BufferKernels& buffer_kernels(const IsaChoice& choice);

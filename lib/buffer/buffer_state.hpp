@@ -19,6 +19,7 @@ struct OccluderCluster;
 namespace homcull::detail {
 struct RectQuery;
 struct SubtileView;
+struct CoarseRectView;
 struct RasterTarget;
 struct VertexClip;
 struct DrawList;
@@ -137,6 +138,7 @@ public:
                  Visibility& decided) const;
     Visibility test_prepared_rect(const RectQuery& q) const;
     SubtileView subtile_view() const;
+    CoarseRectView coarse_view() const;
 
     // Rendering triangles (render_triangles.cpp chooses the path: choose_triangle_path).
     RasterTarget raster_target(int row_begin, int row_end);

@@ -22,36 +22,7 @@ constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtil
 
 bool detail::BufferState::prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, detail::RectQuery& q,
                               Visibility& decided) const {
-    if (!std::isfinite(ndc_min_x) || !std::isfinite(ndc_min_y) || !std::isfinite(ndc_max_x) || !std::isfinite(ndc_max_y) ||
-        !std::isfinite(w_min) || !(ndc_min_x <= ndc_max_x) || !(ndc_min_y <= ndc_max_y)) {
-        decided = Visibility::visible;  // nothing to reason with: never cull
-        return false;
-    }
-    if (w_min < config_.near_w) {
-        decided = Visibility::visible;
-        return false;
-    }
-    if (ndc_max_x < -1.0f || ndc_min_x > 1.0f || ndc_max_y < -1.0f || ndc_min_y > 1.0f) {
-        decided = Visibility::view_culled;
-        return false;
-    }
-    // The samples whose centres lie in the rectangle.
-    const double sx0 = (double(ndc_min_x) + 1.0) * 0.5 * sample_width_, sx1 = (double(ndc_max_x) + 1.0) * 0.5 * sample_width_;
-    const double sy0 = (1.0 - double(ndc_max_y)) * 0.5 * sample_height_, sy1 = (1.0 - double(ndc_min_y)) * 0.5 * sample_height_;
-    detail::sample_span(sx0, sx1, sample_width_, q.i0, q.i1);
-    detail::sample_span(sy0, sy1, sample_height_, q.j0, q.j1);
-    if (q.i0 > q.i1 || q.j0 > q.j1) {
-        decided = Visibility::occluded;  // covers no sample: invisible at every sample
-        return false;
-    }
-    // Nearest 1/w of the occludee, rounded up and raised by a relative 2^-20.
-    q.d_near = detail::float_up(1.0 / double(w_min)) * (1.0f + 0x1.0p-20f);
-    return true;
-}
-
-detail::SubtileView detail::BufferState::subtile_view() const {
-    return {d0_.data(),       d1_.data(),     mask_.data(),      stride_, sample_depth_.empty() ? nullptr : sample_depth_.data(),
-            sample_depth_stride_, pyramid_.data(), levels_.data(), int(levels_.size())};
+    return detail::prepare_rect(coarse_view(), {ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min}, q, decided);
 }
 
 Visibility detail::BufferState::test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y,
@@ -69,6 +40,9 @@ Visibility detail::BufferState::test_rect_exhaustive(float ndc_min_x, float ndc_
 
 Visibility detail::BufferState::test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
+    // One dispatch for all of it where a SIMD kernel exists: the call's fixed costs are most of
+    // a small rectangle's test.
+    if (const detail::RectOneKernel one = kernels_->rect_one) return one(*this, {ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min});
     detail::RectQuery q;
     Visibility decided;
     if (!prepare(ndc_min_x, ndc_min_y, ndc_max_x, ndc_max_y, w_min, q, decided)) return decided;
@@ -76,20 +50,12 @@ Visibility detail::BufferState::test_rect(float ndc_min_x, float ndc_min_y, floa
 }
 
 Visibility detail::BufferState::test_prepared_rect(const detail::RectQuery& q) const {
-    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
-
-    // Coarse check: the level where the subtile range spans at most 2 x 2 cells. Their minimum
-    // d0 is at most any covered subtile's bound, so d_near below it hides the rectangle.
-    // The four corner cells, read without a branch (one to four distinct cells; a repeated one
-    // changes no minimum), as the batches' SIMD coarse stage reads them.
-    const int level = detail::coarse_level(tx0, tx1, ty0, ty1, int(levels_.size()));
-    const int x0 = tx0 >> level, x1 = tx1 >> level, y0 = ty0 >> level, y1 = ty1 >> level;
-    const float coarse = std::min(std::min(min_d0(level, x0, y0), min_d0(level, x1, y0)), std::min(min_d0(level, x0, y1), min_d0(level, x1, y1)));
-    if (q.d_near < coarse) return Visibility::occluded;
+    if (detail::coarse_rect_hides(coarse_view(), q)) return Visibility::occluded;
     if (const detail::RectScanKernel scan = kernels_->rect_scan) return scan(subtile_view(), q);
     // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound
     // (>= d0) is above d_near and the rectangle is hidden. Most hidden rectangles end here.
     const int level_count = int(levels_.size());
+    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
     if (detail::min_pyramid_range_above(pyramid_.data(), levels_.data(), level_count, tx0, ty0, tx1, ty1, q.d_near))
         return Visibility::occluded;
 
@@ -195,8 +161,7 @@ void detail::BufferState::test_rects(const ScreenRect* rects, std::size_t count,
             results[k] = test_rect(rects[k].ndc_min_x, rects[k].ndc_min_y, rects[k].ndc_max_x, rects[k].ndc_max_y, rects[k].w_min);
         return;
     }
-    const detail::CoarseRectView view{pyramid_.data(), level_offset_.data(), level_width_.data(), int(levels_.size()),
-                                      sample_width_,   sample_height_,       config_.near_w};
+    const detail::CoarseRectView view = coarse_view();
     const detail::SubtileView subtiles = subtile_view();
     for (std::size_t base = 0; base < count; base += detail::kRectBlock)
         block(view, subtiles, rects + base, std::min(detail::kRectBlock, count - base), results + base);

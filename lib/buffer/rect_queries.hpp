@@ -6,6 +6,7 @@
 #include <homcull/occlusion_buffer.hpp>
 
 #include "buffer/buffer_state.hpp"
+#include "buffer/min_pyramid.hpp"
 #include "common/float_round.hpp"
 #include "raster/rasterize.hpp"
 
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 namespace homcull::detail {
 
@@ -35,6 +37,65 @@ struct RectQuery {
     float d_near;
 };
 
+// What the rectangle tests do before reading the buffer (detail::BufferState::prepare, and
+// the single test_rect's SIMD kernel, which inlines it compiled for its instruction set): the
+// samples whose centres lie in the rectangle and its nearest 1/w, rounded up and raised by a
+// relative 2^-20; or, returning false, the answer when it needs no buffer (invalid input or
+// before the near plane: visible; outside the view: view-culled; between sample centres:
+// occluded). The batches' SIMD coarse stage repeats these operations in lanes.
+inline bool prepare_rect(const CoarseRectView& view, const ScreenRect& r, RectQuery& q, Visibility& decided) {
+    if (!std::isfinite(r.ndc_min_x) || !std::isfinite(r.ndc_min_y) || !std::isfinite(r.ndc_max_x) || !std::isfinite(r.ndc_max_y) ||
+        !std::isfinite(r.w_min) || !(r.ndc_min_x <= r.ndc_max_x) || !(r.ndc_min_y <= r.ndc_max_y)) {
+        decided = Visibility::visible;  // nothing to reason with: never cull
+        return false;
+    }
+    if (r.w_min < view.near_w) {
+        decided = Visibility::visible;
+        return false;
+    }
+    if (r.ndc_max_x < -1.0f || r.ndc_min_x > 1.0f || r.ndc_max_y < -1.0f || r.ndc_min_y > 1.0f) {
+        decided = Visibility::view_culled;
+        return false;
+    }
+    const double sx0 = (double(r.ndc_min_x) + 1.0) * 0.5 * view.sample_width, sx1 = (double(r.ndc_max_x) + 1.0) * 0.5 * view.sample_width;
+    const double sy0 = (1.0 - double(r.ndc_max_y)) * 0.5 * view.sample_height, sy1 = (1.0 - double(r.ndc_min_y)) * 0.5 * view.sample_height;
+    sample_span(sx0, sx1, view.sample_width, q.i0, q.i1);
+    sample_span(sy0, sy1, view.sample_height, q.j0, q.j1);
+    if (q.i0 > q.i1 || q.j0 > q.j1) {
+        decided = Visibility::occluded;  // covers no sample: invisible at every sample
+        return false;
+    }
+    // 1/w_min is positive, finite and within float's range (w_min >= near_w >= 2^-126), so
+    // rounding it up is one step of its bits where float() rounded it down: float_up without
+    // its branches, which were mispredicted half the time on S1.
+    const double inverse = 1.0 / double(r.w_min);
+    const float nearest = float(inverse);
+    std::uint32_t bits;
+    std::memcpy(&bits, &nearest, sizeof bits);
+    bits += std::uint32_t(double(nearest) < inverse);
+    float up;
+    std::memcpy(&up, &bits, sizeof up);
+    q.d_near = up * (1.0f + 0x1.0p-20f);
+    return true;
+}
+
+// The coarse check of a prepared rectangle: at the level where its subtile range spans at
+// most 2 x 2 cells, the minimum d0 of the four corner cells (one to four distinct cells, read
+// without a branch; a repeated one changes no minimum) is at most any covered subtile's bound,
+// so d_near below it hides the rectangle. The batches' SIMD coarse stage reads the same cells.
+inline bool coarse_rect_hides(const CoarseRectView& view, const RectQuery& q) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+    const int level = coarse_level(tx0, tx1, ty0, ty1, view.levels);
+    const int x0 = tx0 >> level, x1 = tx1 >> level, y0 = ty0 >> level, y1 = ty1 >> level;
+    const float* cells = view.pyramid + view.level_offset[level];
+    const std::size_t width = std::size_t(view.level_width[level]);
+    const float* row0 = cells + std::size_t(y0) * width;
+    const float* row1 = cells + std::size_t(y1) * width;
+    const float coarse = std::min(std::min(row0[x0], row0[x1]), std::min(row1[x0], row1[x1]));
+    return q.d_near < coarse;
+}
+
 // The subtile planes (OcclusionBuffer's layout, rows padded for full-vector loads).
 struct SubtileView {
     const float* d0;
@@ -49,6 +110,16 @@ struct SubtileView {
     const PyramidLevel* levels;
     int level_count;
 };
+
+// A buffer's views, inline so that kernels given the buffer read its fields where they need
+// them instead of copying views on every call.
+inline CoarseRectView BufferState::coarse_view() const {
+    return {pyramid_.data(), level_offset_.data(), level_width_.data(), int(levels_.size()), sample_width_, sample_height_, config_.near_w};
+}
+inline SubtileView BufferState::subtile_view() const {
+    return {d0_.data(),           d1_.data(),      mask_.data(),   stride_, sample_depth_.empty() ? nullptr : sample_depth_.data(),
+            sample_depth_stride_, pyramid_.data(), levels_.data(), int(levels_.size())};
+}
 
 // Which of the samples `samples` of subtile (tx, ty) an occludee at 1/w `d_near` may be seen
 // at by the layers: those whose layer bound (d0, or max(d0, d1) in the working layer's mask)
@@ -85,6 +156,10 @@ inline InteriorSubtiles interior_subtiles(const RectQuery& q) {
 // every subtile the rectangle reaches hides it. None for the scalar choice (test_rect then
 // searches the pyramid; the answers are the same): BufferKernels::rect_scan.
 using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q);
+
+// Both stages for one rectangle, compiled per instruction set: prepare_rect, the coarse check
+// and the exact scan in one dispatch (single test_rect calls). None for the scalar choice.
+using RectOneKernel = Visibility (*)(const BufferState& buffer, const ScreenRect& rect);
 
 // The eight corners of a box under a model-to-clip matrix, by the incremental corner transform
 // (Zhang: the base corner plus the three transformed edge vectors), in double. Returns a bound

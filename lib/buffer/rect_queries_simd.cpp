@@ -230,6 +230,17 @@ HWY_INLINE Visibility ScanRect(const SubtileView& view, const RectQuery& q) {
 // ScanRect for test_rect, one rectangle per dispatch; the batches inline it (TestRectBlock).
 Visibility RectScan(const SubtileView& view, const RectQuery& q) { return ScanRect(view, q); }
 
+// Both stages for one rectangle (single test_rect calls): one dispatch, and prepare_rect and
+// the coarse check compiled for this instruction set with the scan.
+Visibility TestOneRect(const BufferState& buffer, const ScreenRect& rect) {
+    const CoarseRectView view = buffer.coarse_view();
+    RectQuery q;
+    Visibility decided;
+    if (!prepare_rect(view, rect, q, decided)) return decided;
+    if (coarse_rect_hides(view, q)) return Visibility::occluded;
+    return ScanRect(buffer.subtile_view(), q);
+}
+
 // Both stages for a block of rectangles: the coarse stage one rectangle per lane, then the scan
 // of the ones it leaves open, which it has packed: no branch per rectangle on whether it is
 // open (about one in four on S1, at random: a branch mispredicted that often cost more than
@@ -252,10 +263,12 @@ namespace homcull::detail {
 
 HWY_EXPORT(TestRectBlock);
 HWY_EXPORT(RectScan);
+HWY_EXPORT(TestOneRect);
 
 void resolve_rect_query_kernels(const IsaChoice& choice, BufferKernels& k) {
     k.rect_block = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, TestRectBlock);
     k.rect_scan = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RectScan);
+    k.rect_one = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, TestOneRect);
 }
 
 }  // namespace homcull::detail
