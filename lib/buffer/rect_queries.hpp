@@ -37,6 +37,21 @@ struct RectQuery {
     float d_near;
 };
 
+// An occludee's nearest 1/w from its w_min >= near_w >= 2^-126: rounded up and raised by a
+// relative 2^-20. 1/w_min is positive, finite and within float's range, so rounding it up is
+// one step of its bits where float() rounded it down: float_up without its branches, which
+// were mispredicted about half the time on S1's rectangles.
+inline float nearest_depth_bound(float w_min) {
+    const double inverse = 1.0 / double(w_min);
+    const float nearest = float(inverse);
+    std::uint32_t bits;
+    std::memcpy(&bits, &nearest, sizeof bits);
+    bits += std::uint32_t(double(nearest) < inverse);
+    float up;
+    std::memcpy(&up, &bits, sizeof up);
+    return up * (1.0f + 0x1.0p-20f);
+}
+
 // What the rectangle tests do before reading the buffer (detail::BufferState::prepare, and
 // the single test_rect's SIMD kernel, which inlines it compiled for its instruction set): the
 // samples whose centres lie in the rectangle and its nearest 1/w, rounded up and raised by a
@@ -65,17 +80,7 @@ inline bool prepare_rect(const CoarseRectView& view, const ScreenRect& r, RectQu
         decided = Visibility::occluded;  // covers no sample: invisible at every sample
         return false;
     }
-    // 1/w_min is positive, finite and within float's range (w_min >= near_w >= 2^-126), so
-    // rounding it up is one step of its bits where float() rounded it down: float_up without
-    // its branches, which were mispredicted half the time on S1.
-    const double inverse = 1.0 / double(r.w_min);
-    const float nearest = float(inverse);
-    std::uint32_t bits;
-    std::memcpy(&bits, &nearest, sizeof bits);
-    bits += std::uint32_t(double(nearest) < inverse);
-    float up;
-    std::memcpy(&up, &bits, sizeof up);
-    q.d_near = up * (1.0f + 0x1.0p-20f);
+    q.d_near = nearest_depth_bound(r.w_min);
     return true;
 }
 
