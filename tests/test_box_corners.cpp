@@ -1,15 +1,22 @@
 // The occludee boxes' corners (detail::box_corners, buffer/occludee_queries.cpp) take their edge
 // vectors as plain products instead of the full accurate transform; the two must agree to the
 // bit (signed zeros included), since the rectangles feed answers that are the same on every
-// instruction set and in the golden images.
+// instruction set and in the golden images. The SIMD kernels of box_rectangle
+// (buffer/box_rectangle_simd.cpp) must give the scalar function's rectangles to the bit.
+#include <homcull/isa.hpp>
+
+#include "buffer/buffer_kernels.hpp"
 #include "buffer/rect_queries.hpp"
+#include "common/isa_choice.hpp"
 #include "raster/triangle_setup.hpp"
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstring>
+#include <cmath>
 #include <random>
+#include <string>
 
 namespace homcull {
 namespace {
@@ -48,6 +55,61 @@ TEST(BoxCorners, EdgeVectorsAsTheFullTransform) {
         }
     }
     EXPECT_EQ(checked, 20000 * 32);
+}
+
+// Every instruction set's box_rectangle kernel against the scalar function: perspective
+// cameras anywhere (boxes in view, beside it, crossing the near plane or behind the eye, far
+// from the origin), random matrices, extreme values, zero-width boxes and boxes whose
+// rectangle touches NDC 0 (where the sign of a zero extreme depends on the corners' order).
+TEST(BoxRectangle, KernelsGiveTheScalarRectangle) {
+    std::mt19937 random(11);
+    std::uniform_real_distribution<float> uniform(-1.0f, 1.0f), size(0.0f, 20.0f), angle(0.0f, 6.2831853f);
+    const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 1e-20f, -1e-20f, 1e20f, -1e20f, 3.4e38f, 1e-42f, NAN, INFINITY};
+    std::uniform_int_distribution<int> pick(0, int(std::size(values)) - 1);
+    std::size_t kernels = 0, rectangles = 0, decided_without = 0;
+    for (const std::string& name : available_isas()) {
+        const detail::IsaChoice* choice = detail::find_isa_choice(name.c_str());
+        ASSERT_NE(choice, nullptr) << name;
+        const detail::BufferKernels& k = detail::buffer_kernels(*choice);
+        if (!k.box_rectangle) continue;  // the scalar choice
+        ++kernels;
+        for (int trial = 0; trial < 40000; ++trial) {
+            std::array<float, 16> m{};
+            const int kind = trial % 4;
+            if (kind < 3) {  // a perspective camera: rotation about y, translation, projection
+                const float a = angle(random), c = std::cos(a), s = std::sin(a), f = 1.0f + 2.0f * std::abs(uniform(random));
+                const float scale = kind == 2 ? 1e5f : 50.0f;  // far from the origin
+                const float tx = uniform(random) * scale, ty = uniform(random) * scale, tz = uniform(random) * scale;
+                // column-major: clip = P * (R x + t), w = -z_view
+                m = {f * c, 0, s, s, 0, f, 0, 0, -f * s, 0, c, c, f * (c * tx - s * tz), f * ty, s * tx + c * tz - 0.2f, s * tx + c * tz};
+            } else {
+                for (float& e : m) e = trial % 8 == 3 ? values[pick(random)] : uniform(random) * 4.0f;
+            }
+            float lo[3], hi[3];
+            for (int axis = 0; axis < 3; ++axis) {
+                lo[axis] = uniform(random) * (kind == 2 ? 1e5f : 60.0f);
+                hi[axis] = lo[axis] + (trial % 16 == 5 ? 0.0f : size(random));
+                if (trial % 32 == 7) lo[axis] = values[pick(random)];
+            }
+            if (trial % 16 == 9) lo[0] = -(hi[0] = size(random));  // straddles x = 0 in model space
+            const float near_w = trial % 3 ? 0.1f : 1.0f;
+            ScreenRect want{}, got{};
+            Visibility want_decided = Visibility::occluded, got_decided = Visibility::occluded;
+            const bool want_rect = detail::box_rectangle(lo, hi, m, near_w, false, want, want_decided);
+            const bool got_rect = k.box_rectangle(lo, hi, m, near_w, got, got_decided);
+            ASSERT_EQ(got_rect, want_rect) << name << ", trial " << trial;
+            if (want_rect) {
+                ASSERT_EQ(std::memcmp(&got, &want, sizeof got), 0) << name << ", trial " << trial;
+                ++rectangles;
+            } else {
+                ASSERT_EQ(got_decided, want_decided) << name << ", trial " << trial;
+                ++decided_without;
+            }
+        }
+    }
+    if (kernels == 0) GTEST_SKIP() << "no SIMD instruction set here";
+    EXPECT_GT(rectangles, kernels * 10000) << "the test must produce rectangles";
+    EXPECT_GT(decided_without, kernels * 1000) << "and boxes decided without one";
 }
 
 }  // namespace

@@ -10,6 +10,7 @@ BufferKernels resolve_buffer_kernels(const IsaChoice& choice) {
     k.raster = raster_kernels(choice);
     resolve_occludee_row_kernels(choice, k);
     resolve_rect_query_kernels(choice, k);
+    resolve_box_rectangle_kernel(choice, k);
     return k;
 }
 }  // namespace

@@ -16,12 +16,22 @@ struct BufferKernels {
     RectScanKernel rect_scan;        // rect_queries.hpp
     RectBlockKernel rect_block;
     RectOneKernel rect_one;
+    BoxRectangleKernel box_rectangle;
 };
+
+// box_rectangle through a kernel table: its SIMD kernel for a perspective matrix, the scalar
+// function otherwise; the same rectangle and answer either way.
+inline bool box_rectangle(const BufferKernels& kernels, const float box_min[3], const float box_max[3],
+                          const std::array<float, 16>& model_to_clip, float near_w, bool orthographic, ScreenRect& rect, Visibility& decided) {
+    if (!orthographic && kernels.box_rectangle) return kernels.box_rectangle(box_min, box_max, model_to_clip, near_w, rect, decided);
+    return box_rectangle(box_min, box_max, model_to_clip, near_w, orthographic, rect, decided);
+}
 
 const BufferKernels& buffer_kernels(const IsaChoice& choice);
 
 // Each SIMD translation unit's part of the table (they hold the HWY_EXPORTs).
 void resolve_occludee_row_kernels(const IsaChoice& choice, BufferKernels& kernels);
 void resolve_rect_query_kernels(const IsaChoice& choice, BufferKernels& kernels);
+void resolve_box_rectangle_kernel(const IsaChoice& choice, BufferKernels& kernels);
 
 }  // namespace homcull::detail

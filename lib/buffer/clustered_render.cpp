@@ -58,7 +58,8 @@ void detail::BufferState::place_cluster(const OccluderCluster& c, std::uint32_t 
     ScreenRect rect;
     Visibility decided = Visibility::visible;
     detail::RectQuery q;
-    if (c.bounded && detail::box_rectangle(&c.bounds.min.x, &c.bounds.max.x, model_to_clip, config_.near_w, config_.orthographic, rect, decided) &&
+    if (c.bounded && detail::box_rectangle(*kernels_, &c.bounds.min.x, &c.bounds.max.x, model_to_clip, config_.near_w, config_.orthographic, rect,
+                                              decided) &&
         prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
         out.placed = {rect.w_min, number, 0, q.i0, q.i1, q.j0, q.j1, q.d_near, true, backface};
     else if (decided != Visibility::visible)  // outside the view, or between sample centres

@@ -130,16 +130,20 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
         decided = b.finite && b.behind == 8 ? Visibility::view_culled : Visibility::visible;
         return false;
     }
+    return rectangle_from_bounds(b.min_x, b.max_x, b.min_y, b.max_y, b.min_w, error, rect, decided);
+}
+
+bool rectangle_from_bounds(double min_x, double max_x, double min_y, double max_y, double min_w, double error, ScreenRect& rect,
+                           Visibility& decided) {
     // Wherever the exact corners are, they lie within the widened rectangle and at or beyond
     // its lowered w; rounded outwards and towards the eye when going to float. A bound that
     // reaches the nearest w leaves no rectangle to reason with: visible.
-    const double ndc = ndc_error_bound(error, std::max({-b.min_x, b.max_x, -b.min_y, b.max_y}), b.min_w);
+    const double ndc = ndc_error_bound(error, std::max({-min_x, max_x, -min_y, max_y}), min_w);
     if (!(ndc < HUGE_VAL)) {
         decided = Visibility::visible;
         return false;
     }
-    rect = {float_down(b.min_x - ndc), float_down(b.min_y - ndc), float_up(b.max_x + ndc), float_up(b.max_y + ndc),
-            float_down(b.min_w - error)};
+    rect = {float_down(min_x - ndc), float_down(min_y - ndc), float_up(max_x + ndc), float_up(max_y + ndc), float_down(min_w - error)};
     return true;
 }
 
@@ -149,7 +153,7 @@ Visibility detail::BufferState::test_aabb(const float box_min[3], const float bo
     const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
-    if (!detail::box_rectangle(box_min, box_max, m, config_.near_w, config_.orthographic, r, decided)) return decided;
+    if (!detail::box_rectangle(*kernels_, box_min, box_max, m, config_.near_w, config_.orthographic, r, decided)) return decided;
     return test_rect(r.ndc_min_x, r.ndc_min_y, r.ndc_max_x, r.ndc_max_y, r.w_min);
 }
 
@@ -177,7 +181,7 @@ void detail::BufferState::test_aabbs(const Aabb* boxes, std::size_t count, const
         const std::size_t n = std::min(kBlock, count - base);
         std::size_t pending = 0;
         for (std::size_t k = 0; k < n; ++k)
-            if (detail::box_rectangle(&boxes[base + k].min.x, &boxes[base + k].max.x, m, config_.near_w, config_.orthographic, rects[pending],
+            if (detail::box_rectangle(*kernels_, &boxes[base + k].min.x, &boxes[base + k].max.x, m, config_.near_w, config_.orthographic, rects[pending],
                                       results[base + k]))
                 index[pending++] = base + k;
         test_rects(rects, pending, answers);

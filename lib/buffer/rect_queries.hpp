@@ -188,6 +188,17 @@ double ndc_error_bound(double error, double max_abs_ndc, double min_w);
 // orthographic representatives (orthographic_corners).
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,
                    bool orthographic, ScreenRect& rect, Visibility& decided);
+// box_rectangle's last step, from the corners' NDC bounds and nearest w (every corner finite
+// and at or beyond the near plane) and their error bound: the rectangle widened and rounded
+// outwards, or false (visible) when the bound leaves none. Shared with the SIMD kernel
+// (box_rectangle_simd.cpp), which finds the bounds in lanes.
+bool rectangle_from_bounds(double min_x, double max_x, double min_y, double max_y, double min_w, double error, ScreenRect& rect,
+                           Visibility& decided);
+// box_rectangle for a perspective matrix (orthographic false), its corners in SIMD lanes: the
+// same rectangle or answer. None for the scalar choice: BufferKernels::box_rectangle.
+using BoxRectangleKernel = bool (*)(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip,
+                                    float near_w, ScreenRect& rect, Visibility& decided);
+
 // Replaces the eight corners by their orthographic representatives (triangle_setup.hpp) and
 // returns a bound on the error of their coordinates, from `error`, the corners' own bound
 // (box_corners); infinite when the corners come too near h = 0 to bound it (or beyond twice

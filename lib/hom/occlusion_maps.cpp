@@ -10,6 +10,7 @@
 #include <homcull/error.hpp>
 #include <homcull/occlusion_maps.hpp>
 
+#include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
 #include "hom/map_kernels.hpp"
 #include "hom/maps_state.hpp"
@@ -357,7 +358,8 @@ OccludeeAnswer detail::MapsState::test_aabb(const Aabb& box, const std::array<fl
     const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
-    if (!detail::box_rectangle(&box.min.x, &box.max.x, m, built().config().near_w, false, r, decided)) return decided_answer(decided);
+    if (!detail::box_rectangle(*built().state().kernels_, &box.min.x, &box.max.x, m, built().config().near_w, false, r, decided))
+        return decided_answer(decided);
     return test_rect(r);
 }
 
