@@ -13,9 +13,9 @@ struct BufferKernels {
     RasterKernels raster;
     // The queries' SIMD kernels; null for the scalar choice (the scalar paths answer the same).
     OccludeeRowKernel occludee_row;  // occludee_depth.hpp
-    RectScanKernel rect_scan;        // rect_queries.hpp
     RectBlockKernel rect_block;
     RectOneKernel rect_one;
+    RectPreparedKernel rect_prepared;
     BoxRectangleKernel box_rectangle;
 };
 

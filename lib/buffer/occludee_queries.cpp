@@ -50,8 +50,8 @@ Visibility detail::BufferState::test_rect(float ndc_min_x, float ndc_min_y, floa
 }
 
 Visibility detail::BufferState::test_prepared_rect(const detail::RectQuery& q) const {
+    if (const detail::RectPreparedKernel prepared = kernels_->rect_prepared) return prepared(*this, q);
     if (detail::coarse_rect_hides(coarse_view(), q)) return Visibility::occluded;
-    if (const detail::RectScanKernel scan = kernels_->rect_scan) return scan(subtile_view(), q);
     // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound
     // (>= d0) is above d_near and the rectangle is hidden. Most hidden rectangles end here.
     const int level_count = int(levels_.size());

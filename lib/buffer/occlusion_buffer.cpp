@@ -87,7 +87,7 @@ detail::BufferSizes buffer_sizes(const BufferConfig& config) {
         w = (w + 1) / 2, h = (h + 1) / 2;
         size += std::size_t(w) * std::size_t(h);
     }
-    z.pyramid = size + detail::kMaxSimdLanes;  // padded: RectScan loads whole vectors of a level's row
+    z.pyramid = size + detail::kMaxSimdLanes;  // padded: ScanRect loads whole vectors of a level's row
     z.cells_width = std::size_t(detail::reference_cells_width(z.subtiles_x));
     z.cells_height = std::size_t(detail::reference_cells_height(z.subtiles_y));
     z.cells = std::size_t(detail::kCellTables) * z.cells_width * z.cells_height;

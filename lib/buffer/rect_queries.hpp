@@ -157,14 +157,14 @@ inline InteriorSubtiles interior_subtiles(const RectQuery& q) {
             q.j1 % kH == kH - 1 ? ty1 : ty1 - 1};
 }
 
-// The exact stage after the coarse check, scanning the subtile rows in SIMD: occluded when
-// every subtile the rectangle reaches hides it. None for the scalar choice (test_rect then
-// searches the pyramid; the answers are the same): BufferKernels::rect_scan.
-using RectScanKernel = Visibility (*)(const SubtileView& view, const RectQuery& q);
-
 // Both stages for one rectangle, compiled per instruction set: prepare_rect, the coarse check
-// and the exact scan in one dispatch (single test_rect calls). None for the scalar choice.
+// and the exact scan (ScanRect, the subtile rows in SIMD: occluded when every subtile the
+// rectangle reaches hides it) in one dispatch (single test_rect calls). None for the scalar
+// choice, whose test_rect searches the pyramid instead (the answers are the same).
 using RectOneKernel = Visibility (*)(const BufferState& buffer, const ScreenRect& rect);
+// The coarse check and the exact scan of a prepared rectangle in one dispatch
+// (detail::BufferState::test_prepared_rect). None for the scalar choice.
+using RectPreparedKernel = Visibility (*)(const BufferState& buffer, const RectQuery& q);
 
 // The eight corners of a box under a model-to-clip matrix, by the incremental corner transform
 // (Zhang: the base corner plus the three transformed edge vectors), in double. Returns a bound
@@ -210,7 +210,7 @@ constexpr std::uint8_t kUndecided = 0xFF;
 
 // The batched tests of rectangles [0, count), count <= kRectBlock, in an instruction set's
 // SIMD lanes: the coarse stage in SIMD lanes (repeating prepare() and test_rect's coarse check), then
-// the exact scan (ScanRect, which RectScan runs for test_rect) of the ones it leaves open: the
+// the exact scan (ScanRect, which test_rect's kernel runs too) of the ones it leaves open: the
 // answers of test_rect. None for the scalar choice: BufferKernels::rect_block.
 constexpr std::size_t kRectBlock = 256;
 using RectBlockKernel = void (*)(const CoarseRectView& view, const SubtileView& subtiles, const ScreenRect* rects, std::size_t count,

@@ -6,7 +6,7 @@
 //   rectangles they decide there, with the same answers. On S1 about three in four are decided
 //   here.
 // - The others are packed with the query computed here and go on to the exact scan (ScanRect),
-//   which test_rect also uses (RectScan).
+//   which the single test_rect's kernel (TestOneRect) and the prepared one's also run.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "buffer/rect_queries_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -227,9 +227,6 @@ HWY_INLINE Visibility ScanRect(const SubtileView& view, const RectQuery& q) {
     return Visibility::occluded;
 }
 
-// ScanRect for test_rect, one rectangle per dispatch; the batches inline it (TestRectBlock).
-Visibility RectScan(const SubtileView& view, const RectQuery& q) { return ScanRect(view, q); }
-
 // Both stages for one rectangle (single test_rect calls): one dispatch, and prepare_rect and
 // the coarse check compiled for this instruction set with the scan.
 Visibility TestOneRect(const BufferState& buffer, const ScreenRect& rect) {
@@ -238,6 +235,13 @@ Visibility TestOneRect(const BufferState& buffer, const ScreenRect& rect) {
     Visibility decided;
     if (!prepare_rect(view, rect, q, decided)) return decided;
     if (coarse_rect_hides(view, q)) return Visibility::occluded;
+    return ScanRect(buffer.subtile_view(), q);
+}
+
+// The coarse check and the scan of a prepared rectangle in one dispatch (the occlusion maps'
+// box tests, which prepare their rectangles themselves).
+Visibility TestPreparedRect(const BufferState& buffer, const RectQuery& q) {
+    if (coarse_rect_hides(buffer.coarse_view(), q)) return Visibility::occluded;
     return ScanRect(buffer.subtile_view(), q);
 }
 
@@ -262,13 +266,13 @@ HWY_AFTER_NAMESPACE();
 namespace homcull::detail {
 
 HWY_EXPORT(TestRectBlock);
-HWY_EXPORT(RectScan);
 HWY_EXPORT(TestOneRect);
+HWY_EXPORT(TestPreparedRect);
 
 void resolve_rect_query_kernels(const IsaChoice& choice, BufferKernels& k) {
     k.rect_block = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, TestRectBlock);
-    k.rect_scan = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RectScan);
     k.rect_one = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, TestOneRect);
+    k.rect_prepared = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, TestPreparedRect);
 }
 
 }  // namespace homcull::detail

@@ -25,6 +25,9 @@ public:
     OccludeeAnswer test_aabb(const Aabb& box, const std::array<float, 16>& model_to_clip) const;
     double hole_budget() const;
     OccludeeAnswer test_rect_within(const ScreenRect& rect, double& budget) const;
+    // test_rect_within's work, for callers already under a StandardFloatMode (each guard reads
+    // MXCSR, a few nanoseconds of every box test).
+    OccludeeAnswer answer_rect(const ScreenRect& rect, double& budget) const;
     const OcclusionMapsConfig& config() const { return config_; }
     int levels() const { return int(levels_.size()); }
     int level_width(int k) const { return levels_[std::size_t(k)].width; }

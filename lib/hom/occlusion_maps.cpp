@@ -330,11 +330,15 @@ OccludeeAnswer decided_answer(Visibility v) {
 OccludeeAnswer detail::MapsState::test_rect(const ScreenRect& rect) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     double budget = hole_budget();
-    return test_rect_within(rect, budget);
+    return answer_rect(rect, budget);
 }
 
 OccludeeAnswer detail::MapsState::test_rect_within(const ScreenRect& rect, double& budget) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
+    return answer_rect(rect, budget);
+}
+
+OccludeeAnswer detail::MapsState::answer_rect(const ScreenRect& rect, double& budget) const {
     detail::RectQuery q;
     Visibility decided;
     if (!built().state().prepare(rect.ndc_min_x, rect.ndc_min_y, rect.ndc_max_x, rect.ndc_max_y, rect.w_min, q, decided))
@@ -360,7 +364,8 @@ OccludeeAnswer detail::MapsState::test_aabb(const Aabb& box, const std::array<fl
     Visibility decided;
     if (!detail::box_rectangle(*built().state().kernels_, &box.min.x, &box.max.x, m, built().config().near_w, false, r, decided))
         return decided_answer(decided);
-    return test_rect(r);
+    double budget = hole_budget();
+    return answer_rect(r, budget);
 }
 
 }  // namespace homcull
