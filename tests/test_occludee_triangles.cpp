@@ -3,9 +3,12 @@
 // random triangles that the test never hides a triangle seen at a sample of the buffer.
 #include "buffer/buffer_kernels.hpp"
 #include "buffer/occludee_depth.hpp"
+#include "common/isa_choice.hpp"
+#include "raster/triangle_batch.hpp"
 #include "support.hpp"
 
 #include <homcull/error.hpp>
+#include <homcull/isa.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
 #include <glm/glm.hpp>
@@ -645,6 +648,57 @@ TEST(OccludeeTriangles, NeverHidesWhatTheExactMatrixShows) {
                 seen_count);
     EXPECT_GT(seen_count, trials / 5);
     EXPECT_GT(hidden_count, trials / 5);
+}
+
+// The batches' side-plane kernel with beyond_side_plane_exactly's margins: every instruction
+// set passes over the lanes the scalar reference does, on batches whose corners lie just
+// inside, on and just beyond the margin of each side plane (test_triangles skips those lanes
+// without another check).
+TEST(OccludeeTriangles, SidePlaneKernelsPassOverTheReferencesLanes) {
+    std::mt19937_64 random(19);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), magnitude(0.0, 6.0);
+    std::size_t passed = 0, lanes = 0;
+    for (const std::string& name : available_isas()) {
+        const detail::IsaChoice* choice = detail::find_isa_choice(name.c_str());
+        ASSERT_NE(choice, nullptr) << name;
+        const auto kernel = detail::raster_kernels(*choice).front_end.beyond_side_plane;
+        for (int trial = 0; trial < 3000; ++trial) {
+            detail::TriangleBatch batch;
+            const int count = 1 + int(random() % detail::TriangleBatch::kSize);
+            batch.count = count;
+            batch.indices_valid = std::uint32_t(random()) | (trial % 2 ? ~0u : 0u);
+            const double scale_x = trial % 5 == 0 ? 0.0 : std::ldexp(1.0, -22) * (1.0 + magnitude(random)), scale_y = scale_x * 0.75;
+            for (int t = 0; t < count; ++t) {
+                const double size = std::pow(10.0, magnitude(random));
+                const int plane = int(random() % 4);
+                for (int k = 0; k < 3; ++k) {
+                    batch.px[k][t] = unit(random) * size, batch.py[k][t] = unit(random) * size;
+                    batch.pz[k][t] = unit(random) * size, batch.pw[k][t] = 1.0;
+                }
+                double p = 0.0;
+                for (int k = 0; k < 3; ++k)
+                    p = std::max({p, std::abs(batch.px[k][t]), std::abs(batch.py[k][t]), std::abs(batch.pz[k][t]), 1.0});
+                for (int k = 0; k < 3; ++k) {
+                    const double w = 1.0 + magnitude(random), across = unit(random) * w;
+                    // Beyond the plane by the margin, give or take a few of its units (or
+                    // nowhere near it), so that lanes fall on both sides.
+                    const double margin = (plane < 2 ? scale_x : scale_y) * p, off = margin + std::trunc(unit(random) * 3.0) * margin + unit(random) * 1e-3;
+                    double x = across, y = across;
+                    if (plane == 0) x = w + off;
+                    if (plane == 1) x = -w - off;
+                    if (plane == 2) y = w + off;
+                    if (plane == 3) y = -w - off;
+                    if (trial % 7 == 3 && k == 1) x = std::numeric_limits<double>::quiet_NaN();
+                    batch.cx[k][t] = x, batch.cy[k][t] = y, batch.cz[k][t] = 0.0, batch.cw[k][t] = w;
+                }
+            }
+            const std::uint32_t want = detail::beyond_side_plane_reference(batch, count, scale_x, scale_y);
+            ASSERT_EQ(kernel(batch, count, scale_x, scale_y), want) << name << ", trial " << trial;
+            passed += std::size_t(__builtin_popcount(want)), lanes += std::size_t(count);
+        }
+    }
+    EXPECT_GT(passed, lanes / 20) << "lanes passed over";
+    EXPECT_LT(passed, lanes * 7 / 8) << "and lanes kept";
 }
 
 }  // namespace

@@ -368,11 +368,14 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
         kernels.transform_batch_plain(in, batch);
         // Lanes beyond a side plane (valid and finite) cannot show the occludee: shows() would
         // pass over them first thing. Decided for the whole batch in SIMD lanes: most lanes on
-        // a walk (the castle's: 88 %). The others are taken in order, as before.
-        // The kernel judges the rounded coordinates; a lane it passes over is confirmed beyond
-        // the rounding (beyond_exactly), else taken in order with the others.
-        const std::uint32_t passed_over = kernels.beyond_side_plane(batch, int(count));
+        // a walk (the castle's: 88 %). The others are taken in order, as before. For a
+        // perspective input the kernel applies beyond_side_plane_exactly's margins itself, so
+        // the lanes it passes over need nothing more; an orthographic input's are confirmed
+        // beyond its rounding (beyond_exactly), else taken in order with the others.
+        const std::uint32_t passed_over = in.orthographic ? kernels.beyond_side_plane(batch, int(count), 0.0, 0.0)
+                                                          : kernels.beyond_side_plane(batch, int(count), rows[0] + rows[3], rows[1] + rows[3]);
         for (std::size_t k = 0; k < count; ++k) {
+            if (!in.orthographic && ((passed_over >> k) & 1u)) continue;
             glm::dvec4 model[3], clip[3];
             for (int v = 0; v < 3; ++v) {
                 model[v] = {batch.px[v][k], batch.py[v][k], batch.pz[v][k], batch.pw[v][k]};

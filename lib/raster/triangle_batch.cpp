@@ -127,12 +127,15 @@ void transform_batch_with(const TriangleInput& in, TriangleBatch& batch) {
 void transform_batch_reference(const TriangleInput& in, TriangleBatch& batch) { transform_batch_with<false>(in, batch); }
 void transform_batch_plain_reference(const TriangleInput& in, TriangleBatch& batch) { transform_batch_with<true>(in, batch); }
 
-std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count) {
+std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count, double scale_x, double scale_y) {
     std::uint32_t bits = 0;
     for (int t = 0; t < count; ++t) {
         const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
+        double p = 0.0;
+        for (int k = 0; k < 3; ++k)
+            p = std::max({p, std::abs(batch.px[k][t]), std::abs(batch.py[k][t]), std::abs(batch.pz[k][t]), std::abs(batch.pw[k][t])});
         if (((batch.indices_valid >> t) & 1u) && finite_clip(clip[0]) && finite_clip(clip[1]) && finite_clip(clip[2]) &&
-            outside_side_plane(clip))
+            outside_side_plane(clip, scale_x * p, scale_y * p))
             bits |= 1u << t;
     }
     return bits;

@@ -144,9 +144,10 @@ struct FrontEndKernels {
     // the scalar reference.
     void (*gather_direct)(const TriangleInput& in, std::size_t first, const std::uint32_t* order, TriangleBatch& batch);
     // The lanes [0, count) of a transformed batch with valid indices, finite clip x, y and w at
-    // every vertex (finite_clip) and all three vertices beyond one side plane
-    // (outside_side_plane), as bits (lane t: bit t).
-    std::uint32_t (*beyond_side_plane)(const TriangleBatch& batch, int count);
+    // every vertex (finite_clip) and all three vertices beyond one side plane by more than a
+    // margin (outside_side_plane: x - w > scale_x p, ..., with p the largest |model
+    // coordinate| of the lane's vertices; scales of 0: beyond the plane), as bits (lane t: bit t).
+    std::uint32_t (*beyond_side_plane)(const TriangleBatch& batch, int count, double scale_x, double scale_y);
     // transform_batch with transform_to_clip_plain: the occludee tests' (they bound its error).
     TransformBatchKernel transform_batch_plain;
     // margin_free_edges for a batch's lanes at once (shared_edge_rule.hpp); null for the scalar
@@ -154,7 +155,7 @@ struct FrontEndKernels {
     MarginFreeKernel margin_free;
 };
 void transform_batch_plain_reference(const TriangleInput& in, TriangleBatch& batch);
-std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count);
+std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count, double scale_x, double scale_y);
 
 // Whether triangles [first, first + TriangleBatch::kSize) of the input are consecutive
 // vertices of 4 floats each (aligned as floats), all within vertex_count:

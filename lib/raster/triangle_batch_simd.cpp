@@ -232,18 +232,31 @@ void ClassifyBatch(Backface backface, double near_w, TriangleBatch& batch, Raste
     }
 }
 
-// beyond_side_plane_reference, lane by lane: the same comparisons.
-std::uint32_t BeyondSidePlane(const TriangleBatch& batch, int count) {
+// beyond_side_plane_reference, lane by lane: the same operations (the largest |model
+// coordinate| of the lane's corners, the margins scale * p, the differences x - w and
+// -x - w against them).
+std::uint32_t BeyondSidePlane(const TriangleBatch& batch, int count, double scale_x, double scale_y) {
     const D d;
     const int lanes = int(hn::Lanes(d));
+    const V infinity = hn::Set(d, HUGE_VAL);
     std::uint32_t bits = 0;
     for (int g = 0; g < count; g += lanes) {
         const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};
         const M valid = hn::And(hn::FirstN(d, std::size_t(count - g)), hn::LoadMaskBits(d, index_bits));
+        V p = hn::Zero(d);
+        for (int k = 0; k < 3; ++k)
+            p = hn::Max(p, hn::Max(hn::Max(hn::Abs(hn::Load(d, batch.px[k] + g)), hn::Abs(hn::Load(d, batch.py[k] + g))),
+                                   hn::Max(hn::Abs(hn::Load(d, batch.pz[k] + g)), hn::Abs(hn::Load(d, batch.pw[k] + g)))));
+        const V margin_x = hn::Mul(hn::Set(d, scale_x), p), margin_y = hn::Mul(hn::Set(d, scale_y), p);
         M finite = valid, right = valid, left = valid, above = valid, below = valid;
-        for (int k = 0; k < 3; ++k)  // ClassifyBatch's comparisons (clip_fates-inl.h)
-            AddSidePlaneCorner(d, hn::Load(d, batch.cx[k] + g), hn::Load(d, batch.cy[k] + g), hn::Load(d, batch.cw[k] + g), finite, right, left,
-                               above, below);
+        for (int k = 0; k < 3; ++k) {
+            const V x = hn::Load(d, batch.cx[k] + g), y = hn::Load(d, batch.cy[k] + g), w = hn::Load(d, batch.cw[k] + g);
+            finite = hn::And(finite, hn::And(hn::And(hn::Lt(hn::Abs(x), infinity), hn::Lt(hn::Abs(y), infinity)), hn::Lt(hn::Abs(w), infinity)));
+            right = hn::And(right, hn::Gt(hn::Sub(x, w), margin_x));
+            left = hn::And(left, hn::Gt(hn::Sub(hn::Neg(x), w), margin_x));
+            above = hn::And(above, hn::Gt(hn::Sub(y, w), margin_y));
+            below = hn::And(below, hn::Gt(hn::Sub(hn::Neg(y), w), margin_y));
+        }
         bits |= LaneBits(d, hn::And(finite, hn::Or(hn::Or(right, left), hn::Or(above, below)))) << g;
     }
     return bits;
