@@ -18,7 +18,6 @@
 #include <hwy/highway.h>
 
 #include "buffer/rect_queries.hpp"
-#include "raster/triangle_setup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -32,15 +31,10 @@ bool BoxRectangle(const float box_min[3], const float box_max[3], const std::arr
 #if HWY_TARGET == HWY_SCALAR  // one lane: the scalar function
     return box_rectangle(box_min, box_max, m, near_w, false, rect, decided);
 #else
-    // box_corners: the base corner (an accurate sum per row), the edge vectors, the error bound.
-    const glm::dvec4 base = transform_to_clip(m, box_min[0], box_min[1], box_min[2], 1.0);
-    const double lengths[3] = {double(box_max[0]) - double(box_min[0]), double(box_max[1]) - double(box_min[1]),
-                               double(box_max[2]) - double(box_min[2])};
-    glm::dvec4 edge[3];
-    for (int axis = 0; axis < 3; ++axis)
-        for (int row = 0; row < 4; ++row) edge[axis][row] = double(m[std::size_t(4 * axis + row)]) * lengths[axis] + 0.0;
-    const glm::dvec4 magnitude = glm::abs(base) + glm::abs(edge[0]) + glm::abs(edge[1]) + glm::abs(edge[2]);
-    const double error = 0x1.0p-50 * std::max({magnitude.x, magnitude.y, magnitude.z, magnitude.w});
+    // box_corners' base corner, edge vectors and error bound.
+    const BoxEdges box = box_edges(box_min, box_max, m);
+    const glm::dvec4 &base = box.base, *edge = box.edge;
+    const double error = box.error;
 
     // Corner k = base + (k & 1 ? ex : 0) + (k & 2 ? ey : 0) + (k & 4 ? ez : 0), k in lanes;
     // fewer than 8 lanes take the corners in chunks.

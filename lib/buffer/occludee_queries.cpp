@@ -79,24 +79,30 @@ Visibility detail::BufferState::test_prepared_rect(const detail::RectQuery& q) c
 
 namespace detail {
 
-double box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, glm::dvec4 corners[8]) {
-    const glm::dvec4 base = transform_to_clip(m, box_min[0], box_min[1], box_min[2], 1.0);
+BoxEdges box_edges(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) {
+    BoxEdges b;
+    b.base = transform_to_clip(m, box_min[0], box_min[1], box_min[2], 1.0);
     // The edge vectors: transform_to_clip of (length, 0, 0, 0) and so on, whose accurate sum of
     // one product and three zeros is that product (plus 0.0: a zero comes out +0, as there).
     // Products of a float entry and a difference of floats are finite, so the two agree to the
     // bit (test BoxCorners.EdgeVectorsAsTheFullTransform).
     const double lengths[3] = {double(box_max[0]) - double(box_min[0]), double(box_max[1]) - double(box_min[1]),
                                double(box_max[2]) - double(box_min[2])};
-    glm::dvec4 edge[3];
     for (int axis = 0; axis < 3; ++axis)
-        for (int row = 0; row < 4; ++row) edge[axis][row] = double(m[4 * axis + row]) * lengths[axis] + 0.0;
-    const glm::dvec4 &ex = edge[0], &ey = edge[1], &ez = edge[2];
-    for (int k = 0; k < 8; ++k)
-        corners[k] = base + ((k & 1) ? ex : glm::dvec4(0)) + ((k & 2) ? ey : glm::dvec4(0)) + ((k & 4) ? ez : glm::dvec4(0));
+        for (int row = 0; row < 4; ++row) b.edge[axis][row] = double(m[4 * axis + row]) * lengths[axis] + 0.0;
     // 2^-52 for each transform and the edge lengths' subtraction, 3 * 2^-53 for the sums: 2^-50
     // of the terms' magnitude covers both.
-    const glm::dvec4 magnitude = glm::abs(base) + glm::abs(ex) + glm::abs(ey) + glm::abs(ez);
-    return 0x1.0p-50 * std::max({magnitude.x, magnitude.y, magnitude.z, magnitude.w});
+    const glm::dvec4 magnitude = glm::abs(b.base) + glm::abs(b.edge[0]) + glm::abs(b.edge[1]) + glm::abs(b.edge[2]);
+    b.error = 0x1.0p-50 * std::max({magnitude.x, magnitude.y, magnitude.z, magnitude.w});
+    return b;
+}
+
+double box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, glm::dvec4 corners[8]) {
+    const BoxEdges b = box_edges(box_min, box_max, m);
+    const glm::dvec4 &ex = b.edge[0], &ey = b.edge[1], &ez = b.edge[2];
+    for (int k = 0; k < 8; ++k)
+        corners[k] = b.base + ((k & 1) ? ex : glm::dvec4(0)) + ((k & 2) ? ey : glm::dvec4(0)) + ((k & 4) ? ez : glm::dvec4(0));
+    return b.error;
 }
 
 double orthographic_corners(glm::dvec4 corners[8], double error) {

@@ -172,6 +172,14 @@ using RectPreparedKernel = Visibility (*)(const BufferState& buffer, const RectQ
 // the four transforms is accurate to about 2^-52 of its result (transform_to_clip), and the
 // three sums of a corner round by at most 2^-53 of their terms each.
 double box_corners(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, glm::dvec4 corners[8]);
+// What box_corners builds the corners from: the base corner (box_min transformed), the three
+// edge vectors, and that error bound. Corner k is base + (k & 1 ? edge[0] : 0) + (k & 2 ?
+// edge[1] : 0) + (k & 4 ? edge[2] : 0), added in that order (the SIMD kernel adds the same).
+struct BoxEdges {
+    glm::dvec4 base, edge[3];
+    double error;
+};
+BoxEdges box_edges(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip);
 
 // How far points' NDC bounds may move when each of their clip coordinates may be off by
 // `error`: at most error (1 + |ndc|) / (w - error) for a point at w, plus the division's own
