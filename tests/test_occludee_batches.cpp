@@ -98,9 +98,9 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
     }
 }
 
-// prepare_rect rounds 1/w_min up without float_up's branches; over w_min from the smallest
-// near_w to the largest float (1/w in float's normal and subnormal ranges, exact or not), it
-// gives float_up's bound.
+// prepare_rect's nearest depth over w_min from the smallest near_w to the largest float (1/w in
+// float's normal and subnormal ranges, exact or not): the smallest float at or above 1/w
+// (nextafter where float() rounded down), raised by a relative 2^-20.
 TEST(OccludeeBatches, NearestDepthIsOneOverWRoundedUp) {
     std::mt19937_64 rng(23);
     std::uniform_int_distribution<std::uint32_t> bits(0x00800000u, 0x7F7FFFFFu);  // 2^-126 .. FLT_MAX
@@ -114,7 +114,10 @@ TEST(OccludeeBatches, NearestDepthIsOneOverWRoundedUp) {
         detail::RectQuery q;
         Visibility decided;
         ASSERT_TRUE(detail::prepare_rect(view, {-0.5f, -0.5f, 0.5f, 0.5f, w}, q, decided)) << w;
-        differing += q.d_near != detail::float_up(1.0 / double(w)) * (1.0f + 0x1.0p-20f);
+        const double inverse = 1.0 / double(w);
+        float up = float(inverse);
+        if (double(up) < inverse) up = std::nextafter(up, INFINITY);
+        differing += q.d_near != up * (1.0f + 0x1.0p-20f);
         ++checked;
     }
     EXPECT_EQ(differing, 0u) << "of " << checked;

@@ -129,10 +129,6 @@ public:
     void reduce_pyramid_cells(int level, int x_begin, int x_end, int y_begin, int y_end);
     // Zeroes the subtiles (and per-sample depths) of subtile rows [row_begin, row_end).
     void clear_rows(int row_begin, int row_end);
-    float min_d0(int level, int x, int y) const {
-        const PyramidLevel& l = levels_[std::size_t(level)];
-        return pyramid_[l.offset + std::size_t(y) * std::size_t(l.width) + std::size_t(x)];
-    }
     // Shared by the rectangle tests: the sample range and nearest 1/w, or a decided answer.
     bool prepare(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min, RectQuery& q,
                  Visibility& decided) const;
