@@ -434,6 +434,57 @@ TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
     EXPECT_GT(unhidden_seen, checked / 10);  // both answers compared
 }
 
+// The per-sample depth's test of a subtile (BufferKernels::sample_depth_unhidden) gives its
+// reference's bits on every instruction set: occluder depths placed at each sample's bound,
+// one float step either side, or far from it, with and without the plane and the raised
+// vertices' bound, some samples not asked about.
+TEST(OccludeeTriangles, TheSampleDepthKernelAnswersAsItsReference) {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight, kStride = 24 * kW;
+    std::vector<float> sample_depth(std::size_t(kStride) * 24 * kH);
+    int checked = 0, shown_seen = 0, hidden_seen = 0;
+    for (const std::string& isa : available_isas()) {
+        const detail::SampleDepthUnhiddenKernel kernel = detail::buffer_kernels(detail::isa_choice(isa)).sample_depth_unhidden;
+        ASSERT_NE(kernel, nullptr);
+        for (int trial = 0; trial < 600; ++trial) {
+            detail::OccludeeDepth depth;
+            depth.z_vertex_max = float(0.05 + unit(rng));
+            depth.raise = float(1.0 + 0x1.0p-20 + 1e-7 * unit(rng));
+            depth.plane.has_plane = trial % 5 != 0;
+            depth.plane.a = float(0.2 * unit(rng)), depth.plane.dzdx = float((unit(rng) - 0.5) * 1e-3);
+            depth.plane.dzdy = float((unit(rng) - 0.5) * 1e-2);
+            depth.error = float(1e-6 * unit(rng)), depth.plane_raise = float(1.0 + 1e-5 * unit(rng));
+            depth.raised.usable = trial % 3 != 0;
+            depth.raised.d0 = 0.3 * unit(rng), depth.raised.x0 = 150 * unit(rng), depth.raised.y0 = 80 * unit(rng);
+            depth.raised.dzdx = (unit(rng) - 0.5) * 1e-3, depth.raised.dzdy = (unit(rng) - 0.5) * 1e-2, depth.raised.outside = 1e-6 * unit(rng);
+            const int tx = int(20 * unit(rng)), ty = int(20 * unit(rng));
+            for (int j = 0; j < kH; ++j)
+                for (int i = 0; i < kW; ++i) {
+                    const int x = tx * kW + i, y = ty * kH + j;
+                    const float bound = depth.at(x, y);
+                    const int place = int(5 * unit(rng));
+                    sample_depth[std::size_t(y) * kStride + std::size_t(x)] = place == 0   ? bound
+                                                                              : place == 1 ? std::nextafter(bound, 2.0f)
+                                                                              : place == 2 ? std::nextafter(bound, 0.0f)
+                                                                              : place == 3 ? float(2.0 * unit(rng))
+                                                                                           : 0.0f;
+                }
+            const std::uint32_t asked = trial % 4 == 0 ? ~0u : std::uint32_t(rng());
+            const detail::SubtileView view{nullptr, nullptr, nullptr, 0, sample_depth.data(), std::size_t(kStride), nullptr, nullptr, 0};
+            const std::uint32_t want = detail::sample_depth_unhidden_reference(view, tx, ty, asked, depth);
+            ASSERT_EQ(kernel(view, tx, ty, asked, depth), want) << isa << " trial " << trial;
+            ASSERT_EQ(want & ~asked, 0u);
+            shown_seen += __builtin_popcount(want);
+            hidden_seen += __builtin_popcount(asked & ~want);
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 1000);
+    EXPECT_GT(shown_seen, checked);  // both answers compared, many times
+    EXPECT_GT(hidden_seen, checked);
+}
+
 // Past its first 16 triangles an occludee is fetched and transformed 16 at a time: the
 // answers and counts must not depend on where the scan starts (it wraps at the end, batches
 // stop there), and a bad index or a non-finite vertex anywhere makes it visible.

@@ -11,8 +11,10 @@ namespace homcull::detail {
 
 struct BufferKernels {
     RasterKernels raster;
-    // The queries' SIMD kernels; null for the scalar choice (the scalar paths answer the same).
+    // The queries' SIMD kernels; null for the scalar choice (the scalar paths answer the same)
+    // unless said otherwise.
     OccludeeRowKernel occludee_row;  // occludee_depth.hpp
+    SampleDepthUnhiddenKernel sample_depth_unhidden;  // occludee_depth.hpp; the reference for the scalar choice
     RectBlockKernel rect_block;
     RectOneKernel rect_one;
     RectPreparedKernel rect_prepared;

@@ -71,4 +71,22 @@ using OccludeeRowKernel = void (*)(const SubtileView& view, int ty, const std::i
                                    int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden);
 // (A SIMD kernel: BufferKernels::occludee_row.)
 
+// Of the samples `unhidden` of subtile (tx, ty), those the per-sample depth (view.sample_depth,
+// which must be non-null) does not hide either: the triangle's bound at the sample itself
+// (depth.at) against the occluders' depth there. The reference, sample by sample.
+inline std::uint32_t sample_depth_unhidden_reference(const SubtileView& view, int tx, int ty, std::uint32_t unhidden,
+                                                     const OccludeeDepth& depth) {
+    constexpr int kW = OccludeeDepth::kW;
+    std::uint32_t left = 0;
+    for (std::uint32_t bits = unhidden; bits != 0; bits &= bits - 1) {
+        const int bit = __builtin_ctz(bits);
+        const int x = tx * kW + bit % kW, y = ty * OccludeeDepth::kH + bit / kW;
+        if (!(depth.at(x, y) < view.sample_depth[std::size_t(y) * view.sample_stride + std::size_t(x)])) left |= 1u << bit;
+    }
+    return left;
+}
+// The same with a sample per SIMD lane (BufferKernels::sample_depth_unhidden): the same bits.
+using SampleDepthUnhiddenKernel = std::uint32_t (*)(const SubtileView& view, int tx, int ty, std::uint32_t unhidden,
+                                                    const OccludeeDepth& depth);
+
 }  // namespace homcull::detail

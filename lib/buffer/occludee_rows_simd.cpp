@@ -103,6 +103,71 @@ void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], c
 #endif
 }
 
+// sample_depth_unhidden_reference with a sample per lane: a sample row's 8 samples at a time (in
+// two steps on 4-lane targets), each lane evaluating depth.at with occludee_depth.hpp's
+// operations in its order (the plane's bound in float, the raised vertices' in double rounded up
+// to float, as OccludeeRow takes them at its corners).
+std::uint32_t SampleDepthUnhidden(const SubtileView& view, int tx, int ty, std::uint32_t unhidden, const OccludeeDepth& depth) {
+#if HWY_TARGET == HWY_SCALAR
+    return sample_depth_unhidden_reference(view, tx, ty, unhidden, depth);
+#else
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    const hn::CappedTag<float, kW> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Half<decltype(df)> dfh;
+    const hn::Rebind<double, decltype(dfh)> dd;  // half the float lanes, for the raised bound
+    const hn::Half<decltype(di)> dih;
+    const int lanes = int(hn::Lanes(df));
+    using VF = hn::Vec<decltype(df)>;
+    using VD = hn::Vec<decltype(dd)>;
+
+    const PreparedTriangle& p = depth.plane;
+    const RaisedVertexPlane& r = depth.raised;
+    const VF half = hn::Set(df, 0.5f);
+    const auto lane = hn::Iota(di, 0);
+    std::uint32_t left = 0;
+    for (int j = 0; j < kH; ++j) {
+        if (((unhidden >> (j * kW)) & 0xFFu) == 0) continue;
+        const int row = ty * kH + j;
+        const float* occluders = view.sample_depth + std::size_t(row) * view.sample_stride + std::size_t(tx) * kW;
+        for (int c = 0; c < kW; c += lanes) {
+            const int shift = j * kW + c;
+            const std::uint32_t wanted = (unhidden >> shift) & ((1u << lanes) - 1u);
+            if (wanted == 0) continue;
+            const auto column = hn::Add(lane, hn::Set(di, tx * kW + c));
+            // OccludeeDepth::plane_bound.
+            VF bound = hn::Set(df, depth.z_vertex_max);
+            if (p.has_plane) {
+                const VF x = hn::Add(hn::ConvertTo(df, column), half), y = hn::Set(df, float(row) + 0.5f);
+                const VF on_plane = hn::Mul(hn::Add(hn::Add(hn::Add(hn::Set(df, p.a), hn::Mul(hn::Set(df, p.dzdy), y)), hn::Mul(hn::Set(df, p.dzdx), x)),
+                                                    hn::Set(df, depth.error)),
+                                            hn::Set(df, depth.plane_raise));
+                bound = hn::IfThenElse(hn::Lt(on_plane, bound), on_plane, bound);  // std::min(bound, on_plane)
+            }
+            const VF by_plane = hn::Mul(bound, hn::Set(df, depth.raise));
+            // OccludeeDepth::raised_bound.
+            VF by_vertices = hn::Set(df, HUGE_VALF);
+            if (r.usable) {
+                const VD row_term = hn::Mul(hn::Set(dd, r.dzdy), hn::Set(dd, (double(row) + 0.5) - r.y0));
+                const auto bound_of = [&](auto columns) {
+                    const VD cd = hn::PromoteTo(dd, columns);
+                    const VD at = hn::Add(hn::Add(hn::Add(hn::Set(dd, r.d0), hn::Mul(hn::Set(dd, r.dzdx), hn::Sub(hn::Add(cd, hn::Set(dd, 0.5)), hn::Set(dd, r.x0)))),
+                                                  row_term),
+                                          hn::Set(dd, r.outside));
+                    return FloatOutward<true>(dd, hn::Mul(at, hn::Set(dd, 1.0 + 0x1.0p-20)));
+                };
+                by_vertices = hn::Combine(df, bound_of(hn::UpperHalf(dih, column)), bound_of(hn::LowerHalf(dih, column)));
+            }
+            const VF at = hn::IfThenElse(hn::Lt(by_vertices, by_plane), by_vertices, by_plane);  // std::min(by_plane, by_vertices)
+            std::uint8_t shown[8] = {};
+            hn::StoreMaskBits(df, hn::Not(hn::Lt(at, hn::LoadU(df, occluders + c))), shown);
+            left |= (std::uint32_t(shown[0]) & wanted) << shift;
+        }
+    }
+    return left;
+#endif
+}
+
 }  // namespace homcull::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -112,9 +177,11 @@ HWY_AFTER_NAMESPACE();
 namespace homcull::detail {
 
 HWY_EXPORT(OccludeeRow);
+HWY_EXPORT(SampleDepthUnhidden);
 
 void resolve_occludee_row_kernels(const IsaChoice& choice, BufferKernels& k) {
     k.occludee_row = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, OccludeeRow);
+    k.sample_depth_unhidden = choice.scalar ? &sample_depth_unhidden_reference : HOMCULL_KERNEL_FOR(choice, SampleDepthUnhidden);
 }
 
 }  // namespace homcull::detail

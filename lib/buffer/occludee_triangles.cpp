@@ -149,18 +149,6 @@ PlaneError plane_error(const glm::dvec4 clip[3], const ClipError& e) {
     return {dn * std::sqrt(3.0) / (c - dc), dc / (c - dc)};
 }
 
-// Of the samples `unhidden` of subtile (tx, ty), those the per-sample depth does not hide
-// either: the triangle's bound at the sample itself against the occluders' there.
-std::uint32_t unhidden_by_sample_depth(const detail::SubtileView& view, int tx, int ty, std::uint32_t unhidden, const OccludeeDepth& depth) {
-    std::uint32_t left = 0;
-    for (std::uint32_t bits = unhidden; bits != 0; bits &= bits - 1) {
-        const int bit = __builtin_ctz(bits);
-        const int x = tx * kW + bit % kW, y = ty * kH + bit / kW;
-        if (!(depth.at(x, y) < view.sample_depth[std::size_t(y) * view.sample_stride + std::size_t(x)])) left |= 1u << bit;
-    }
-    return left;
-}
-
 struct SampleCounts {
     std::uint64_t samples = 0, visible = 0;
 };
@@ -205,6 +193,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
 
     bool raised_ready = false;
     const detail::OccludeeRowKernel row_kernel = kernels.occludee_row;
+    const detail::SampleDepthUnhiddenKernel sample_depth_unhidden = kernels.sample_depth_unhidden;
     constexpr int kRunSubtiles = 64;
     // Rows reaching fewer subtiles go subtile by subtile (castle C0's occludee tests: 3.04 ms
     // with lanes from 2 subtiles on, 3.08 from 1 or 3; the castle walk the same as without
@@ -233,7 +222,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
         // True once more than `tolerated` are visible: the triangle shows the occludee.
         const auto count_subtile = [&](int tx, std::uint32_t mask, std::uint32_t unhidden_samples) {
             counts.samples += detail::bit_count(mask);
-            if (view.sample_depth && unhidden_samples) unhidden_samples = unhidden_by_sample_depth(view, tx, ty, unhidden_samples, depth);
+            if (view.sample_depth && unhidden_samples) unhidden_samples = sample_depth_unhidden(view, tx, ty, unhidden_samples, depth);
             counts.visible += detail::bit_count(unhidden_samples);
             return counts.visible > tolerated;
         };
