@@ -267,15 +267,20 @@ HWY_INLINE void UpdateSampleDepth(const SubtilePlanes& planes, int ty, const std
         const float y = float(row) + 0.5f;
         const auto row_part = hn::Set(df, tri.a + tri.dzdy * y);
         float* depth = planes.sample_depth + std::size_t(row) * planes.sample_stride;
-        for (int x = first[j]; x <= last[j]; x += lanes) {
-            const auto xs = hn::Add(hn::ConvertTo(df, hn::Add(lane, hn::Set(di, x))), half);  // exact: |x| < 2^23
+        // The sample centres x + 0.5 of the lanes, stepped by whole vectors: every value is an
+        // integer plus a half below 2^23, exact in float, so the steps round nothing.
+        auto xs = hn::Add(hn::ConvertTo(df, hn::Add(lane, hn::Set(di, first[j]))), half);
+        const auto step = hn::Set(df, float(lanes));
+        const auto update = [&](int x, auto in_interval) {
             const auto lowered = hn::Sub(hn::Add(row_part, hn::Mul(dzdx, xs)), error);
             const auto bound = hn::Mul(hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered), lower);
             const auto old = hn::LoadU(df, depth + x);
-            const auto in_interval = hn::FirstN(df, std::size_t(last[j] - x + 1));
             // std::max(old, bound): bound where old < bound.
             hn::StoreU(hn::IfThenElse(hn::And(in_interval, hn::Lt(old, bound)), bound, old), df, depth + x);
-        }
+        };
+        int x = first[j];
+        for (; x + lanes - 1 <= last[j]; x += lanes, xs = hn::Add(xs, step)) update(x, hn::FirstN(df, std::size_t(lanes)));
+        if (x <= last[j]) update(x, hn::FirstN(df, std::size_t(last[j] - x + 1)));
     }
 }
 
