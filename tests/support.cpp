@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
@@ -171,7 +172,13 @@ bool same_subtiles(const OcclusionBuffer& a, const OcclusionBuffer& b) {
     std::vector<float> depth_a, depth_b;
     a.read_depth(depth_a);
     b.read_depth(depth_b);
-    return depth_a == depth_b;
+    if (depth_a != depth_b) return false;
+    // The per-sample depth itself, bit for bit: read_depth sees it only through a maximum with
+    // the layers and a reciprocal.
+    a.read_sample_depth(depth_a);
+    b.read_sample_depth(depth_b);
+    return depth_a.size() == depth_b.size() &&
+           std::memcmp(depth_a.data(), depth_b.data(), depth_a.size() * sizeof(float)) == 0;
 }
 
 bool same_pyramid(const OcclusionBuffer& a, const OcclusionBuffer& b) {
