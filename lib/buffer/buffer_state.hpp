@@ -71,7 +71,10 @@ public:
     Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
     void test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const;
     void test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& model_to_clip, Visibility* results) const;
-    TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0, std::size_t first_triangle = 0) const;
+    // OcclusionBuffer::test_triangles; with `solid` (seen_solid.hpp), the triangles that the
+    // eye certainly sees from behind are passed over like those outside the view.
+    TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0, std::size_t first_triangle = 0,
+                                const OcclusionBuffer::ClosedSolid* solid = nullptr) const;
     Subtile subtile(int tx, int ty) const;
     std::vector<Subtile> subtiles() const;
     void read_coverage(std::vector<std::uint8_t>& covered) const;

@@ -19,6 +19,7 @@
 #include "common/float_mode.hpp"
 #include "buffer/occludee_depth.hpp"
 #include "buffer/raised_vertex_plane.hpp"
+#include "buffer/seen_solid.hpp"
 #include "buffer/rect_queries.hpp"
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
@@ -268,7 +269,7 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
 }  // namespace
 
 OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const TriangleInput& given, std::uint64_t tolerated_samples,
-                                                              std::size_t first_triangle) const {
+                                                              std::size_t first_triangle, const OcclusionBuffer::ClosedSolid* solid) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     TriangleInput identity;
     const TriangleInput& in = detail::with_clip_space_matrix(given, identity);
@@ -313,6 +314,9 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
             if (beyond_side_plane_exactly(model, clip, rows[0], rows[1], rows[3])) return false;
             error = clip_error(in.model_to_clip, model);
         }
+        // A closed solid's triangles seen from behind (seen_solid.hpp): its first surface along
+        // any ray is a triangle seen from the front.
+        if (solid && detail::certainly_faces_away(glm::dvec3(model[0]), glm::dvec3(model[1]), glm::dvec3(model[2]), *solid)) return false;
         // Ground truth sees surfaces from the near plane on: the part before it is clipped
         // away, at a plane moved towards the eye by the rounding bound of w.
         const double near_clip = near_w * (1.0 - 0x1.0p-20) - error.w;

@@ -48,6 +48,10 @@ OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInpu
                                                               std::size_t first_triangle) const {
     return state_->test_triangles(occludee, tolerated_samples, first_triangle);
 }
+OcclusionBuffer::TriangleTest OcclusionBuffer::test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples,
+                                                              std::size_t first_triangle, const ClosedSolid& solid) const {
+    return state_->test_triangles(occludee, tolerated_samples, first_triangle, &solid);
+}
 
 const BufferConfig& OcclusionBuffer::config() const { return state_->config(); }
 int OcclusionBuffer::sample_width() const { return state_->sample_width(); }

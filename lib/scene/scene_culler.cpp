@@ -6,6 +6,7 @@
 #include "scene/scene_culler_state.hpp"
 
 #include "common/float_mode.hpp"
+#include "scene/closed_occludees.hpp"
 #include "scene/scene_culler_frame.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -153,6 +154,7 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
         occludee_first_vertex_[id] = occludee_positions_.size() / 3;
         append_world_positions(scene, object, occludee_positions_, anchor_);
     }
+    occludee_orientation_ = closed_occludee_orientations(scene, occludee_positions_, occludee_first_vertex_, kNotGathered);
 }
 
 void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {

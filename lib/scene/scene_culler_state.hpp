@@ -125,7 +125,7 @@ public:
     OccludeeAnswer box_answer(const Frame& frame, const Aabb& box) const;
     // What object tests count, per task when they run in parallel (then added to work_ and exits_).
     struct TestTally {
-        std::size_t nodes = 0, objects = 0, parts = 0;
+        std::size_t nodes = 0, objects = 0, parts = 0, solid_parts = 0;
         std::uint64_t exits[7] = {};
     };
     void add_tally(const TestTally& tally);
@@ -154,7 +154,11 @@ public:
     OccludeeParts parts_;  // config_.occludee_parts
     std::vector<std::uint8_t> first_visible_part_;  // per object, the part found visible last time: tested first
     bool parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles, TestTally& tally);
-    bool part_triangles_hidden(std::uint32_t id, std::uint32_t part, const std::array<float, 16>& clip_from_world);
+    bool part_triangles_hidden(const Frame& frame, std::uint32_t id, std::uint32_t part, TestTally& tally);
+    // Per object gathered for the samples test: +1 or -1 when closed (closed_occludees.hpp),
+    // else 0; its part tests then leave out the triangles seen from behind.
+    std::vector<std::int8_t> occludee_orientation_;
+    bool beyond_near_plane(const Frame& frame, const Aabb& box) const;
     bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
 };
 

@@ -97,6 +97,7 @@ void detail::SceneCullerState::add_tally(const TestTally& tally) {
     work_.nodes_tested += tally.nodes;
     work_.objects_tested += tally.objects;
     work_.occludee_parts_tested += tally.parts;
+    work_.solid_parts_tested += tally.solid_parts;
     for (int e = 0; e < 7; ++e) exits_.count[e] += tally.exits[e];
 }
 
@@ -270,7 +271,7 @@ bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id
         const std::uint32_t p = (start + k) % count;
         ++tally.parts;
         if (box_answer(frame, parts_.box(first + p)).visibility != Visibility::visible) continue;
-        if (test_triangles && part_triangles_hidden(id, first + p, frame.clip)) continue;
+        if (test_triangles && part_triangles_hidden(frame, id, first + p, tally)) continue;
         first_visible_part_[id] = std::uint8_t(p);
         return false;
     }
@@ -278,8 +279,10 @@ bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id
 }
 
 // The triangles of one part of an object, sample by sample; the triangle that found the object
-// visible last time goes first when it is in this part.
-bool detail::SceneCullerState::part_triangles_hidden(std::uint32_t id, std::uint32_t part, const std::array<float, 16>& clip_from_world) {
+// visible last time goes first when it is in this part. A closed occludee wholly beyond the near
+// plane is a solid seen from outside (closed_occludees.hpp): the test passes over the triangles
+// the eye certainly sees from behind.
+bool detail::SceneCullerState::part_triangles_hidden(const Frame& frame, std::uint32_t id, std::uint32_t part, TestTally& tally) {
     const Mesh& mesh = scene_->meshes[scene_->objects[id].mesh];
     const std::uint32_t begin = parts_.first_triangle(part), count = parts_.triangle_count(part);
     TriangleInput in;
@@ -287,14 +290,34 @@ bool detail::SceneCullerState::part_triangles_hidden(std::uint32_t id, std::uint
     in.vertex_count = mesh.positions.size();
     in.indices = parts_.indices(scene_->objects[id].mesh) + 3 * std::size_t(begin);
     in.triangle_count = count;
-    in.model_to_clip = clip_from_world;
+    in.model_to_clip = frame.clip;
     in.backface = Backface::none;
     const std::uint32_t last = first_visible_triangle_[id];
     const std::uint32_t start = last >= begin && last < begin + count ? last - begin : 0;
-    const OcclusionBuffer::TriangleTest r = buffer_.test_triangles(in, 0, start);
+    OcclusionBuffer::TriangleTest r;
+    if (occludee_orientation_[id] != 0 && beyond_near_plane(frame, object_boxes_[id])) {
+        ++tally.solid_parts;
+        const glm::vec3 eye(frame.camera->eye - anchor_);  // ground truth's: relative to the anchor, rounded to float
+        r = buffer_.test_triangles(in, 0, start, OcclusionBuffer::ClosedSolid{{eye.x, eye.y, eye.z}, occludee_orientation_[id]});
+    } else {
+        r = buffer_.test_triangles(in, 0, start);
+    }
     if (r.visibility != Visibility::visible) return true;
     first_visible_triangle_[id] = begin + std::uint32_t(r.deciding_triangle);
     return false;
+}
+
+// Whether a box (anchored world) lies wholly beyond the near plane, with room for the float
+// matrix and the rounding of ground truth's rays: every corner's w above near (1 + 2^-10).
+bool detail::SceneCullerState::beyond_near_plane(const Frame& frame, const Aabb& box) const {
+    const glm::dmat4& m = frame.clip_double;
+    const double near = double(buffer_.config().near_w) * (1.0 + 0x1.0p-10);
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec3 p = glm::dvec3((k & 1) ? box.max.x : box.min.x, (k & 2) ? box.max.y : box.min.y, (k & 4) ? box.max.z : box.min.z) + anchor_;
+        const double w = m[0][3] * p.x + m[1][3] * p.y + m[2][3] * p.z + m[3][3];
+        if (!(w > near)) return false;
+    }
+    return true;
 }
 
 // The object's triangles sample by sample (OcclusionBuffer::test_triangles), tolerating the

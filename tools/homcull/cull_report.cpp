@@ -31,7 +31,7 @@ nlohmann::json work_json(const SceneCullWork& w) {
     return {{"occluder_objects", w.occluder_objects}, {"occluder_triangles", w.occluder_triangles},
             {"occluder_lods", w.occluder_lods},       {"renders", w.renders},
             {"nodes_tested", w.nodes_tested},         {"objects_tested", w.objects_tested},
-            {"occludee_parts_tested", w.occludee_parts_tested},
+            {"occludee_parts_tested", w.occludee_parts_tested}, {"solid_parts_tested", w.solid_parts_tested},
             {"back_faces_skipped", w.back_faces_skipped}};
 }
 

@@ -277,6 +277,21 @@ public:
     // same from any start, but starting at last frame's deciding triangle finds a visible
     // occludee's visible triangle at once (frame-to-frame coherence).
     TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0, std::size_t first_triangle = 0) const;
+    // An occludee that is a closed solid seen from outside: every edge of its triangles shared
+    // with another of them in opposite order, each connected piece enclosing a volume with the
+    // triangles' counter-clockwise fronts facing out of it (orientation +1) or into it (-1), and
+    // the whole occludee beyond the near plane, so that no ray starts inside it. Along any ray
+    // its first surface is then a triangle seen from the front, and the test passes over the
+    // triangles that `eye` (in the input's model space, as the rays start from it) certainly sees
+    // from behind: about half of them. The caller vouches for the conditions: an occludee that
+    // meets them only in part may be found hidden where a back face shows. (The scene culler
+    // finds its closed occludees at load time and checks the near plane per frame.)
+    struct ClosedSolid {
+        double eye[3];
+        int orientation;  // +1 or -1
+    };
+    TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples, std::size_t first_triangle,
+                                const ClosedSolid& solid) const;
 
     const BufferConfig& config() const;
     int sample_width() const;

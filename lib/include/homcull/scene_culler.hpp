@@ -133,6 +133,9 @@ struct SceneCullWork {
     std::size_t nodes_tested = 0;        // inner hierarchy nodes tested
     std::size_t objects_tested = 0;      // objects tested on their own (the rest answered by a node)
     std::size_t occludee_parts_tested = 0;  // part boxes tested (SceneCullerConfig::occludee_parts)
+    // Of the parts whose triangles were tested, those of closed occludees seen from outside
+    // (wholly beyond the near plane), tested without the triangles the eye sees from behind.
+    std::size_t solid_parts_tested = 0;
 };
 
 // How many objects each overlap-test exit decided (indexed by OverlapExit).

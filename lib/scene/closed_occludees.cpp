@@ -1,0 +1,115 @@
+// closed_occludee_orientations (closed_occludees.hpp): each mesh's topology once, in model space
+// (which edges are shared, which triangles form a connected piece), then each object's pieces'
+// volumes from its world positions, as ground truth has them.
+#include "scene/closed_occludees.hpp"
+
+#include <homcull/triangle_input.hpp>
+
+#include <cstring>
+#include <numeric>
+#include <optional>
+#include <unordered_map>
+
+namespace homcull::detail {
+namespace {
+
+// A mesh's closed pieces: whether every edge is shared in opposite order, and the piece of each
+// triangle (connected through shared positions).
+struct MeshPieces {
+    bool closed = false;
+    std::vector<std::uint32_t> piece;  // per triangle, in [0, count)
+    std::uint32_t count = 0;
+};
+
+std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];  // path halving
+    return v;
+}
+
+MeshPieces mesh_pieces(const Mesh& mesh) {
+    MeshPieces m;
+    const std::size_t triangles = mesh.triangle_count();
+    if (triangles == 0 || mesh.positions.empty()) return m;
+    std::vector<std::uint8_t> shared(triangles);
+    std::vector<std::uint32_t> apexes(3 * triangles);
+    compute_shared_edges(&mesh.positions[0].x, sizeof(glm::vec3), mesh.positions.size(), mesh.indices.data(), triangles, shared.data(),
+                         apexes.data());
+    for (const std::uint8_t s : shared)
+        if (s != 7) return m;
+    // The same position under several vertex numbers (split normals or texture seams) is one
+    // point of the surface, as compute_shared_edges matches edges by position.
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> by_hash;
+    std::vector<std::uint32_t> parent(mesh.positions.size());
+    std::iota(parent.begin(), parent.end(), 0u);
+    for (std::uint32_t v = 0; v < mesh.positions.size(); ++v) {
+        std::uint32_t bits[3];
+        std::memcpy(bits, &mesh.positions[v].x, sizeof bits);
+        const std::uint64_t hash = (std::uint64_t(bits[0]) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(bits[1]) * 0xC2B2AE3D27D4EB4Full) ^ bits[2];
+        auto& same = by_hash[hash];
+        for (const std::uint32_t u : same)
+            if (std::memcmp(&mesh.positions[u].x, &mesh.positions[v].x, sizeof bits) == 0) {
+                parent[find_root(parent, v)] = find_root(parent, u);
+                break;
+            }
+        same.push_back(v);
+    }
+    for (std::size_t t = 0; t < triangles; ++t) {
+        const std::uint32_t a = find_root(parent, mesh.indices[3 * t]);
+        parent[find_root(parent, mesh.indices[3 * t + 1])] = a;
+        parent[find_root(parent, mesh.indices[3 * t + 2])] = a;
+    }
+    std::unordered_map<std::uint32_t, std::uint32_t> number;
+    m.piece.resize(triangles);
+    for (std::size_t t = 0; t < triangles; ++t) {
+        const auto [it, added] = number.emplace(find_root(parent, mesh.indices[3 * t]), m.count);
+        if (added) ++m.count;
+        m.piece[t] = it->second;
+    }
+    m.closed = true;
+    return m;
+}
+
+// +1, -1 or 0 for one object: the signed volume of each piece (the divergence theorem, each
+// triangle's tetrahedron with a point of the piece) against the sum of the tetrahedra's absolute
+// volumes: a sign counts when the volume is above 2^-20 of that sum (a flat or two-sided piece
+// gives about 0).
+std::int8_t object_orientation(const Mesh& mesh, const MeshPieces& pieces, const float* world) {
+    std::vector<double> volume(pieces.count, 0.0), magnitude(pieces.count, 0.0);
+    std::vector<glm::dvec3> origin(pieces.count);
+    std::vector<std::uint8_t> has_origin(pieces.count, 0);
+    const auto point = [&](std::uint32_t v) { return glm::dvec3(world[3 * std::size_t(v)], world[3 * std::size_t(v) + 1], world[3 * std::size_t(v) + 2]); };
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const std::uint32_t p = pieces.piece[t];
+        const glm::dvec3 a = point(mesh.indices[3 * t]), b = point(mesh.indices[3 * t + 1]), c = point(mesh.indices[3 * t + 2]);
+        if (!has_origin[p]) origin[p] = a, has_origin[p] = 1;
+        const double v = glm::dot(a - origin[p], glm::cross(b - origin[p], c - origin[p]));
+        volume[p] += v;
+        magnitude[p] += std::abs(v);
+    }
+    int sign = 0;
+    for (std::uint32_t p = 0; p < pieces.count; ++p) {
+        const int s = volume[p] > 0x1.0p-20 * magnitude[p] ? 1 : volume[p] < -0x1.0p-20 * magnitude[p] ? -1 : 0;
+        if (s == 0 || (sign != 0 && s != sign)) return 0;
+        sign = s;
+    }
+    return std::int8_t(sign);
+}
+
+}  // namespace
+
+std::vector<std::int8_t> closed_occludee_orientations(const Scene& scene, const std::vector<float>& world_positions,
+                                                      const std::vector<std::size_t>& first_vertex, std::size_t not_gathered) {
+    std::vector<std::int8_t> orientation(scene.objects.size(), 0);
+    std::vector<std::optional<MeshPieces>> meshes(scene.meshes.size());
+    for (std::size_t id = 0; id < scene.objects.size() && id < first_vertex.size(); ++id) {
+        if (first_vertex[id] == not_gathered) continue;
+        const std::size_t mesh_id = scene.objects[id].mesh;
+        const Mesh& mesh = scene.meshes[mesh_id];
+        if (!meshes[mesh_id]) meshes[mesh_id] = mesh_pieces(mesh);
+        if (!meshes[mesh_id]->closed) continue;
+        orientation[id] = object_orientation(mesh, *meshes[mesh_id], world_positions.data() + 3 * first_vertex[id]);
+    }
+    return orientation;
+}
+
+}  // namespace homcull::detail
