@@ -18,6 +18,7 @@
 #include <hwy/highway.h>
 
 #include "buffer/rect_queries.hpp"
+#include "common/accurate_sum-inl.h"
 
 #include <algorithm>
 #include <cmath>
@@ -32,8 +33,8 @@ bool BoxRectangle(const float box_min[3], const float box_max[3], const std::arr
     return box_rectangle(box_min, box_max, m, near_w, false, rect, decided);
 #else
     // box_edges' base corner, edge vectors and error bound, the four clip rows in lanes (two
-    // steps on 2-lane targets): each lane repeats transform_to_clip's products and
-    // accurate_sum4's error-free sums, the edge products and the magnitudes in box_edges' order.
+    // steps on 2-lane targets): each lane repeats transform_to_clip's products and accurate_sum4
+    // (AccurateSum4), the edge products and the magnitudes in box_edges' order.
     // The error's maximum over the rows may take them in another order: it only matters for
     // NaN, and then a corner is not finite and the scalar function decides.
     HWY_ALIGN double base[4], edge[3][4], magnitude[4];
@@ -42,22 +43,12 @@ bool BoxRectangle(const float box_min[3], const float box_max[3], const std::arr
         const hn::Rebind<float, decltype(dr)> fr;
         const double lengths[3] = {double(box_max[0]) - double(box_min[0]), double(box_max[1]) - double(box_min[1]),
                                    double(box_max[2]) - double(box_min[2])};
-        const auto two_sum_error = [&](auto a, auto b, auto sum) {
-            const auto b_virtual = hn::Sub(sum, a);
-            return hn::Add(hn::Sub(a, hn::Sub(sum, b_virtual)), hn::Sub(b, b_virtual));
-        };
         for (std::size_t row = 0; row < 4; row += hn::Lanes(dr)) {
             const auto column = [&](int c) { return hn::PromoteTo(dr, hn::LoadU(fr, m.data() + 4 * c + row)); };
             const auto m0 = column(0), m1 = column(1), m2 = column(2), m3 = column(3);
             const auto p0 = hn::Mul(m0, hn::Set(dr, double(box_min[0]))), p1 = hn::Mul(m1, hn::Set(dr, double(box_min[1])));
             const auto p2 = hn::Mul(m2, hn::Set(dr, double(box_min[2]))), p3 = hn::Mul(m3, hn::Set(dr, 1.0));
-            const auto s1 = hn::Add(p0, p1);
-            auto sum_error = two_sum_error(p0, p1, s1);
-            const auto s2 = hn::Add(s1, p2);
-            sum_error = hn::Add(sum_error, two_sum_error(s1, p2, s2));
-            const auto s3 = hn::Add(s2, p3);
-            sum_error = hn::Add(sum_error, two_sum_error(s2, p3, s3));
-            const auto b = hn::Add(s3, sum_error);
+            const auto b = AccurateSum4(p0, p1, p2, p3);
             const auto zero = hn::Zero(dr);
             const auto e0 = hn::Add(hn::Mul(m0, hn::Set(dr, lengths[0])), zero), e1 = hn::Add(hn::Mul(m1, hn::Set(dr, lengths[1])), zero);
             const auto e2 = hn::Add(hn::Mul(m2, hn::Set(dr, lengths[2])), zero);

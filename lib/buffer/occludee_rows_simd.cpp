@@ -18,6 +18,49 @@ HWY_BEFORE_NAMESPACE();
 namespace homcull::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+#if HWY_TARGET != HWY_SCALAR
+// OccludeeDepth's bound, lane by lane: the plane's (plane_bound) at samples (plane_column,
+// plane_row) in float, and the raised vertices' (raised_bound) at (vertex_column, vertex_row) in
+// double, rounded up to float; the smaller, as OccludeeDepth::over and ::at take it (each at its
+// own corner of the covered samples, or both at one sample). The same operations in the same
+// order as the scalar functions.
+template <class DF>
+HWY_INLINE hn::Vec<DF> OccludeeBound(DF df, const OccludeeDepth& depth, hn::Vec<hn::RebindToSigned<DF>> plane_column,
+                                     hn::Vec<hn::RebindToSigned<DF>> plane_row, hn::Vec<hn::RebindToSigned<DF>> vertex_column,
+                                     hn::Vec<hn::RebindToSigned<DF>> vertex_row) {
+    using VF = hn::Vec<DF>;
+    const hn::Half<DF> dfh;
+    const hn::Rebind<double, decltype(dfh)> dd;  // half the float lanes, for the raised bound
+    const hn::Half<hn::RebindToSigned<DF>> dih;
+    using VD = hn::Vec<decltype(dd)>;
+    const PreparedTriangle& p = depth.plane;
+    const RaisedVertexPlane& r = depth.raised;
+    VF bound = hn::Set(df, depth.z_vertex_max);
+    if (p.has_plane) {
+        const VF half = hn::Set(df, 0.5f);
+        const VF x = hn::Add(hn::ConvertTo(df, plane_column), half), y = hn::Add(hn::ConvertTo(df, plane_row), half);
+        const VF on_plane = hn::Mul(hn::Add(hn::Add(hn::Add(hn::Set(df, p.a), hn::Mul(hn::Set(df, p.dzdy), y)), hn::Mul(hn::Set(df, p.dzdx), x)),
+                                            hn::Set(df, depth.error)),
+                                    hn::Set(df, depth.plane_raise));
+        bound = hn::IfThenElse(hn::Lt(on_plane, bound), on_plane, bound);  // std::min(bound, on_plane)
+    }
+    const VF by_plane = hn::Mul(bound, hn::Set(df, depth.raise));
+    VF by_vertices = hn::Set(df, HUGE_VALF);
+    if (r.usable) {
+        const auto bound_of = [&](auto c, auto rr) {
+            const VD cd = hn::PromoteTo(dd, c), rd = hn::PromoteTo(dd, rr), h = hn::Set(dd, 0.5);
+            const VD at = hn::Add(hn::Add(hn::Add(hn::Set(dd, r.d0), hn::Mul(hn::Set(dd, r.dzdx), hn::Sub(hn::Add(cd, h), hn::Set(dd, r.x0)))),
+                                          hn::Mul(hn::Set(dd, r.dzdy), hn::Sub(hn::Add(rd, h), hn::Set(dd, r.y0)))),
+                                  hn::Set(dd, r.outside));
+            return FloatOutward<true>(dd, hn::Mul(at, hn::Set(dd, 1.0 + 0x1.0p-20)));
+        };
+        by_vertices = hn::Combine(df, bound_of(hn::UpperHalf(dih, vertex_column), hn::UpperHalf(dih, vertex_row)),
+                                  bound_of(hn::LowerHalf(dih, vertex_column), hn::LowerHalf(dih, vertex_row)));
+    }
+    return hn::IfThenElse(hn::Lt(by_vertices, by_plane), by_vertices, by_plane);  // std::min(by_plane, by_vertices)
+}
+#endif
+
 void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin, int count,
                  const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden) {
 #if HWY_TARGET == HWY_SCALAR
@@ -28,20 +71,15 @@ void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], c
     const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many
     const hn::RebindToSigned<decltype(df)> di;
     const hn::RebindToUnsigned<decltype(df)> du;
-    const hn::Half<decltype(df)> dfh;
-    const hn::Rebind<double, decltype(dfh)> dd;  // half the float lanes, for the raised bound
-    const hn::Half<decltype(di)> dih;
     const int lanes = int(hn::Lanes(df));
     using VI = hn::Vec<decltype(di)>;
     using VF = hn::Vec<decltype(df)>;
-    using VD = hn::Vec<decltype(dd)>;
 
     const PreparedTriangle& p = depth.plane;
     const bool far_is_left = p.has_plane && p.far_is_left, far_is_top = p.has_plane && p.far_is_top;
     const RaisedVertexPlane& r = depth.raised;
     const VI lane = hn::Iota(di, 0), zero = hn::Zero(di), seven = hn::Set(di, kW - 1);
     const hn::Vec<decltype(du)> byte = hn::Set(du, 0xFFu);
-    const VF half = hn::Set(df, 0.5f);
     const std::size_t row = std::size_t(ty) * view.stride;
     for (int base = 0; base < count; base += lanes) {
         const auto live = hn::FirstN(di, std::size_t(count - base));
@@ -62,33 +100,10 @@ void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], c
             row_lo = hn::IfThenElse(hn::And(filled, hn::Eq(row_lo, hn::Set(di, kH))), hn::Set(di, j), row_lo);
             row_hi = hn::IfThenElse(filled, hn::Set(di, j), row_hi);
         }
+        // OccludeeDepth::over: the plane's bound at its corner, the raised vertices' at theirs.
         const VI y0 = hn::Set(di, ty * kH);
-        // OccludeeDepth::over: the plane's bound at its corner, in float.
-        const VI plane_column = hn::Add(x0, far_is_left ? column_hi : column_lo), plane_row = hn::Add(y0, far_is_top ? row_hi : row_lo);
-        VF bound = hn::Set(df, depth.z_vertex_max);
-        if (p.has_plane) {
-            const VF x = hn::Add(hn::ConvertTo(df, plane_column), half), y = hn::Add(hn::ConvertTo(df, plane_row), half);
-            const VF on_plane = hn::Mul(hn::Add(hn::Add(hn::Add(hn::Set(df, p.a), hn::Mul(hn::Set(df, p.dzdy), y)), hn::Mul(hn::Set(df, p.dzdx), x)),
-                                                hn::Set(df, depth.error)),
-                                        hn::Set(df, depth.plane_raise));
-            bound = hn::IfThenElse(hn::Lt(on_plane, bound), on_plane, bound);  // std::min(bound, on_plane)
-        }
-        const VF by_plane = hn::Mul(bound, hn::Set(df, depth.raise));
-        // ... and the raised vertices' bound at theirs, in double, rounded up to float.
-        VF by_vertices = hn::Set(df, HUGE_VALF);
-        if (r.usable) {
-            const VI column = hn::Add(x0, r.dzdx > 0.0 ? column_hi : column_lo), row_of = hn::Add(y0, r.dzdy > 0.0 ? row_hi : row_lo);
-            const auto bound_of = [&](auto c, auto rr) {
-                const VD cd = hn::PromoteTo(dd, c), rd = hn::PromoteTo(dd, rr), h = hn::Set(dd, 0.5);
-                const VD at = hn::Add(hn::Add(hn::Add(hn::Set(dd, r.d0), hn::Mul(hn::Set(dd, r.dzdx), hn::Sub(hn::Add(cd, h), hn::Set(dd, r.x0)))),
-                                              hn::Mul(hn::Set(dd, r.dzdy), hn::Sub(hn::Add(rd, h), hn::Set(dd, r.y0)))),
-                                      hn::Set(dd, r.outside));
-                return FloatOutward<true>(dd, hn::Mul(at, hn::Set(dd, 1.0 + 0x1.0p-20)));
-            };
-            by_vertices = hn::Combine(df, bound_of(hn::UpperHalf(dih, column), hn::UpperHalf(dih, row_of)),
-                                      bound_of(hn::LowerHalf(dih, column), hn::LowerHalf(dih, row_of)));
-        }
-        const VF d_near = hn::IfThenElse(hn::Lt(by_vertices, by_plane), by_vertices, by_plane);  // std::min(by_plane, by_vertices)
+        const VF d_near = OccludeeBound(df, depth, hn::Add(x0, far_is_left ? column_hi : column_lo), hn::Add(y0, far_is_top ? row_hi : row_lo),
+                                        hn::Add(x0, r.dzdx > 0.0 ? column_hi : column_lo), hn::Add(y0, r.dzdy > 0.0 ? row_hi : row_lo));
         // subtile_unhidden_samples, lane by lane.
         const std::size_t at = row + std::size_t(tx_begin + base);
         const VF d0 = hn::LoadU(df, view.d0 + at), d1 = hn::LoadU(df, view.d1 + at);
@@ -114,16 +129,7 @@ std::uint32_t SampleDepthUnhidden(const SubtileView& view, int tx, int ty, std::
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     const hn::CappedTag<float, kW> df;
     const hn::RebindToSigned<decltype(df)> di;
-    const hn::Half<decltype(df)> dfh;
-    const hn::Rebind<double, decltype(dfh)> dd;  // half the float lanes, for the raised bound
-    const hn::Half<decltype(di)> dih;
     const int lanes = int(hn::Lanes(df));
-    using VF = hn::Vec<decltype(df)>;
-    using VD = hn::Vec<decltype(dd)>;
-
-    const PreparedTriangle& p = depth.plane;
-    const RaisedVertexPlane& r = depth.raised;
-    const VF half = hn::Set(df, 0.5f);
     const auto lane = hn::Iota(di, 0);
     std::uint32_t left = 0;
     for (int j = 0; j < kH; ++j) {
@@ -135,30 +141,9 @@ std::uint32_t SampleDepthUnhidden(const SubtileView& view, int tx, int ty, std::
             const std::uint32_t wanted = (unhidden >> shift) & ((1u << lanes) - 1u);
             if (wanted == 0) continue;
             const auto column = hn::Add(lane, hn::Set(di, tx * kW + c));
-            // OccludeeDepth::plane_bound.
-            VF bound = hn::Set(df, depth.z_vertex_max);
-            if (p.has_plane) {
-                const VF x = hn::Add(hn::ConvertTo(df, column), half), y = hn::Set(df, float(row) + 0.5f);
-                const VF on_plane = hn::Mul(hn::Add(hn::Add(hn::Add(hn::Set(df, p.a), hn::Mul(hn::Set(df, p.dzdy), y)), hn::Mul(hn::Set(df, p.dzdx), x)),
-                                                    hn::Set(df, depth.error)),
-                                            hn::Set(df, depth.plane_raise));
-                bound = hn::IfThenElse(hn::Lt(on_plane, bound), on_plane, bound);  // std::min(bound, on_plane)
-            }
-            const VF by_plane = hn::Mul(bound, hn::Set(df, depth.raise));
-            // OccludeeDepth::raised_bound.
-            VF by_vertices = hn::Set(df, HUGE_VALF);
-            if (r.usable) {
-                const VD row_term = hn::Mul(hn::Set(dd, r.dzdy), hn::Set(dd, (double(row) + 0.5) - r.y0));
-                const auto bound_of = [&](auto columns) {
-                    const VD cd = hn::PromoteTo(dd, columns);
-                    const VD at = hn::Add(hn::Add(hn::Add(hn::Set(dd, r.d0), hn::Mul(hn::Set(dd, r.dzdx), hn::Sub(hn::Add(cd, hn::Set(dd, 0.5)), hn::Set(dd, r.x0)))),
-                                                  row_term),
-                                          hn::Set(dd, r.outside));
-                    return FloatOutward<true>(dd, hn::Mul(at, hn::Set(dd, 1.0 + 0x1.0p-20)));
-                };
-                by_vertices = hn::Combine(df, bound_of(hn::UpperHalf(dih, column)), bound_of(hn::LowerHalf(dih, column)));
-            }
-            const VF at = hn::IfThenElse(hn::Lt(by_vertices, by_plane), by_vertices, by_plane);  // std::min(by_plane, by_vertices)
+            // OccludeeDepth::at: both bounds at the sample itself.
+            const auto row_of = hn::Set(di, row);
+            const auto at = OccludeeBound(df, depth, column, row_of, column, row_of);
             std::uint8_t shown[8] = {};
             hn::StoreMaskBits(df, hn::Not(hn::Lt(at, hn::LoadU(df, occluders + c))), shown);
             left |= (std::uint32_t(shown[0]) & wanted) << shift;

@@ -10,6 +10,7 @@
 #include <hwy/highway.h>
 
 #include "raster/clip_fates-inl.h"
+#include "common/accurate_sum-inl.h"
 #include "common/float_outward-inl.h"
 #include "common/lane_bits-inl.h"
 #include "raster/triangle_batch.hpp"
@@ -26,12 +27,6 @@ using D = hn::CappedTag<double, 8>;  // at most 8 lanes: one byte of mask bits p
 using V = hn::Vec<D>;
 using M = hn::Mask<D>;
 
-// two_sum_error and accurate_sum4 (triangle_setup.hpp) lane by lane: the same operations.
-HWY_INLINE V TwoSumError(V a, V b, V s) {
-    const V b_virtual = hn::Sub(s, a);
-    return hn::Add(hn::Sub(a, hn::Sub(s, b_virtual)), hn::Sub(b, b_virtual));
-}
-
 // transform_to_clip's row r: accurate_sum4(m[r] x, m[4 + r] y, m[8 + r] z, m[12 + r] w); with
 // kPlain, transform_to_clip_plain's ((m[r] x + m[4 + r] y) + m[8 + r] z) + m[12 + r] w.
 template <bool kPlain = false>
@@ -39,13 +34,7 @@ HWY_INLINE V ClipRow(D d, const std::array<float, 16>& m, int r, V x, V y, V z, 
     const V p0 = hn::Mul(hn::Set(d, double(m[r])), x), p1 = hn::Mul(hn::Set(d, double(m[4 + r])), y);
     const V p2 = hn::Mul(hn::Set(d, double(m[8 + r])), z), p3 = hn::Mul(hn::Set(d, double(m[12 + r])), w);
     if (kPlain) return hn::Add(hn::Add(hn::Add(p0, p1), p2), p3);
-    const V s1 = hn::Add(p0, p1);
-    V error = TwoSumError(p0, p1, s1);
-    const V s2 = hn::Add(s1, p2);
-    error = hn::Add(error, TwoSumError(s1, p2, s2));
-    const V s3 = hn::Add(s2, p3);
-    error = hn::Add(error, TwoSumError(s2, p3, s3));
-    return hn::Add(s3, error);
+    return AccurateSum4(p0, p1, p2, p3);
 }
 
 // orthographic_representative (triangle_setup.hpp) lane by lane, in its order of operations.
