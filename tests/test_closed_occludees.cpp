@@ -66,6 +66,14 @@ TEST(ClosedOccludees, OrientationsOfClosedOpenFlatMirroredAndSplitMeshes) {
     for (std::size_t t = 0; t < other.indices.size(); t += 3)
         mixed.indices.insert(mixed.indices.end(), {other.indices[t] + 6, other.indices[t + 2] + 6, other.indices[t + 1] + 6});
     const std::uint32_t two_signs = test::add_object_with_own_mesh(scene, mixed);
+    // A small inside-out piece touching an outward one at a vertex only: two pieces, two signs
+    // (joined through the vertex, their volumes would sum to a positive one).
+    Mesh touching = octahedron({40, 0, 0}, 1);
+    const Mesh small = octahedron({41.5f, 0, 0}, 0.5f);  // its vertex (41, 0, 0) is the other's
+    for (const glm::vec3& p : small.positions) touching.positions.push_back(p);
+    for (std::size_t t = 0; t < small.indices.size(); t += 3)
+        touching.indices.insert(touching.indices.end(), {small.indices[t] + 6, small.indices[t + 2] + 6, small.indices[t + 1] + 6});
+    const std::uint32_t at_a_vertex = test::add_object_with_own_mesh(scene, touching);
     // Each face with its own four vertices (split normals): closed by position.
     Mesh split;
     const Mesh whole = octahedron({35, 0, 0}, 2);
@@ -88,6 +96,7 @@ TEST(ClosedOccludees, OrientationsOfClosedOpenFlatMirroredAndSplitMeshes) {
     EXPECT_EQ(o[open_id], 0);
     EXPECT_EQ(o[flat], 0);
     EXPECT_EQ(o[two_signs], 0);
+    EXPECT_EQ(o[at_a_vertex], 0);
     EXPECT_EQ(o[seams], 1);
     EXPECT_EQ(o[mirror], -1);
 }

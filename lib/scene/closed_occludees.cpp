@@ -5,6 +5,7 @@
 
 #include <homcull/triangle_input.hpp>
 
+#include <algorithm>
 #include <cstring>
 #include <numeric>
 #include <optional>
@@ -14,7 +15,8 @@ namespace homcull::detail {
 namespace {
 
 // A mesh's closed pieces: whether every edge is shared in opposite order, and the piece of each
-// triangle (connected through shared positions).
+// triangle (connected to the others of its piece through shared edges: two closed surfaces that
+// only touch at a vertex are two pieces, each with its own sign).
 struct MeshPieces {
     bool closed = false;
     std::vector<std::uint32_t> piece;  // per triangle, in [0, count)
@@ -36,32 +38,39 @@ MeshPieces mesh_pieces(const Mesh& mesh) {
                          apexes.data());
     for (const std::uint8_t s : shared)
         if (s != 7) return m;
-    // The same position under several vertex numbers (split normals or texture seams) is one
-    // point of the surface, as compute_shared_edges matches edges by position.
+    // One number per position (split normals or texture seams give a position several vertex
+    // numbers; compute_shared_edges matches edges by position too), then the triangles joined
+    // across each edge.
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> by_hash;
-    std::vector<std::uint32_t> parent(mesh.positions.size());
-    std::iota(parent.begin(), parent.end(), 0u);
+    std::vector<std::uint32_t> point(mesh.positions.size());
     for (std::uint32_t v = 0; v < mesh.positions.size(); ++v) {
         std::uint32_t bits[3];
         std::memcpy(bits, &mesh.positions[v].x, sizeof bits);
         const std::uint64_t hash = (std::uint64_t(bits[0]) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(bits[1]) * 0xC2B2AE3D27D4EB4Full) ^ bits[2];
         auto& same = by_hash[hash];
+        point[v] = v;
         for (const std::uint32_t u : same)
             if (std::memcmp(&mesh.positions[u].x, &mesh.positions[v].x, sizeof bits) == 0) {
-                parent[find_root(parent, v)] = find_root(parent, u);
+                point[v] = u;
                 break;
             }
-        same.push_back(v);
+        if (point[v] == v) same.push_back(v);
     }
-    for (std::size_t t = 0; t < triangles; ++t) {
-        const std::uint32_t a = find_root(parent, mesh.indices[3 * t]);
-        parent[find_root(parent, mesh.indices[3 * t + 1])] = a;
-        parent[find_root(parent, mesh.indices[3 * t + 2])] = a;
-    }
+    std::vector<std::uint32_t> parent(triangles);
+    std::iota(parent.begin(), parent.end(), 0u);
+    std::unordered_map<std::uint64_t, std::uint32_t> edge_owner;
+    for (std::uint32_t t = 0; t < triangles; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t a = point[mesh.indices[3 * std::size_t(t) + std::size_t(k)]];
+            const std::uint32_t b = point[mesh.indices[3 * std::size_t(t) + std::size_t((k + 1) % 3)]];
+            const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
+            const auto [it, added] = edge_owner.emplace(key, t);
+            if (!added) parent[find_root(parent, t)] = find_root(parent, it->second);
+        }
     std::unordered_map<std::uint32_t, std::uint32_t> number;
     m.piece.resize(triangles);
-    for (std::size_t t = 0; t < triangles; ++t) {
-        const auto [it, added] = number.emplace(find_root(parent, mesh.indices[3 * t]), m.count);
+    for (std::uint32_t t = 0; t < triangles; ++t) {
+        const auto [it, added] = number.emplace(find_root(parent, t), m.count);
         if (added) ++m.count;
         m.piece[t] = it->second;
     }

@@ -307,11 +307,14 @@ bool detail::SceneCullerState::part_triangles_hidden(const Frame& frame, std::ui
     return false;
 }
 
-// Whether a box (anchored world) lies wholly beyond the near plane, with room for the float
-// matrix and the rounding of ground truth's rays: every corner's w above near (1 + 2^-10).
+// Whether a box (anchored world: it holds the rounded vertices ground truth has, anchored_box)
+// lies wholly beyond the near plane, where ground truth's rays start: every corner's w (the
+// view depth) above near (1 + 2^-10), plus how far the rays' origin, the eye rounded to float
+// relative to the anchor, may lie from the eye (2^-24 of each coordinate; 2^-22 of their sum).
 bool detail::SceneCullerState::beyond_near_plane(const Frame& frame, const Aabb& box) const {
     const glm::dmat4& m = frame.clip_double;
-    const double near = double(buffer_.config().near_w) * (1.0 + 0x1.0p-10);
+    const glm::dvec3 eye = frame.camera->eye - anchor_;
+    const double near = double(buffer_.config().near_w) * (1.0 + 0x1.0p-10) + 0x1.0p-22 * (std::abs(eye.x) + std::abs(eye.y) + std::abs(eye.z));
     for (int k = 0; k < 8; ++k) {
         const glm::dvec3 p = glm::dvec3((k & 1) ? box.max.x : box.min.x, (k & 2) ? box.max.y : box.min.y, (k & 4) ? box.max.z : box.min.z) + anchor_;
         const double w = m[0][3] * p.x + m[1][3] * p.y + m[2][3] * p.z + m[3][3];
