@@ -3,6 +3,7 @@
 // over those triangles only for a solid seen from outside, never hiding what Embree sees.
 #include "support.hpp"
 
+#include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 #include <homcull/truth/ray_scene.hpp>
 #include <homcull/world_triangles.hpp>
@@ -121,6 +122,39 @@ TEST(ClosedOccludees, BackFacesOnlyWhenCertain) {
     const glm::dvec3 far(1e6, -2e6, 3e5);
     EXPECT_TRUE(detail::certainly_faces_away(far + a, far + b, far + c, solid(far + glm::dvec3(0.2, 0.2, -1.0), 1)));
     EXPECT_FALSE(detail::certainly_faces_away(far + a, far + b, far + c, solid(far + glm::dvec3(0.2, 0.2, 1.0), 1)));
+}
+
+// ClosedSolid's argument needs rays from one eye and point positions: an orthographic, clip-space
+// or 4-component input, an orientation other than +1 or -1, or a non-finite eye is an error,
+// not a quietly wrong answer.
+TEST(ClosedOccludees, AClosedSolidOutsideItsArgumentIsAnError) {
+    const OcclusionBuffer buffer(test::buffer_config(64, 48, 1, 0.5f, false));
+    const Mesh solid_mesh = octahedron({0, 0, -5}, 1);
+    TriangleInput in;
+    in.positions = &solid_mesh.positions[0].x;
+    in.vertex_count = solid_mesh.positions.size();
+    in.indices = solid_mesh.indices.data();
+    in.triangle_count = solid_mesh.triangle_count();
+    in.model_to_clip = clip_from_world(test::camera_down_minus_z(90.0), 64.0 / 48.0);
+    const OcclusionBuffer::ClosedSolid good = solid({0, 0, 0}, 1);
+    EXPECT_EQ(buffer.test_triangles(in, 0, 0, good).visibility, buffer.test_triangles(in).visibility);
+    EXPECT_THROW(buffer.test_triangles(in, 0, 0, solid({0, 0, 0}, 0)), Error);
+    EXPECT_THROW(buffer.test_triangles(in, 0, 0, solid({0, 0, 0}, 2)), Error);
+    EXPECT_THROW(buffer.test_triangles(in, 0, 0, solid({std::numeric_limits<double>::quiet_NaN(), 0, 0}, 1)), Error);
+    EXPECT_THROW(buffer.test_triangles(in, 0, 0, solid({0, 0, std::numeric_limits<double>::infinity()}, 1)), Error);
+    TriangleInput clip = in;
+    clip.clip_space = true;
+    EXPECT_THROW(buffer.test_triangles(clip, 0, 0, good), Error);
+    std::vector<float> xyzw;
+    for (const glm::vec3& p : solid_mesh.positions) xyzw.insert(xyzw.end(), {p.x, p.y, p.z, 1.0f});
+    TriangleInput four = in;
+    four.positions = xyzw.data();
+    four.position_components = 4;
+    four.position_stride = 4 * sizeof(float);
+    EXPECT_THROW(buffer.test_triangles(four, 0, 0, good), Error);
+    TriangleInput ortho = in;
+    ortho.orthographic = true;
+    EXPECT_THROW(buffer.test_triangles(ortho, 0, 0, good), Error);
 }
 
 // A closed octahedron behind a wall, placed so that the wall hides it but not its box (and not

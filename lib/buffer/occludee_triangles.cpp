@@ -150,6 +150,18 @@ PlaneError plane_error(const glm::dvec4 clip[3], const ClipError& e) {
     return {dn * std::sqrt(3.0) / (c - dc), dc / (c - dc)};
 }
 
+// What OcclusionBuffer::ClosedSolid's argument needs: rays from one eye point (a perspective
+// input) and model positions that are points (3 components, not clip space), whose planes the
+// eye can be placed against; an orientation of +1 or -1 and a finite eye. Anything else throws.
+void check_closed_solid(const TriangleInput& in, const OcclusionBuffer::ClosedSolid& solid) {
+    if (in.orthographic || in.clip_space || in.position_components != 3)
+        throw Error("test_triangles: ClosedSolid needs a perspective input with 3-component model positions (not orthographic, not "
+                    "clip space)");
+    if (solid.orientation != 1 && solid.orientation != -1) throw Error("test_triangles: ClosedSolid::orientation must be +1 or -1");
+    if (!std::isfinite(solid.eye[0]) || !std::isfinite(solid.eye[1]) || !std::isfinite(solid.eye[2]))
+        throw Error("test_triangles: ClosedSolid::eye must be finite");
+}
+
 struct SampleCounts {
     std::uint64_t samples = 0, visible = 0;
 };
@@ -273,6 +285,7 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
     const detail::StandardFloatMode mode;  // float_mode.hpp
     TriangleInput identity;
     const TriangleInput& in = detail::with_clip_space_matrix(given, identity);
+    if (solid) check_closed_solid(given, *solid);
     TriangleTest result;
     if (in.triangle_count == 0) return result;
     detail::check_triangle_input(in, "test_triangles");

@@ -5,8 +5,9 @@
 
 #include <homcull/triangle_input.hpp>
 
+#include <meshoptimizer.h>
+
 #include <algorithm>
-#include <cstring>
 #include <numeric>
 #include <optional>
 #include <unordered_map>
@@ -23,6 +24,8 @@ struct MeshPieces {
     std::uint32_t count = 0;
 };
 
+constexpr std::uint32_t kNoPiece = ~std::uint32_t(0);
+
 std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t v) {
     while (parent[v] != v) v = parent[v] = parent[parent[v]];  // path halving
     return v;
@@ -38,24 +41,12 @@ MeshPieces mesh_pieces(const Mesh& mesh) {
                          apexes.data());
     for (const std::uint8_t s : shared)
         if (s != 7) return m;
-    // One number per position (split normals or texture seams give a position several vertex
-    // numbers; compute_shared_edges matches edges by position too), then the triangles joined
-    // across each edge.
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> by_hash;
-    std::vector<std::uint32_t> point(mesh.positions.size());
-    for (std::uint32_t v = 0; v < mesh.positions.size(); ++v) {
-        std::uint32_t bits[3];
-        std::memcpy(bits, &mesh.positions[v].x, sizeof bits);
-        const std::uint64_t hash = (std::uint64_t(bits[0]) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(bits[1]) * 0xC2B2AE3D27D4EB4Full) ^ bits[2];
-        auto& same = by_hash[hash];
-        point[v] = v;
-        for (const std::uint32_t u : same)
-            if (std::memcmp(&mesh.positions[u].x, &mesh.positions[v].x, sizeof bits) == 0) {
-                point[v] = u;
-                break;
-            }
-        if (point[v] == v) same.push_back(v);
-    }
+    // One number per position, by bytes (split normals or texture seams give a position several
+    // vertex numbers; compute_shared_edges matches edges by position bits too): meshoptimizer's
+    // vertex remap, as the occluder LOD build welds (truth/lod_mesh_parts.cpp). Then the
+    // triangles joined across each edge.
+    std::vector<unsigned> point(mesh.positions.size());
+    meshopt_generateVertexRemap(point.data(), nullptr, mesh.positions.size(), mesh.positions.data(), mesh.positions.size(), sizeof(glm::vec3));
     std::vector<std::uint32_t> parent(triangles);
     std::iota(parent.begin(), parent.end(), 0u);
     std::unordered_map<std::uint64_t, std::uint32_t> edge_owner;
@@ -67,12 +58,12 @@ MeshPieces mesh_pieces(const Mesh& mesh) {
             const auto [it, added] = edge_owner.emplace(key, t);
             if (!added) parent[find_root(parent, t)] = find_root(parent, it->second);
         }
-    std::unordered_map<std::uint32_t, std::uint32_t> number;
+    std::vector<std::uint32_t> number(triangles, kNoPiece);  // per root triangle
     m.piece.resize(triangles);
     for (std::uint32_t t = 0; t < triangles; ++t) {
-        const auto [it, added] = number.emplace(find_root(parent, t), m.count);
-        if (added) ++m.count;
-        m.piece[t] = it->second;
+        std::uint32_t& n = number[find_root(parent, t)];
+        if (n == kNoPiece) n = m.count++;
+        m.piece[t] = n;
     }
     m.closed = true;
     return m;

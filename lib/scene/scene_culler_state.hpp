@@ -7,6 +7,7 @@
 #include "scene/occludee_parts.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -154,11 +155,12 @@ public:
     OccludeeParts parts_;  // config_.occludee_parts
     std::vector<std::uint8_t> first_visible_part_;  // per object, the part found visible last time: tested first
     bool parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles, TestTally& tally);
-    bool part_triangles_hidden(const Frame& frame, std::uint32_t id, std::uint32_t part, TestTally& tally);
+    bool part_triangles_hidden(const Frame& frame, std::uint32_t id, std::uint32_t part, const OcclusionBuffer::ClosedSolid* solid);
     // Per object gathered for the samples test: +1 or -1 when closed (closed_occludees.hpp),
     // else 0; its part tests then leave out the triangles seen from behind.
     std::vector<std::int8_t> occludee_orientation_;
     bool beyond_near_plane(const Frame& frame, const Aabb& box) const;
+    std::optional<OcclusionBuffer::ClosedSolid> seen_solid(const Frame& frame, std::uint32_t id) const;
     bool triangle_samples_hidden(std::size_t id, const std::array<float, 16>& clip_from_world, float& level_of_visibility);
 };
 

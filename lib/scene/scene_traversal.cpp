@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace homcull {
 namespace {
@@ -267,22 +268,37 @@ bool detail::SceneCullerState::triangle_rectangles_hidden(const Object& object, 
 bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id, bool test_triangles, TestTally& tally) {
     const std::uint32_t first = parts_.first(id), count = parts_.count(id);
     const std::uint32_t start = first_visible_part_[id] < count ? first_visible_part_[id] : 0;
+    std::optional<OcclusionBuffer::ClosedSolid> solid;  // decided once per object, when a part first needs its triangles
+    bool solid_decided = false;
     for (std::uint32_t k = 0; k < count; ++k) {
         const std::uint32_t p = (start + k) % count;
         ++tally.parts;
         if (box_answer(frame, parts_.box(first + p)).visibility != Visibility::visible) continue;
-        if (test_triangles && part_triangles_hidden(frame, id, first + p, tally)) continue;
+        if (test_triangles) {
+            if (!solid_decided) solid = seen_solid(frame, id), solid_decided = true;
+            tally.solid_parts += solid.has_value();
+            if (part_triangles_hidden(frame, id, first + p, solid ? &*solid : nullptr)) continue;
+        }
         first_visible_part_[id] = std::uint8_t(p);
         return false;
     }
     return true;
 }
 
+// The object as a closed solid seen from outside (closed_occludees.hpp), when it is one this
+// frame: closed, and its box wholly beyond the near plane; the eye as ground truth's rays start
+// from it (relative to the anchor, rounded to float).
+std::optional<OcclusionBuffer::ClosedSolid> detail::SceneCullerState::seen_solid(const Frame& frame, std::uint32_t id) const {
+    if (occludee_orientation_[id] == 0 || !beyond_near_plane(frame, object_boxes_[id])) return std::nullopt;
+    const glm::vec3 eye(frame.camera->eye - anchor_);
+    return OcclusionBuffer::ClosedSolid{{eye.x, eye.y, eye.z}, occludee_orientation_[id]};
+}
+
 // The triangles of one part of an object, sample by sample; the triangle that found the object
-// visible last time goes first when it is in this part. A closed occludee wholly beyond the near
-// plane is a solid seen from outside (closed_occludees.hpp): the test passes over the triangles
-// the eye certainly sees from behind.
-bool detail::SceneCullerState::part_triangles_hidden(const Frame& frame, std::uint32_t id, std::uint32_t part, TestTally& tally) {
+// visible last time goes first when it is in this part. With `solid` (seen_solid), the test
+// passes over the triangles the eye certainly sees from behind.
+bool detail::SceneCullerState::part_triangles_hidden(const Frame& frame, std::uint32_t id, std::uint32_t part,
+                                                     const OcclusionBuffer::ClosedSolid* solid) {
     const Mesh& mesh = scene_->meshes[scene_->objects[id].mesh];
     const std::uint32_t begin = parts_.first_triangle(part), count = parts_.triangle_count(part);
     TriangleInput in;
@@ -294,14 +310,7 @@ bool detail::SceneCullerState::part_triangles_hidden(const Frame& frame, std::ui
     in.backface = Backface::none;
     const std::uint32_t last = first_visible_triangle_[id];
     const std::uint32_t start = last >= begin && last < begin + count ? last - begin : 0;
-    OcclusionBuffer::TriangleTest r;
-    if (occludee_orientation_[id] != 0 && beyond_near_plane(frame, object_boxes_[id])) {
-        ++tally.solid_parts;
-        const glm::vec3 eye(frame.camera->eye - anchor_);  // ground truth's: relative to the anchor, rounded to float
-        r = buffer_.test_triangles(in, 0, start, OcclusionBuffer::ClosedSolid{{eye.x, eye.y, eye.z}, occludee_orientation_[id]});
-    } else {
-        r = buffer_.test_triangles(in, 0, start);
-    }
+    const OcclusionBuffer::TriangleTest r = solid ? buffer_.test_triangles(in, 0, start, *solid) : buffer_.test_triangles(in, 0, start);
     if (r.visibility != Visibility::visible) return true;
     first_visible_triangle_[id] = begin + std::uint32_t(r.deciding_triangle);
     return false;

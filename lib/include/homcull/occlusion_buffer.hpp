@@ -285,7 +285,9 @@ public:
     // triangles that `eye` (in the input's model space, as the rays start from it) certainly sees
     // from behind: about half of them. The caller vouches for the conditions: an occludee that
     // meets them only in part may be found hidden where a back face shows. (The scene culler
-    // finds its closed occludees at load time and checks the near plane per frame.)
+    // finds its closed occludees at load time and checks the near plane per frame.) Throws
+    // homcull::Error for an orthographic or clip-space input, 4-component positions, an
+    // orientation other than +1 and -1, or an eye that is not finite.
     struct ClosedSolid {
         double eye[3];
         int orientation;  // +1 or -1
