@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include "buffer/min_pyramid.hpp"
+#include "raster/sample_depth_tiles.hpp"
 
 #include <cstdint>
 #include <new>
@@ -107,6 +108,17 @@ public:
     // Its row stride: the width plus room for a whole vector from any sample of the row, so that
     // the SIMD kernel's vectors never reach into the next row (another band's, on another thread).
     std::size_t sample_depth_stride_ = 0;
+    // The per-sample depth computed where queries read it (raster/sample_depth_tiles.hpp), when
+    // config_.sample_depth and deferred_sample_depth_enabled() at configure: its tiles' states and
+    // lists, and per group of rows the records and list entries with their counts.
+    bool deferred_sample_depth_ = false;
+    Vector<std::uint8_t> depth_tile_state_;
+    Vector<std::uint32_t> depth_tile_head_, depth_group_words_, depth_group_entries_;
+    Vector<std::int32_t> depth_words_;
+    Vector<DepthTileEntry> depth_entries_;
+    std::uint8_t depth_any_filled_ = 0;
+    SampleDepthTiles depth_tiles_{};  // points into the arrays above (set by configure and reserve)
+    void point_depth_tiles();
     std::size_t at(int tx, int ty) const { return std::size_t(ty) * stride_ + std::size_t(tx); }
     RasterStats stats_;
 

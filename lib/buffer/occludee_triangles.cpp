@@ -235,7 +235,10 @@ void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error
         // True once more than `tolerated` are visible: the triangle shows the occludee.
         const auto count_subtile = [&](int tx, std::uint32_t mask, std::uint32_t unhidden_samples) {
             counts.samples += detail::bit_count(mask);
-            if (view.sample_depth && unhidden_samples) unhidden_samples = sample_depth_unhidden(view, tx, ty, unhidden_samples, depth);
+            if (view.sample_depth && unhidden_samples) {
+                if (view.sample_tiles) detail::ensure_depth_subtile(*view.sample_tiles, tx, ty);
+                unhidden_samples = sample_depth_unhidden(view, tx, ty, unhidden_samples, depth);
+            }
             counts.visible += detail::bit_count(unhidden_samples);
             return counts.visible > tolerated;
         };

@@ -66,6 +66,10 @@ void validate_config(const BufferConfig& config) {
 struct detail::BufferSizes {
     int sample_width, sample_height, subtiles_x, subtiles_y;
     std::size_t stride, plane, sample_depth_stride, sample_depth, bands, pyramid, levels, cells_width, cells_height, cells;
+    // The deferred per-sample depth's arrays (raster/sample_depth_tiles.hpp): 0 without per-sample depth.
+    int depth_tiles_x, depth_tiles_y, depth_groups;
+    std::uint32_t depth_word_capacity, depth_entry_capacity;
+    std::size_t depth_tiles, depth_words, depth_entries;
 };
 
 namespace {
@@ -80,6 +84,16 @@ detail::BufferSizes buffer_sizes(const BufferConfig& config) {
     z.plane = z.stride * std::size_t(z.subtiles_y);
     z.sample_depth_stride = std::size_t(z.sample_width) + detail::kMaxSimdLanes;
     z.sample_depth = config.sample_depth ? z.sample_depth_stride * std::size_t(z.sample_height) : 0;
+    if (config.sample_depth) {
+        z.depth_tiles_x = (z.sample_width + detail::kDepthTileWidth - 1) / detail::kDepthTileWidth;
+        z.depth_tiles_y = (z.sample_height + detail::kDepthTileHeight - 1) / detail::kDepthTileHeight;
+        z.depth_groups = (z.subtiles_y + detail::kDepthGroupSubtileRows - 1) / detail::kDepthGroupSubtileRows;
+        z.depth_word_capacity = detail::depth_word_capacity(z.subtiles_x);
+        z.depth_entry_capacity = detail::depth_entry_capacity(z.subtiles_x);
+        z.depth_tiles = std::size_t(z.depth_tiles_x) * std::size_t(z.depth_tiles_y);
+        z.depth_words = std::size_t(z.depth_groups) * z.depth_word_capacity;
+        z.depth_entries = std::size_t(z.depth_groups) * z.depth_entry_capacity;
+    }
     z.bands = std::size_t((z.subtiles_y + kBandSubtileRows - 1) / kBandSubtileRows);
     z.levels = 1;
     std::size_t size = std::size_t(z.subtiles_x) * std::size_t(z.subtiles_y);
@@ -100,6 +114,9 @@ detail::BufferSizes buffer_sizes(const BufferConfig& config) {
 void detail::BufferState::reserve_arrays(const detail::BufferSizes& z) {
     d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
     sample_depth_.reserve(z.sample_depth);
+    depth_tile_state_.reserve(z.depth_tiles), depth_tile_head_.reserve(z.depth_tiles);
+    depth_group_words_.reserve(std::size_t(z.depth_groups)), depth_group_entries_.reserve(std::size_t(z.depth_groups));
+    depth_words_.reserve(z.depth_words), depth_entries_.reserve(z.depth_entries);
     band_updated_.reserve(z.bands);
     levels_.reserve(z.levels), level_offset_.reserve(z.levels), level_width_.reserve(z.levels);
     pyramid_.reserve(z.pyramid);
@@ -130,6 +147,18 @@ void detail::BufferState::configure(const BufferConfig& config) {
     covered_.assign(z.plane, 0u);
     sample_depth_stride_ = z.sample_depth_stride;
     sample_depth_.assign(z.sample_depth, 0.0f);
+    deferred_sample_depth_ = config.sample_depth && detail::deferred_sample_depth_enabled();
+    depth_tile_state_.assign(z.depth_tiles, detail::kDepthTileStale);
+    depth_tile_head_.assign(z.depth_tiles, detail::kNoDepthEntry);
+    depth_group_words_.assign(std::size_t(z.depth_groups), 0u);
+    depth_group_entries_.assign(std::size_t(z.depth_groups), 0u);
+    depth_words_.resize(z.depth_words);
+    depth_entries_.resize(z.depth_entries);
+    depth_any_filled_ = 0;
+    depth_tiles_ = {};
+    depth_tiles_.sample_width = z.sample_width, depth_tiles_.sample_height = z.sample_height;
+    depth_tiles_.tiles_x = z.depth_tiles_x, depth_tiles_.tiles_y = z.depth_tiles_y, depth_tiles_.groups = z.depth_groups;
+    depth_tiles_.word_capacity = z.depth_word_capacity, depth_tiles_.entry_capacity = z.depth_entry_capacity;
     band_updated_.assign(z.bands, 0);
     levels_.clear();
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
@@ -149,7 +178,23 @@ void detail::BufferState::configure(const BufferConfig& config) {
         level_offset_.push_back(std::int32_t(l.offset));
         level_width_.push_back(l.width);
     }
+    point_depth_tiles();
     stats_ = RasterStats{};
+}
+
+void detail::BufferState::point_depth_tiles() {
+    detail::SampleDepthTiles& t = depth_tiles_;
+    const bool kept = deferred_sample_depth_ && !sample_depth_.empty();
+    t.depth = kept ? sample_depth_.data() : nullptr;
+    t.stride = sample_depth_stride_;
+    t.tile_state = kept ? depth_tile_state_.data() : nullptr;
+    t.tile_head = kept ? depth_tile_head_.data() : nullptr;
+    t.words = kept ? depth_words_.data() : nullptr;
+    t.entries = kept ? depth_entries_.data() : nullptr;
+    t.group_words = kept ? depth_group_words_.data() : nullptr;
+    t.group_entries = kept ? depth_group_entries_.data() : nullptr;
+    t.any_filled = &depth_any_filled_;
+    t.fill_tile = kernels_->raster.fill_depth_tile;
 }
 
 void detail::BufferState::set_near_w(float near_w) {
@@ -170,6 +215,7 @@ void detail::BufferState::reserve(const BufferReserve& r) {
     validate_config(largest);
     const detail::BufferSizes z = buffer_sizes(largest);
     reserve_arrays(z);
+    point_depth_tiles();  // the arrays may have moved
 
     const auto at_least = [](auto& v, std::size_t n) {
         if (v.size() < n) v.resize(n);
@@ -246,9 +292,15 @@ void detail::BufferState::clear_rows(int row_begin, int row_end) {
     zero(d1_, begin, end);
     zero(mask_, begin, end);
     zero(covered_, begin, end);
-    if (!sample_depth_.empty())
+    if (deferred_sample_depth_) {
+        // Whole groups: rows begin at a multiple of kDepthGroupSubtileRows wherever a render
+        // clears them (bands, parts of rows, the whole buffer). Were one not to, the group's
+        // rows above it would lose their per-sample depth (0: no bound), which only costs culling.
+        detail::reset_sample_depth_rows(depth_tiles_, row_begin / detail::kDepthGroupSubtileRows * detail::kDepthGroupSubtileRows, row_end);
+    } else if (!sample_depth_.empty()) {
         zero(sample_depth_, std::size_t(row_begin * kH) * sample_depth_stride_,
              std::size_t(std::min(row_end * kH, sample_height_)) * sample_depth_stride_);
+    }
 }
 
 void detail::BufferState::build_pyramid_rows(int row_begin, int row_end, int last_level) {
@@ -295,9 +347,17 @@ detail::RasterTarget detail::BufferState::raster_target(int row_begin, int row_e
                                        mask_.data(),
                                        covered_.data(),
                                        stride_,
-                                       sample_depth_.empty() ? nullptr : sample_depth_.data(),
+                                       sample_depth_.empty() || deferred_sample_depth_ ? nullptr : sample_depth_.data(),
                                        sample_depth_stride_};
-    return {planes, sample_width_, sample_height_, row_begin, row_end, kernels_->raster.rows, detail::hidden_skip_enabled(), kernels_->raster.hidden_test};
+    return {planes,
+            sample_width_,
+            sample_height_,
+            row_begin,
+            row_end,
+            kernels_->raster.rows,
+            detail::hidden_skip_enabled(),
+            kernels_->raster.hidden_test,
+            deferred_sample_depth_ ? &depth_tiles_ : nullptr};
 }
 
 void detail::BufferState::build_changed_pyramid(bool cleared, const detail::ChangedSubtiles& changed) {
@@ -329,6 +389,7 @@ void detail::BufferState::read_coverage(std::vector<std::uint8_t>& covered) cons
 
 void detail::BufferState::read_depth(std::vector<float>& w) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
+    if (deferred_sample_depth_) detail::ensure_all_depth_tiles(depth_tiles_);
     w.assign(std::size_t(sample_width_) * std::size_t(sample_height_), INFINITY);
     for (int y = 0; y < sample_height_; ++y)
         for (int x = 0; x < sample_width_; ++x) {
@@ -344,6 +405,7 @@ void detail::BufferState::read_depth(std::vector<float>& w) const {
 void detail::BufferState::read_sample_depth(std::vector<float>& d) const {
     d.clear();
     if (sample_depth_.empty()) return;
+    if (deferred_sample_depth_) detail::ensure_all_depth_tiles(depth_tiles_);
     d.reserve(std::size_t(sample_width_) * std::size_t(sample_height_));
     for (int y = 0; y < sample_height_; ++y) {
         const auto row = sample_depth_.begin() + std::ptrdiff_t(std::size_t(y) * sample_depth_stride_);

@@ -114,6 +114,9 @@ struct SubtileView {
     const float* pyramid;
     const PyramidLevel* levels;
     int level_count;
+    // The per-sample depth's units, when computed where read (sample_depth_tiles.hpp): a reader
+    // makes a subtile's unit ready (ensure_depth_subtile) before reading sample_depth there.
+    const SampleDepthTiles* sample_tiles = nullptr;
 };
 
 // A buffer's views, inline so that kernels given the buffer read its fields where they need
@@ -123,7 +126,7 @@ inline CoarseRectView BufferState::coarse_view() const {
 }
 inline SubtileView BufferState::subtile_view() const {
     return {d0_.data(),           d1_.data(),      mask_.data(),   stride_, sample_depth_.empty() ? nullptr : sample_depth_.data(),
-            sample_depth_stride_, pyramid_.data(), levels_.data(), int(levels_.size())};
+            sample_depth_stride_, pyramid_.data(), levels_.data(), int(levels_.size()), deferred_sample_depth_ ? &depth_tiles_ : nullptr};
 }
 
 // Which of the samples `samples` of subtile (tx, ty) an occludee at 1/w `d_near` may be seen

@@ -14,6 +14,7 @@
 // prepare_float_row_edges in rasterize.hpp.
 //
 #include "raster/rasterize.hpp"
+#include "raster/sample_depth_tiles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -222,6 +223,12 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriang
     int ty_first, ty_last;
     if (!subtile_rows_within(j0, j1, t.row_begin, t.row_end, ty_first, ty_last)) return 0;
     std::uint64_t updated = 0;
+    // The per-sample depth: written below (the planes'), or when the buffer computes it where
+    // read, each chunk's intervals listed, or written below into its zeroed tiles (list_sample_depth).
+    SubtilePlanes depth_planes = t.planes;
+    const bool listed = t.sample_tiles && list_sample_depth(*t.sample_tiles, triangle, ty_first, ty_last);
+    if (t.sample_tiles && !listed) depth_planes.sample_depth = t.sample_tiles->depth;
+    std::int32_t chunk_first[kChunkSubtileRows * kH], chunk_last[kChunkSubtileRows * kH];  // a listed chunk's intervals
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         if (t.skip_hidden &&
@@ -238,11 +245,16 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriang
                     last[j] = i0 - 1;
                     if (row >= j0 && row <= j1) float_sample_row_interval(triangle.float_edges, row, i0, i1, first[j], last[j]);
                 }
+            std::copy(first, first + kH, chunk_first + (ty - ty0) * kH);
+            std::copy(last, last + kH, chunk_last + (ty - ty0) * kH);
             int tx_begin, tx_end;
             if (!reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
             updated += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, first, last, prepared, t.sample_width, t.sample_height);
-            if (t.planes.sample_depth) update_sample_depth(t.planes, ty, first, last, prepared);
+            if (depth_planes.sample_depth) update_sample_depth(depth_planes, ty, first, last, prepared);
         }
+        if (listed)
+            record_sample_depth(*t.sample_tiles, prepared, i0, i1, ty0 * kH, (ty1 - ty0 + 1) * kH, chunk_first, chunk_last,
+                                [&](const std::int32_t* record, int tx, int ty) { apply_depth_record_reference(*t.sample_tiles, record, tx, ty); });
     }
     return updated;
 }

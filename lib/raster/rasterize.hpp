@@ -32,6 +32,7 @@ struct ScreenTriangle {
 struct PreparedTriangle;
 struct TriangleEdges;
 struct RasterTarget;
+struct SampleDepthTiles;
 
 struct RasterTriangle;
 
@@ -67,6 +68,9 @@ struct RasterTarget {
     TriangleRowsKernel kernel;
     bool skip_hidden;  // hidden_skip_enabled() when the target was made
     HiddenTestKernel hidden_test;  // the same instruction set's: the setup's test before drawing (triangle_batch.hpp)
+    // The per-sample depth computed where queries read it (sample_depth_tiles.hpp): the row
+    // loops record each drawn triangle there instead of writing planes.sample_depth (then null).
+    const SampleDepthTiles* sample_tiles = nullptr;
 };
 
 // The subtile rows [ty0, ty1] that hold sample rows [j0, j1] and lie within subtile rows

@@ -11,6 +11,7 @@
 #include <hwy/highway.h>
 
 #include "raster/rasterize.hpp"
+#include "raster/sample_depth_tiles.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -407,6 +408,46 @@ bool HiddenBehindReferenceLayerKernel(const SubtilePlanes& planes, int tx0, int 
     return HiddenBehindReferenceLayer(planes, tx0, tx1, ty0, ty1, nearest);
 }
 
+// apply_depth_record_reference in lanes: each of the record's rows in the tile in whole vectors
+// aligned to the tile's columns, so that none reaches past them (another thread may be filling
+// the next tile); samples outside the interval are written back as read. Each sample's value is
+// UpdateSampleDepth's: its centre x + 0.5 exact in float, the same float operations.
+HWY_INLINE void ApplyDepthRecord(const SampleDepthTiles& t, const std::int32_t* record, int tx, int ty) {
+    const DepthRowsRecord r = depth_record_header(record);
+    const std::int32_t *first = depth_record_first(record), *last = depth_record_last(record, r.rows);
+    const int x0 = tx * kDepthTileWidth, x1 = x0 + kDepthTileWidth - 1;
+    const int begin = std::max(r.row0, ty * kDepthTileHeight), end = std::min({r.row0 + r.rows, (ty + 1) * kDepthTileHeight, t.sample_height});
+    const PreparedTriangle& tri = r.plane;
+    const hn::CappedTag<float, kMaxSimdLanes> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const int lanes = int(hn::Lanes(df));
+    const auto lane = hn::Iota(di, 0);
+    const auto dzdx = hn::Set(df, tri.dzdx), error = hn::Set(df, tri.error), z_vertex_min = hn::Set(df, tri.z_vertex_min);
+    const auto half = hn::Set(df, 0.5f), lower = hn::Set(df, 1.0f - 0x1.0p-20f);
+    for (int row = begin; row < end; ++row) {
+        const int lo = std::max(first[row - r.row0], x0), hi = std::min(last[row - r.row0], x1);
+        if (lo > hi) continue;
+        const float y = float(row) + 0.5f;
+        const auto row_part = hn::Set(df, tri.a + tri.dzdy * y);
+        float* depth = t.depth + std::size_t(row) * t.stride;
+        const auto lo_v = hn::Set(di, lo), hi_v = hn::Set(di, hi);
+        for (int x = x0 + (lo - x0) / lanes * lanes; x <= hi; x += lanes) {
+            const auto column = hn::Add(lane, hn::Set(di, x));
+            const auto in_interval = hn::RebindMask(df, hn::And(hn::Not(hn::Lt(column, lo_v)), hn::Not(hn::Gt(column, hi_v))));
+            const auto xs = hn::Add(hn::ConvertTo(df, column), half);
+            const auto lowered = hn::Sub(hn::Add(row_part, hn::Mul(dzdx, xs)), error);
+            const auto bound = hn::Mul(hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered), lower);
+            const auto old = hn::LoadU(df, depth + x);
+            hn::StoreU(hn::IfThenElse(hn::And(in_interval, hn::Lt(old, bound)), bound, old), df, depth + x);
+        }
+    }
+}
+
+// fill_depth_tile_reference in lanes.
+void FillDepthTile(const SampleDepthTiles& t, int tx, int ty) {
+    for_each_in_depth_tile(t, tx, ty, [&](const std::int32_t* record) { ApplyDepthRecord(t, record, tx, ty); });
+}
+
 // The reference's row loop, over chunks of up to kChunkSubtileRows subtile rows. A chunk where
 // the triangle is hidden behind the reference layer is skipped (HiddenBehindReferenceLayer; on
 // S1 that is most of them). Otherwise two passes: first the
@@ -435,6 +476,11 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     // + kMaxSimdLanes: the last vector may pass the chunk's rows
     HWY_ALIGN std::int32_t first[kChunkRows + kMaxSimdLanes], last[kChunkRows + kMaxSimdLanes];
     std::uint64_t updated = 0;
+    // The per-sample depth: written below (the planes'), or when the buffer computes it where
+    // read, each chunk's intervals listed, or written below into its zeroed tiles (list_sample_depth).
+    SubtilePlanes depth_planes = t.planes;
+    const bool listed = t.sample_tiles && list_sample_depth(*t.sample_tiles, triangle, ty_first, ty_last);
+    if (t.sample_tiles && !listed) depth_planes.sample_depth = t.sample_tiles->depth;
     for (int ty0 = ty_first; ty0 <= ty_last; ty0 += kChunkSubtileRows) {
         const int ty1 = std::min(ty_last, ty0 + kChunkSubtileRows - 1);
         const int row0 = ty0 * kH, rows = (ty1 - ty0 + 1) * kH;
@@ -443,6 +489,9 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
             continue;
         if (triangle.plane.float_rows) FloatRowIntervals(triangle, row0, rows, first, last);
         else DoubleRowIntervals(triangle.edges, i0, i1, triangle.j0, j1, row0, rows, first, last);
+        if (listed)
+            record_sample_depth(*t.sample_tiles, tri, i0, i1, row0, rows, first, last,
+                                [&](const std::int32_t* record, int tx, int ty) { ApplyDepthRecord(*t.sample_tiles, record, tx, ty); });
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
@@ -459,9 +508,9 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
                 updated += update_subtile_row_reference(t.planes, ty, tx_begin, tx_end, row_first, row_last, tri, t.sample_width,
                                                         t.sample_height);
 #endif
-            if (t.planes.sample_depth)
+            if (depth_planes.sample_depth)
                 for (int r = 0; r < rows_now; ++r)
-                    UpdateSampleDepth(t.planes, ty + r, row_first + r * kH, row_last + r * kH, tri, sample_lane);
+                    UpdateSampleDepth(depth_planes, ty + r, row_first + r * kH, row_last + r * kH, tri, sample_lane);
             ty += rows_now;
         }
     }
@@ -488,6 +537,7 @@ namespace detail {
 HWY_EXPORT(RasterizeRows);
 HWY_EXPORT(HiddenBehindReferenceLayerKernel);
 HWY_EXPORT(RowIntervals);
+HWY_EXPORT(FillDepthTile);
 
 namespace {
 std::atomic<bool> skip_hidden{true};
@@ -497,6 +547,7 @@ void resolve_rasterize_kernels(const IsaChoice& choice, RasterKernels& k) {
     k.rows = choice.scalar ? &rasterize_rows_reference : HOMCULL_KERNEL_FOR(choice, RasterizeRows);
     k.hidden_test = choice.scalar ? &hidden_behind_reference_layer : HOMCULL_KERNEL_FOR(choice, HiddenBehindReferenceLayerKernel);
     k.row_intervals = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RowIntervals);
+    k.fill_depth_tile = choice.scalar ? &fill_depth_tile_reference : HOMCULL_KERNEL_FOR(choice, FillDepthTile);
 }
 void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
 bool hidden_skip_enabled() { return skip_hidden; }
