@@ -98,6 +98,16 @@ std::string shared_scene(const std::string& file) {
     return std::filesystem::is_regular_file(path) ? path.string() : std::string();
 }
 
+Camera castle_view_c0() {
+    Camera c0;
+    c0.eye = {27, 2, -47};
+    c0.target = {28.4258, 2.6111, -37.1211};
+    c0.fov_y_degrees = 36;
+    c0.near_plane = 1;
+    c0.far_plane = 5000;
+    return c0;
+}
+
 void write_text(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;
 }

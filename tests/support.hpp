@@ -88,6 +88,8 @@ std::string temp_dir(const std::string& test_name);
 std::string shared_scenes_dir();
 // <shared scenes folder>/<file>, or "" when it is missing.
 std::string shared_scene(const std::string& file);
+// DESIGN.md's castle view C0 (the first view of data/views/castle.json).
+Camera castle_view_c0();
 void write_text(const std::string& path, const std::string& text);
 
 }  // namespace homcull::test

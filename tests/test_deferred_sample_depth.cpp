@@ -89,12 +89,7 @@ TEST(DeferredSampleDepth, SameBitsAsWritingEveryTriangleOnTheCastle) {
     if (path.empty()) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
     const Scene scene = load_scene(path);
     const WorldTriangles occluders = gather_world_triangles(scene, objects_with_role(scene, "occluder"));
-    Camera c0;
-    c0.eye = {27, 2, -47};
-    c0.target = {28.4258, 2.6111, -37.1211};
-    c0.fov_y_degrees = 36;
-    c0.near_plane = 1;
-    c0.far_plane = 5000;
+    const Camera c0 = test::castle_view_c0();  // DESIGN.md, "Castle view C0"
     const TriangleInput all = occluders.input(clip_from_world(c0, 1280.0 / 720.0), Backface::none);
     TriangleInput first = all, second = all;
     first.triangle_count = all.triangle_count / 2;

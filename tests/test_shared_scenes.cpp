@@ -113,12 +113,7 @@ TEST(SharedScenes, FzkHausGroundTruthMatchesSingleRaysAndHidesTheInterior) {
 TEST(SharedScenes, CastleViewC0) {
     REQUIRE_SHARED_SCENE(path, "intel_castle.glb");
     const Scene castle = load_scene(path);
-    Camera c0;  // DESIGN.md, "Castle view C0"
-    c0.eye = {27, 2, -47};
-    c0.target = {28.4258, 2.6111, -37.1211};
-    c0.fov_y_degrees = 36;
-    c0.near_plane = 1;
-    c0.far_plane = 5000;
+    const Camera c0 = test::castle_view_c0();  // DESIGN.md, "Castle view C0"
     const RayScene rays(castle);
     TruthOptions options;
     options.resolution = {1280, 720};
