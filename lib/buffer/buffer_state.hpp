@@ -109,10 +109,10 @@ public:
     // the SIMD kernel's vectors never reach into the next row (another band's, on another thread).
     std::size_t sample_depth_stride_ = 0;
     // The per-sample depth computed where queries read it (raster/sample_depth_tiles.hpp), when
-    // config_.sample_depth and deferred_sample_depth_enabled() at configure: its tiles' states and
-    // lists, and per group of rows the records and list entries with their counts.
+    // config_.sample_depth and deferred_sample_depth_enabled() at configure: its units' states, its
+    // tiles' lists, and per group of rows the records and list entries with their counts.
     bool deferred_sample_depth_ = false;
-    Vector<std::uint8_t> depth_tile_state_;
+    Vector<std::uint8_t> depth_unit_state_;
     Vector<std::uint32_t> depth_tile_head_, depth_group_words_, depth_group_entries_;
     Vector<std::int32_t> depth_words_;
     Vector<DepthTileEntry> depth_entries_;

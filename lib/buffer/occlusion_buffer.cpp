@@ -67,9 +67,9 @@ struct detail::BufferSizes {
     int sample_width, sample_height, subtiles_x, subtiles_y;
     std::size_t stride, plane, sample_depth_stride, sample_depth, bands, pyramid, levels, cells_width, cells_height, cells;
     // The deferred per-sample depth's arrays (raster/sample_depth_tiles.hpp): 0 without per-sample depth.
-    int depth_tiles_x, depth_tiles_y, depth_groups;
+    int depth_units_x, depth_units_y, depth_tiles_x, depth_tiles_y, depth_groups;
     std::uint32_t depth_word_capacity, depth_entry_capacity;
-    std::size_t depth_tiles, depth_words, depth_entries;
+    std::size_t depth_units, depth_tiles, depth_words, depth_entries;
 };
 
 namespace {
@@ -85,11 +85,14 @@ detail::BufferSizes buffer_sizes(const BufferConfig& config) {
     z.sample_depth_stride = std::size_t(z.sample_width) + detail::kMaxSimdLanes;
     z.sample_depth = config.sample_depth ? z.sample_depth_stride * std::size_t(z.sample_height) : 0;
     if (config.sample_depth) {
+        z.depth_units_x = (z.sample_width + detail::kDepthUnitWidth - 1) / detail::kDepthUnitWidth;
+        z.depth_units_y = (z.sample_height + detail::kDepthUnitHeight - 1) / detail::kDepthUnitHeight;
         z.depth_tiles_x = (z.sample_width + detail::kDepthTileWidth - 1) / detail::kDepthTileWidth;
         z.depth_tiles_y = (z.sample_height + detail::kDepthTileHeight - 1) / detail::kDepthTileHeight;
         z.depth_groups = (z.subtiles_y + detail::kDepthGroupSubtileRows - 1) / detail::kDepthGroupSubtileRows;
         z.depth_word_capacity = detail::depth_word_capacity(z.subtiles_x);
         z.depth_entry_capacity = detail::depth_entry_capacity(z.subtiles_x);
+        z.depth_units = std::size_t(z.depth_units_x) * std::size_t(z.depth_units_y);
         z.depth_tiles = std::size_t(z.depth_tiles_x) * std::size_t(z.depth_tiles_y);
         z.depth_words = std::size_t(z.depth_groups) * z.depth_word_capacity;
         z.depth_entries = std::size_t(z.depth_groups) * z.depth_entry_capacity;
@@ -114,7 +117,7 @@ detail::BufferSizes buffer_sizes(const BufferConfig& config) {
 void detail::BufferState::reserve_arrays(const detail::BufferSizes& z) {
     d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
     sample_depth_.reserve(z.sample_depth);
-    depth_tile_state_.reserve(z.depth_tiles), depth_tile_head_.reserve(z.depth_tiles);
+    depth_unit_state_.reserve(z.depth_units), depth_tile_head_.reserve(z.depth_tiles);
     depth_group_words_.reserve(std::size_t(z.depth_groups)), depth_group_entries_.reserve(std::size_t(z.depth_groups));
     depth_words_.reserve(z.depth_words), depth_entries_.reserve(z.depth_entries);
     band_updated_.reserve(z.bands);
@@ -148,7 +151,7 @@ void detail::BufferState::configure(const BufferConfig& config) {
     sample_depth_stride_ = z.sample_depth_stride;
     sample_depth_.assign(z.sample_depth, 0.0f);
     deferred_sample_depth_ = config.sample_depth && detail::deferred_sample_depth_enabled();
-    depth_tile_state_.assign(z.depth_tiles, detail::kDepthTileStale);
+    depth_unit_state_.assign(z.depth_units, detail::kDepthUnitStale);
     depth_tile_head_.assign(z.depth_tiles, detail::kNoDepthEntry);
     depth_group_words_.assign(std::size_t(z.depth_groups), 0u);
     depth_group_entries_.assign(std::size_t(z.depth_groups), 0u);
@@ -157,6 +160,7 @@ void detail::BufferState::configure(const BufferConfig& config) {
     depth_any_filled_ = 0;
     depth_tiles_ = {};
     depth_tiles_.sample_width = z.sample_width, depth_tiles_.sample_height = z.sample_height;
+    depth_tiles_.units_x = z.depth_units_x, depth_tiles_.units_y = z.depth_units_y;
     depth_tiles_.tiles_x = z.depth_tiles_x, depth_tiles_.tiles_y = z.depth_tiles_y, depth_tiles_.groups = z.depth_groups;
     depth_tiles_.word_capacity = z.depth_word_capacity, depth_tiles_.entry_capacity = z.depth_entry_capacity;
     band_updated_.assign(z.bands, 0);
@@ -187,14 +191,14 @@ void detail::BufferState::point_depth_tiles() {
     const bool kept = deferred_sample_depth_ && !sample_depth_.empty();
     t.depth = kept ? sample_depth_.data() : nullptr;
     t.stride = sample_depth_stride_;
-    t.tile_state = kept ? depth_tile_state_.data() : nullptr;
+    t.unit_state = kept ? depth_unit_state_.data() : nullptr;
     t.tile_head = kept ? depth_tile_head_.data() : nullptr;
     t.words = kept ? depth_words_.data() : nullptr;
     t.entries = kept ? depth_entries_.data() : nullptr;
     t.group_words = kept ? depth_group_words_.data() : nullptr;
     t.group_entries = kept ? depth_group_entries_.data() : nullptr;
     t.any_filled = &depth_any_filled_;
-    t.fill_tile = kernels_->raster.fill_depth_tile;
+    t.fill_unit = kernels_->raster.fill_depth_unit;
 }
 
 void detail::BufferState::set_near_w(float near_w) {
@@ -389,7 +393,7 @@ void detail::BufferState::read_coverage(std::vector<std::uint8_t>& covered) cons
 
 void detail::BufferState::read_depth(std::vector<float>& w) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
-    if (deferred_sample_depth_) detail::ensure_all_depth_tiles(depth_tiles_);
+    if (deferred_sample_depth_) detail::ensure_all_depth_units(depth_tiles_);
     w.assign(std::size_t(sample_width_) * std::size_t(sample_height_), INFINITY);
     for (int y = 0; y < sample_height_; ++y)
         for (int x = 0; x < sample_width_; ++x) {
@@ -405,7 +409,7 @@ void detail::BufferState::read_depth(std::vector<float>& w) const {
 void detail::BufferState::read_sample_depth(std::vector<float>& d) const {
     d.clear();
     if (sample_depth_.empty()) return;
-    if (deferred_sample_depth_) detail::ensure_all_depth_tiles(depth_tiles_);
+    if (deferred_sample_depth_) detail::ensure_all_depth_units(depth_tiles_);
     d.reserve(std::size_t(sample_width_) * std::size_t(sample_height_));
     for (int y = 0; y < sample_height_; ++y) {
         const auto row = sample_depth_.begin() + std::ptrdiff_t(std::size_t(y) * sample_depth_stride_);

@@ -33,7 +33,7 @@ struct RasterKernels {
     TriangleRowsKernel rows;           // the row loop (rasterize.hpp)
     HiddenTestKernel hidden_test;      // hidden_behind_reference_layer
     RowIntervalsKernel row_intervals;  // null for the scalar reference
-    FillDepthTileKernel fill_depth_tile;  // sample_depth_tiles.hpp
+    FillDepthUnitKernel fill_depth_unit;  // sample_depth_tiles.hpp
     RefreshCellsKernel refresh_cells;  // null for the scalar reference (reference_cells.hpp)
     DropHiddenKernel drop_hidden;
     BucketPackedSoupKernel bucket_packed_soup;

@@ -254,7 +254,7 @@ std::uint64_t rasterize_rows_reference(const RasterTarget& t, const RasterTriang
         }
         if (listed)
             record_sample_depth(*t.sample_tiles, prepared, i0, i1, ty0 * kH, (ty1 - ty0 + 1) * kH, chunk_first, chunk_last,
-                                [&](const std::int32_t* record, int tx, int ty) { apply_depth_record_reference(*t.sample_tiles, record, tx, ty); });
+                                [&](const std::int32_t* record, int ux, int uy) { apply_depth_record_reference(*t.sample_tiles, record, ux, uy); });
     }
     return updated;
 }

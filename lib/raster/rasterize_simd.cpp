@@ -408,15 +408,15 @@ bool HiddenBehindReferenceLayerKernel(const SubtilePlanes& planes, int tx0, int 
     return HiddenBehindReferenceLayer(planes, tx0, tx1, ty0, ty1, nearest);
 }
 
-// apply_depth_record_reference in lanes: each of the record's rows in the tile in whole vectors
-// aligned to the tile's columns, so that none reaches past them (another thread may be filling
-// the next tile); samples outside the interval are written back as read. Each sample's value is
+// apply_depth_record_reference in lanes: each of the record's rows in the unit in whole vectors
+// aligned to the unit's columns, so that none reaches past them (another thread may be filling
+// the next unit); samples outside the interval are written back as read. Each sample's value is
 // UpdateSampleDepth's: its centre x + 0.5 exact in float, the same float operations.
-HWY_INLINE void ApplyDepthRecord(const SampleDepthTiles& t, const std::int32_t* record, int tx, int ty) {
+HWY_INLINE void ApplyDepthRecord(const SampleDepthTiles& t, const std::int32_t* record, int ux, int uy) {
     const DepthRowsRecord r = depth_record_header(record);
     const std::int32_t *first = depth_record_first(record), *last = depth_record_last(record, r.rows);
-    const int x0 = tx * kDepthTileWidth, x1 = x0 + kDepthTileWidth - 1;
-    const int begin = std::max(r.row0, ty * kDepthTileHeight), end = std::min({r.row0 + r.rows, (ty + 1) * kDepthTileHeight, t.sample_height});
+    const int x0 = ux * kDepthUnitWidth, x1 = x0 + kDepthUnitWidth - 1;
+    const int begin = std::max(r.row0, uy * kDepthUnitHeight), end = std::min({r.row0 + r.rows, (uy + 1) * kDepthUnitHeight, t.sample_height});
     const PreparedTriangle& tri = r.plane;
     const hn::CappedTag<float, kMaxSimdLanes> df;
     const hn::RebindToSigned<decltype(df)> di;
@@ -443,9 +443,9 @@ HWY_INLINE void ApplyDepthRecord(const SampleDepthTiles& t, const std::int32_t* 
     }
 }
 
-// fill_depth_tile_reference in lanes.
-void FillDepthTile(const SampleDepthTiles& t, int tx, int ty) {
-    for_each_in_depth_tile(t, tx, ty, [&](const std::int32_t* record) { ApplyDepthRecord(t, record, tx, ty); });
+// fill_depth_unit_reference in lanes.
+void FillDepthUnit(const SampleDepthTiles& t, int ux, int uy) {
+    for_each_in_depth_unit(t, ux, uy, [&](const std::int32_t* record) { ApplyDepthRecord(t, record, ux, uy); });
 }
 
 // The reference's row loop, over chunks of up to kChunkSubtileRows subtile rows. A chunk where
@@ -491,7 +491,7 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
         else DoubleRowIntervals(triangle.edges, i0, i1, triangle.j0, j1, row0, rows, first, last);
         if (listed)
             record_sample_depth(*t.sample_tiles, tri, i0, i1, row0, rows, first, last,
-                                [&](const std::int32_t* record, int tx, int ty) { ApplyDepthRecord(*t.sample_tiles, record, tx, ty); });
+                                [&](const std::int32_t* record, int ux, int uy) { ApplyDepthRecord(*t.sample_tiles, record, ux, uy); });
         for (int ty = ty0; ty <= ty1;) {
             const std::int32_t* row_first = first + (ty - ty0) * kH;
             const std::int32_t* row_last = last + (ty - ty0) * kH;
@@ -537,7 +537,7 @@ namespace detail {
 HWY_EXPORT(RasterizeRows);
 HWY_EXPORT(HiddenBehindReferenceLayerKernel);
 HWY_EXPORT(RowIntervals);
-HWY_EXPORT(FillDepthTile);
+HWY_EXPORT(FillDepthUnit);
 
 namespace {
 std::atomic<bool> skip_hidden{true};
@@ -547,7 +547,7 @@ void resolve_rasterize_kernels(const IsaChoice& choice, RasterKernels& k) {
     k.rows = choice.scalar ? &rasterize_rows_reference : HOMCULL_KERNEL_FOR(choice, RasterizeRows);
     k.hidden_test = choice.scalar ? &hidden_behind_reference_layer : HOMCULL_KERNEL_FOR(choice, HiddenBehindReferenceLayerKernel);
     k.row_intervals = choice.scalar ? nullptr : HOMCULL_KERNEL_FOR(choice, RowIntervals);
-    k.fill_depth_tile = choice.scalar ? &fill_depth_tile_reference : HOMCULL_KERNEL_FOR(choice, FillDepthTile);
+    k.fill_depth_unit = choice.scalar ? &fill_depth_unit_reference : HOMCULL_KERNEL_FOR(choice, FillDepthUnit);
 }
 void set_hidden_skip(bool enabled) { skip_hidden = enabled; }
 bool hidden_skip_enabled() { return skip_hidden; }

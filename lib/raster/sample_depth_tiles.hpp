@@ -6,7 +6,7 @@
 // Writing it for every covered sample of every occluder triangle cost about as much as the rest
 // of the render. So the row loops list each drawn triangle's rows (its depth plane and the
 // coverage intervals they computed) in the tiles they reach, and the first query that reads a
-// tile writes that tile's samples from its list.
+// unit of a tile writes that unit's samples from the tile's list.
 //
 // The values are the same bits as writing every triangle at once (the row loops' eager
 // update): a sample holds the maximum, over the triangles drawn into its rows, of
@@ -14,14 +14,16 @@
 // loop skipped as hidden behind the reference layer (hidden_behind_reference_layer) are neither
 // listed nor written, as before.
 //
-// Layout: tiles of kDepthTileSubtilesX x kDepthTileSubtilesY subtiles (64 x 16 samples), each
-// with a list of entries, and per group of kDepthGroupSubtileRows subtile rows an arena of
-// records and entries of fixed size. A triangle that does not fit its groups' arenas is written
-// at once by the row loop, into tiles zeroed first: the same values, at the eager cost. Renders
-// that run at the same time write disjoint rows whose bounds are multiples of
-// kDepthGroupSubtileRows (bands, parts of rows), so each group and tile has one writer during a
-// render; queries run after renders, and fill tiles under an atomic state (several threads may
-// query at once).
+// Layout: lists per tile of kDepthTileSubtilesX x kDepthTileSubtilesY subtiles (64 x 16
+// samples), each entry with the subtiles its record reaches in the tile; samples filled per unit
+// of kDepthUnitSubtilesX x kDepthUnitSubtilesY subtiles (16 x 4 samples: a query reads about 3 of
+// a tile's 32 subtiles, and filling whole tiles did ten times the writes needed); per group of
+// kDepthGroupSubtileRows subtile rows an arena of records and entries of fixed size. A triangle
+// that does not fit its groups' arenas is written at once by the row loop, into units zeroed
+// first: the same values, at the eager cost. Renders that run at the same time write disjoint
+// rows whose bounds are multiples of kDepthGroupSubtileRows (bands, parts of rows), so each
+// group, tile and unit has one writer during a render; queries run after renders, and fill units
+// under an atomic state (several threads may query at once).
 #include "raster/rasterize.hpp"
 
 #include <algorithm>
@@ -34,20 +36,27 @@ namespace homcull::detail {
 constexpr int kDepthTileSubtilesX = 8, kDepthTileSubtilesY = 4;
 constexpr int kDepthTileWidth = kDepthTileSubtilesX * kSubtileWidth;    // 64 samples
 constexpr int kDepthTileHeight = kDepthTileSubtilesY * kSubtileHeight;  // 16 samples
-static_assert(kDepthTileWidth % kMaxSimdLanes == 0, "vectors aligned to a tile's columns never write past them");
+constexpr int kDepthUnitSubtilesX = 2, kDepthUnitSubtilesY = 1;
+constexpr int kDepthUnitWidth = kDepthUnitSubtilesX * kSubtileWidth;    // 16 samples
+constexpr int kDepthUnitHeight = kDepthUnitSubtilesY * kSubtileHeight;  // 4 samples
+static_assert(kDepthUnitWidth % kMaxSimdLanes == 0, "vectors aligned to a unit's columns never write past them");
+static_assert(kDepthTileSubtilesX % kDepthUnitSubtilesX == 0 && kDepthTileSubtilesY % kDepthUnitSubtilesY == 0, "tiles of whole units");
 constexpr int kDepthGroupSubtileRows = 8;
 static_assert(kDepthGroupSubtileRows % kDepthTileSubtilesY == 0, "a group holds whole tiles");
 
-// Tile states. A tile's samples are stale (last frame's) until a render writes a triangle into
-// it at once (zeroed first) or a query fills it (zeroed first when stale, then its list). Only
-// queries fill (through filling, under an atomic compare-and-swap); renders touch only their
-// own rows' tiles, with no query running.
-constexpr std::uint8_t kDepthTileStale = 0, kDepthTileZeroed = 1, kDepthTileFilling = 2, kDepthTileFilled = 3;
+// Unit states. A unit's samples are stale (last frame's) until a render writes a triangle into
+// it at once (zeroed first) or a query fills it (zeroed first when stale, then its tile's list).
+// Only queries fill (through filling, under an atomic compare-and-swap); renders touch only their
+// own rows' units, with no query running.
+constexpr std::uint8_t kDepthUnitStale = 0, kDepthUnitZeroed = 1, kDepthUnitFilling = 2, kDepthUnitFilled = 3;
 constexpr std::uint32_t kNoDepthEntry = 0xFFFFFFFFu;
 
 struct DepthTileEntry {
     std::uint32_t record;  // the record's first word in its group's arena
     std::uint32_t next;    // the tile's next entry, kNoDepthEntry at the end
+    // The subtiles of the tile the record reaches, relative to the tile: columns [x0, x1], rows
+    // [y0, y1]; a fill passes over the entries that miss its unit without reading the record.
+    std::uint8_t x0, x1, y0, y1;
 };
 
 // A record: a drawn triangle's depth plane and the coverage intervals of some of its sample rows
@@ -61,64 +70,73 @@ struct DepthRowsRecord {
 constexpr std::uint32_t kDepthRecordHeaderWords = (sizeof(DepthRowsRecord) + 3) / 4;
 
 struct SampleDepthTiles;
-// Applies every triangle of a tile's list to its samples (this instruction set's kernel).
-using FillDepthTileKernel = void (*)(const SampleDepthTiles& tiles, int tx, int ty);
+// Applies every record of a unit's tile that reaches the unit to its samples (this instruction
+// set's kernel).
+using FillDepthUnitKernel = void (*)(const SampleDepthTiles& tiles, int ux, int uy);
 
 // A buffer's per-sample depth and its bookkeeping (the arrays belong to the buffer).
 struct SampleDepthTiles {
     float* depth;          // per sample, rows `stride` apart (padded by kMaxSimdLanes)
     std::size_t stride;
     int sample_width, sample_height;
-    int tiles_x, tiles_y, groups;
-    std::uint8_t* tile_state;      // per tile, row-major
+    int units_x, units_y, tiles_x, tiles_y, groups;
+    std::uint8_t* unit_state;      // per unit, row-major
     std::uint32_t* tile_head;      // per tile, row-major: its first entry (in its group's arena)
     std::int32_t* words;           // the records, group g's from g * word_capacity
     DepthTileEntry* entries;       // group g's from g * entry_capacity
     std::uint32_t* group_words;    // per group: words taken
     std::uint32_t* group_entries;  // per group: entries taken
-    std::uint8_t* any_filled;      // whether a query may have filled a tile since the whole buffer was last reset
+    std::uint8_t* any_filled;      // whether a query may have filled a unit since the whole buffer was last reset
     std::uint32_t word_capacity, entry_capacity;
-    FillDepthTileKernel fill_tile;
+    FillDepthUnitKernel fill_unit;
 
-    std::uint8_t& state(int tx, int ty) const { return tile_state[std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx)]; }
+    std::uint8_t& state(int ux, int uy) const { return unit_state[std::size_t(uy) * std::size_t(units_x) + std::size_t(ux)]; }
 };
 
-// Room per group: 24 words per subtile of the group's rows (about a record of 8 sample rows for
-// every two subtiles), and an entry per two subtiles (the castle's drawn triangles reach about
-// 1.5 tiles each). Fuller groups write at once.
-inline std::uint32_t depth_word_capacity(int subtiles_x) { return std::uint32_t(subtiles_x) * kDepthGroupSubtileRows * 24 + 1024; }
-inline std::uint32_t depth_entry_capacity(int subtiles_x) { return std::uint32_t(subtiles_x) * kDepthGroupSubtileRows + 256; }
+// Room per group: 48 words per subtile of the group's rows (a record of 8 sample rows for every
+// subtile), and four entries per subtile (a large triangle takes one in every tile it crosses).
+// Fuller groups write at once.
+inline std::uint32_t depth_word_capacity(int subtiles_x) { return std::uint32_t(subtiles_x) * kDepthGroupSubtileRows * 48 + 1024; }
+inline std::uint32_t depth_entry_capacity(int subtiles_x) { return std::uint32_t(subtiles_x) * kDepthGroupSubtileRows * 4 + 256; }
 
-// Forgets what subtile rows [row_begin, row_end) held: their tiles empty, their lists and the
-// arenas of their groups (row_begin a multiple of kDepthGroupSubtileRows; row_end too, or the
-// last row).
+// Forgets what subtile rows [row_begin, row_end) held: their units stale, their tiles' lists and
+// the arenas of their groups empty (row_begin a multiple of kDepthGroupSubtileRows; row_end too,
+// or the last row).
 inline void reset_sample_depth_rows(const SampleDepthTiles& t, int row_begin, int row_end) {
-    if (!t.tile_state || row_begin >= row_end) return;
+    if (!t.unit_state || row_begin >= row_end) return;
+    const int unit_row_end = std::min(t.units_y, (row_end + kDepthUnitSubtilesY - 1) / kDepthUnitSubtilesY);
+    for (int uy = row_begin / kDepthUnitSubtilesY; uy < unit_row_end; ++uy)
+        std::fill_n(t.unit_state + std::size_t(uy) * std::size_t(t.units_x), t.units_x, kDepthUnitStale);
     const int tile_row_end = std::min(t.tiles_y, (row_end + kDepthTileSubtilesY - 1) / kDepthTileSubtilesY);
-    for (int ty = row_begin / kDepthTileSubtilesY; ty < tile_row_end; ++ty) {
-        std::fill_n(t.tile_state + std::size_t(ty) * std::size_t(t.tiles_x), t.tiles_x, kDepthTileStale);
+    for (int ty = row_begin / kDepthTileSubtilesY; ty < tile_row_end; ++ty)
         std::fill_n(t.tile_head + std::size_t(ty) * std::size_t(t.tiles_x), t.tiles_x, kNoDepthEntry);
-    }
     const int group_end = std::min(t.groups, (row_end + kDepthGroupSubtileRows - 1) / kDepthGroupSubtileRows);
     for (int g = row_begin / kDepthGroupSubtileRows; g < group_end; ++g) t.group_words[g] = 0, t.group_entries[g] = 0;
-    if (row_begin == 0 && tile_row_end == t.tiles_y) *t.any_filled = 0;
+    if (row_begin == 0 && unit_row_end == t.units_y) *t.any_filled = 0;
 }
 
-// Zeroes a tile's samples (the last column of tiles ends at the rows' padding).
-inline void zero_depth_tile(const SampleDepthTiles& t, int tx, int ty) {
-    const int row_end = std::min(t.sample_height, (ty + 1) * kDepthTileHeight);
-    const std::size_t x0 = std::size_t(tx) * kDepthTileWidth, width = std::min<std::size_t>(kDepthTileWidth, t.stride - x0);
-    for (int row = ty * kDepthTileHeight; row < row_end; ++row) std::fill_n(t.depth + std::size_t(row) * t.stride + x0, width, 0.0f);
+// Zeroes a unit's samples (the last column of units ends at the rows' padding).
+inline void zero_depth_unit(const SampleDepthTiles& t, int ux, int uy) {
+    const int row_end = std::min(t.sample_height, (uy + 1) * kDepthUnitHeight);
+    const std::size_t x0 = std::size_t(ux) * kDepthUnitWidth, width = std::min<std::size_t>(kDepthUnitWidth, t.stride - x0);
+    for (int row = uy * kDepthUnitHeight; row < row_end; ++row) std::fill_n(t.depth + std::size_t(row) * t.stride + x0, width, 0.0f);
 }
 
-// Calls visit(record) for every record in tile (tx, ty)'s list.
+// Calls visit(record) for every record of unit (ux, uy)'s tile that reaches the unit.
 template <typename Visit>
-void for_each_in_depth_tile(const SampleDepthTiles& t, int tx, int ty, Visit&& visit) {
+void for_each_in_depth_unit(const SampleDepthTiles& t, int ux, int uy, Visit&& visit) {
+    constexpr int kUnitsX = kDepthTileSubtilesX / kDepthUnitSubtilesX, kUnitsY = kDepthTileSubtilesY / kDepthUnitSubtilesY;
+    const int tx = ux / kUnitsX, ty = uy / kUnitsY;
+    const int x0 = (ux % kUnitsX) * kDepthUnitSubtilesX, x1 = x0 + kDepthUnitSubtilesX - 1;
+    const int y0 = (uy % kUnitsY) * kDepthUnitSubtilesY, y1 = y0 + kDepthUnitSubtilesY - 1;
     const int group = ty * kDepthTileSubtilesY / kDepthGroupSubtileRows;
     const std::int32_t* words = t.words + std::size_t(group) * t.word_capacity;
     const DepthTileEntry* entries = t.entries + std::size_t(group) * t.entry_capacity;
-    for (std::uint32_t e = t.tile_head[std::size_t(ty) * std::size_t(t.tiles_x) + std::size_t(tx)]; e != kNoDepthEntry; e = entries[e].next)
-        visit(words + entries[e].record);
+    for (std::uint32_t e = t.tile_head[std::size_t(ty) * std::size_t(t.tiles_x) + std::size_t(tx)]; e != kNoDepthEntry;) {
+        const DepthTileEntry& entry = entries[e];
+        if (entry.x0 <= x1 && entry.x1 >= x0 && entry.y0 <= y1 && entry.y1 >= y0) visit(words + entry.record);
+        e = entry.next;
+    }
 }
 
 // A record's header and intervals.
@@ -130,46 +148,46 @@ inline DepthRowsRecord depth_record_header(const std::int32_t* record) {
 inline const std::int32_t* depth_record_first(const std::int32_t* record) { return record + kDepthRecordHeaderWords; }
 inline const std::int32_t* depth_record_last(const std::int32_t* record, int rows) { return record + kDepthRecordHeaderWords + rows; }
 
-// Makes tile (tx, ty) hold its samples' depth before a query reads it: fills it (zeroed first
+// Makes unit (ux, uy) hold its samples' depth before a query reads it: fills it (zeroed first
 // when stale), or waits while another thread fills it.
-inline void ensure_depth_tile(const SampleDepthTiles& t, int tx, int ty) {
-    std::uint8_t* state = &t.state(tx, ty);
+inline void ensure_depth_unit(const SampleDepthTiles& t, int ux, int uy) {
+    std::uint8_t* state = &t.state(ux, uy);
     // C++17 has no atomic_ref, and the states live in the buffer's plain arrays (resized with
     // the buffer, which std::atomic elements cannot be): the GCC and Clang builtins, as
     // std::atomic_ref would compile to.
     for (;;) {
         std::uint8_t seen = __atomic_load_n(state, __ATOMIC_ACQUIRE);
-        if (seen == kDepthTileFilled) return;
-        if (seen == kDepthTileFilling) {
+        if (seen == kDepthUnitFilled) return;
+        if (seen == kDepthUnitFilling) {
             std::this_thread::yield();
             continue;
         }
-        if (__atomic_compare_exchange_n(state, &seen, kDepthTileFilling, false, __ATOMIC_ACQUIRE, __ATOMIC_ACQUIRE)) {
+        if (__atomic_compare_exchange_n(state, &seen, kDepthUnitFilling, false, __ATOMIC_ACQUIRE, __ATOMIC_ACQUIRE)) {
             __atomic_store_n(t.any_filled, std::uint8_t(1), __ATOMIC_RELAXED);
-            if (seen == kDepthTileStale) zero_depth_tile(t, tx, ty);
-            t.fill_tile(t, tx, ty);
-            __atomic_store_n(state, kDepthTileFilled, __ATOMIC_RELEASE);
+            if (seen == kDepthUnitStale) zero_depth_unit(t, ux, uy);
+            t.fill_unit(t, ux, uy);
+            __atomic_store_n(state, kDepthUnitFilled, __ATOMIC_RELEASE);
             return;
         }
     }
 }
 
-// The tile of subtile (tx, ty), made ready (ensure_depth_tile).
+// The unit of subtile (tx, ty), made ready (ensure_depth_unit).
 inline void ensure_depth_subtile(const SampleDepthTiles& t, int tx, int ty) {
-    ensure_depth_tile(t, tx / kDepthTileSubtilesX, ty / kDepthTileSubtilesY);
+    ensure_depth_unit(t, tx / kDepthUnitSubtilesX, ty / kDepthUnitSubtilesY);
 }
 
-// Every tile made ready (read-backs of the whole per-sample depth).
-inline void ensure_all_depth_tiles(const SampleDepthTiles& t) {
-    for (int ty = 0; ty < t.tiles_y; ++ty)
-        for (int tx = 0; tx < t.tiles_x; ++tx) ensure_depth_tile(t, tx, ty);
+// Every unit made ready (read-backs of the whole per-sample depth).
+inline void ensure_all_depth_units(const SampleDepthTiles& t) {
+    for (int uy = 0; uy < t.units_y; ++uy)
+        for (int ux = 0; ux < t.units_x; ++ux) ensure_depth_unit(t, ux, uy);
 }
 
 // Whether a triangle about to be drawn into subtile rows [ty0, ty1] goes into the tiles' lists
 // (record_sample_depth with each chunk's intervals): whether every group's arena it reaches has
 // room (a large triangle takes an entry in each of its tiles, which costs less than writing its
-// samples: most lie in tiles no query reads). Otherwise the row loop writes it at once, and this
-// zeroes its stale tiles first.
+// samples: most lie in units no query reads). Otherwise the row loop writes it at once, and this
+// zeroes its stale units first.
 inline bool list_sample_depth(const SampleDepthTiles& t, const RasterTriangle& tri, int ty0, int ty1) {
     constexpr int kH = kSubtileHeight;
     const int tx0 = tri.i0 / kDepthTileWidth, tx1 = std::min(t.tiles_x - 1, tri.i1 / kDepthTileWidth);
@@ -183,18 +201,20 @@ inline bool list_sample_depth(const SampleDepthTiles& t, const RasterTriangle& t
         room = t.group_words[group] + words <= t.word_capacity && t.group_entries[group] + entries <= t.entry_capacity;
     }
     if (room) return true;
-    for (int ty = ty0 / kDepthTileSubtilesY; ty <= ty1 / kDepthTileSubtilesY; ++ty)
-        for (int tx = tx0; tx <= tx1; ++tx) {
-            std::uint8_t& state = t.state(tx, ty);
-            if (state == kDepthTileStale) zero_depth_tile(t, tx, ty), state = kDepthTileZeroed;
+    const int ux0 = tri.i0 / kDepthUnitWidth, ux1 = std::min(t.units_x - 1, tri.i1 / kDepthUnitWidth);
+    for (int uy = ty0 / kDepthUnitSubtilesY; uy <= ty1 / kDepthUnitSubtilesY; ++uy)
+        for (int ux = ux0; ux <= ux1; ++ux) {
+            std::uint8_t& state = t.state(ux, uy);
+            if (state == kDepthUnitStale) zero_depth_unit(t, ux, uy), state = kDepthUnitZeroed;
         }
     return false;
 }
 
 // Lists the sample rows [row0, row0 + rows) of a triangle being drawn (list_sample_depth said so)
 // with their intervals [first[r], last[r]] within columns [i0, i1]: a record in each group's arena
-// the rows with samples reach, and an entry in each of their tiles' lists. Tiles already filled
-// (a query read them since the frame began) take the record at once through apply(record, tx, ty).
+// the rows with samples reach, and an entry in each of their tiles' lists. Units already filled
+// (a query read them since the frame began) take the record at once through
+// apply(record, ux, uy).
 template <typename Apply>
 void record_sample_depth(const SampleDepthTiles& t, const PreparedTriangle& plane, int i0, int i1, int row0, int rows,
                          const std::int32_t* first, const std::int32_t* last, Apply&& apply) {
@@ -202,7 +222,7 @@ void record_sample_depth(const SampleDepthTiles& t, const PreparedTriangle& plan
     int begin = 0, end = rows;  // the rows with samples
     while (begin < end && first[begin] > last[begin]) ++begin;
     while (end > begin && first[end - 1] > last[end - 1]) --end;
-    const int tx0 = i0 / kDepthTileWidth, tx1 = std::min(t.tiles_x - 1, i1 / kDepthTileWidth);
+    const int sx0 = i0 / kSubtileWidth, sx1 = std::min(t.units_x * kDepthUnitSubtilesX - 1, i1 / kSubtileWidth);  // subtile columns
     const bool any_filled = *t.any_filled != 0;
     for (int r = begin; r < end;) {
         const int row = row0 + r, group = row / kGroupRows;
@@ -215,13 +235,20 @@ void record_sample_depth(const SampleDepthTiles& t, const PreparedTriangle& plan
         std::memcpy(words + record + kDepthRecordHeaderWords, first + r, sizeof(std::int32_t) * std::size_t(n));
         std::memcpy(words + record + kDepthRecordHeaderWords + n, last + r, sizeof(std::int32_t) * std::size_t(n));
         DepthTileEntry* entries = t.entries + std::size_t(group) * t.entry_capacity;
-        for (int ty = row / kDepthTileHeight; ty <= (row + n - 1) / kDepthTileHeight; ++ty)
-            for (int tx = tx0; tx <= tx1; ++tx) {
+        const int sy0 = row / kSubtileHeight, sy1 = (row + n - 1) / kSubtileHeight;  // subtile rows
+        for (int ty = sy0 / kDepthTileSubtilesY; ty <= sy1 / kDepthTileSubtilesY; ++ty)
+            for (int tx = sx0 / kDepthTileSubtilesX; tx <= sx1 / kDepthTileSubtilesX; ++tx) {
+                const int bx0 = tx * kDepthTileSubtilesX, by0 = ty * kDepthTileSubtilesY;
+                const int x0 = std::max(sx0, bx0), x1 = std::min(sx1, bx0 + kDepthTileSubtilesX - 1);
+                const int y0 = std::max(sy0, by0), y1 = std::min(sy1, by0 + kDepthTileSubtilesY - 1);
                 const std::uint32_t e = t.group_entries[group]++;
                 std::uint32_t& head = t.tile_head[std::size_t(ty) * std::size_t(t.tiles_x) + std::size_t(tx)];
-                entries[e] = {record, head};
+                entries[e] = {record, head, std::uint8_t(x0 - bx0), std::uint8_t(x1 - bx0), std::uint8_t(y0 - by0), std::uint8_t(y1 - by0)};
                 head = e;
-                if (any_filled && t.state(tx, ty) == kDepthTileFilled) apply(words + record, tx, ty);  // its fill is past
+                if (!any_filled) continue;
+                for (int uy = y0 / kDepthUnitSubtilesY; uy <= y1 / kDepthUnitSubtilesY; ++uy)  // units whose fill is past
+                    for (int ux = x0 / kDepthUnitSubtilesX; ux <= x1 / kDepthUnitSubtilesX; ++ux)
+                        if (t.state(ux, uy) == kDepthUnitFilled) apply(words + record, ux, uy);
             }
         r += n;
     }
@@ -234,8 +261,8 @@ void set_deferred_sample_depth(bool enabled);
 bool deferred_sample_depth_enabled();
 
 // The reference's fill and its one-record step: conservative_depth at each sample of a record's
-// intervals within the tile, kept where larger (update_sample_depth's operations).
-void apply_depth_record_reference(const SampleDepthTiles& t, const std::int32_t* record, int tx, int ty);
-void fill_depth_tile_reference(const SampleDepthTiles& t, int tx, int ty);
+// intervals within the unit, kept where larger (update_sample_depth's operations).
+void apply_depth_record_reference(const SampleDepthTiles& t, const std::int32_t* record, int ux, int uy);
+void fill_depth_unit_reference(const SampleDepthTiles& t, int ux, int uy);
 
 }  // namespace homcull::detail
