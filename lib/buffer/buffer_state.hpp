@@ -112,11 +112,10 @@ public:
     // config_.sample_depth and deferred_sample_depth_enabled() at configure: its units' states, its
     // tiles' lists, and per group of rows the records and list entries with their counts.
     bool deferred_sample_depth_ = false;
-    Vector<std::uint8_t> depth_unit_state_;
+    Vector<std::uint8_t> depth_unit_state_, depth_group_filled_;
     Vector<std::uint32_t> depth_tile_head_, depth_group_words_, depth_group_entries_;
     Vector<std::int32_t> depth_words_;
     Vector<DepthTileEntry> depth_entries_;
-    std::uint8_t depth_any_filled_ = 0;
     SampleDepthTiles depth_tiles_{};  // points into the arrays above (set by configure and reserve)
     void point_depth_tiles();
     std::size_t at(int tx, int ty) const { return std::size_t(ty) * stride_ + std::size_t(tx); }

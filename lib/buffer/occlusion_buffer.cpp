@@ -119,6 +119,7 @@ void detail::BufferState::reserve_arrays(const detail::BufferSizes& z) {
     sample_depth_.reserve(z.sample_depth);
     depth_unit_state_.reserve(z.depth_units), depth_tile_head_.reserve(z.depth_tiles);
     depth_group_words_.reserve(std::size_t(z.depth_groups)), depth_group_entries_.reserve(std::size_t(z.depth_groups));
+    depth_group_filled_.reserve(std::size_t(z.depth_groups));
     depth_words_.reserve(z.depth_words), depth_entries_.reserve(z.depth_entries);
     band_updated_.reserve(z.bands);
     levels_.reserve(z.levels), level_offset_.reserve(z.levels), level_width_.reserve(z.levels);
@@ -154,10 +155,10 @@ void detail::BufferState::configure(const BufferConfig& config) {
     depth_unit_state_.assign(z.depth_units, detail::kDepthUnitStale);
     depth_tile_head_.assign(z.depth_tiles, detail::kNoDepthEntry);
     depth_group_words_.assign(std::size_t(z.depth_groups), 0u);
+    depth_group_filled_.assign(std::size_t(z.depth_groups), 0);
     depth_group_entries_.assign(std::size_t(z.depth_groups), 0u);
     depth_words_.resize(z.depth_words);
     depth_entries_.resize(z.depth_entries);
-    depth_any_filled_ = 0;
     depth_tiles_ = {};
     depth_tiles_.sample_width = z.sample_width, depth_tiles_.sample_height = z.sample_height;
     depth_tiles_.units_x = z.depth_units_x, depth_tiles_.units_y = z.depth_units_y;
@@ -197,7 +198,7 @@ void detail::BufferState::point_depth_tiles() {
     t.entries = kept ? depth_entries_.data() : nullptr;
     t.group_words = kept ? depth_group_words_.data() : nullptr;
     t.group_entries = kept ? depth_group_entries_.data() : nullptr;
-    t.any_filled = &depth_any_filled_;
+    t.group_filled = kept ? depth_group_filled_.data() : nullptr;
     t.fill_unit = kernels_->raster.fill_depth_unit;
 }
 

@@ -86,7 +86,7 @@ struct SampleDepthTiles {
     DepthTileEntry* entries;       // group g's from g * entry_capacity
     std::uint32_t* group_words;    // per group: words taken
     std::uint32_t* group_entries;  // per group: entries taken
-    std::uint8_t* any_filled;      // whether a query may have filled a unit since the whole buffer was last reset
+    std::uint8_t* group_filled;    // per group: whether a query may have filled one of its units since its rows were last reset
     std::uint32_t word_capacity, entry_capacity;
     FillDepthUnitKernel fill_unit;
 
@@ -111,8 +111,7 @@ inline void reset_sample_depth_rows(const SampleDepthTiles& t, int row_begin, in
     for (int ty = row_begin / kDepthTileSubtilesY; ty < tile_row_end; ++ty)
         std::fill_n(t.tile_head + std::size_t(ty) * std::size_t(t.tiles_x), t.tiles_x, kNoDepthEntry);
     const int group_end = std::min(t.groups, (row_end + kDepthGroupSubtileRows - 1) / kDepthGroupSubtileRows);
-    for (int g = row_begin / kDepthGroupSubtileRows; g < group_end; ++g) t.group_words[g] = 0, t.group_entries[g] = 0;
-    if (row_begin == 0 && unit_row_end == t.units_y) *t.any_filled = 0;
+    for (int g = row_begin / kDepthGroupSubtileRows; g < group_end; ++g) t.group_words[g] = 0, t.group_entries[g] = 0, t.group_filled[g] = 0;
 }
 
 // Zeroes a unit's samples (the last column of units ends at the rows' padding).
@@ -163,7 +162,10 @@ inline void ensure_depth_unit(const SampleDepthTiles& t, int ux, int uy) {
             continue;
         }
         if (__atomic_compare_exchange_n(state, &seen, kDepthUnitFilling, false, __ATOMIC_ACQUIRE, __ATOMIC_ACQUIRE)) {
-            __atomic_store_n(t.any_filled, std::uint8_t(1), __ATOMIC_RELAXED);
+            // Written once per group and frame: a store per fill would bounce the line between
+            // the querying threads.
+            std::uint8_t* filled = &t.group_filled[uy * kDepthUnitSubtilesY / kDepthGroupSubtileRows];
+            if (!__atomic_load_n(filled, __ATOMIC_RELAXED)) __atomic_store_n(filled, std::uint8_t(1), __ATOMIC_RELAXED);
             if (seen == kDepthUnitStale) zero_depth_unit(t, ux, uy);
             t.fill_unit(t, ux, uy);
             __atomic_store_n(state, kDepthUnitFilled, __ATOMIC_RELEASE);
@@ -223,10 +225,10 @@ void record_sample_depth(const SampleDepthTiles& t, const PreparedTriangle& plan
     while (begin < end && first[begin] > last[begin]) ++begin;
     while (end > begin && first[end - 1] > last[end - 1]) --end;
     const int sx0 = i0 / kSubtileWidth, sx1 = std::min(t.units_x * kDepthUnitSubtilesX - 1, i1 / kSubtileWidth);  // subtile columns
-    const bool any_filled = *t.any_filled != 0;
     for (int r = begin; r < end;) {
         const int row = row0 + r, group = row / kGroupRows;
         const int n = std::min(end - r, (group + 1) * kGroupRows - row);
+        const bool any_filled = t.group_filled[group] != 0;
         std::int32_t* words = t.words + std::size_t(group) * t.word_capacity;
         const std::uint32_t record = t.group_words[group];
         t.group_words[group] = record + kDepthRecordHeaderWords + 2 * std::uint32_t(n);
