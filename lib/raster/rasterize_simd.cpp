@@ -249,6 +249,20 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
 }
 #endif  // HOMCULL_SUBTILE_LANES
 
+// One vector of a sample row's per-sample depth: conservative_depth at the sample centres xs
+// (row_part = a + dzdy y, the row's part), kept where larger than what the samples hold, in the
+// lanes of in_interval; the other lanes are written back as read. The float operations of the
+// reference's update_sample_depth, so the eager writes and the deferred fills give its bits.
+template <class D, class M>
+HWY_INLINE void RaiseSampleDepth(D df, float* depth, hn::Vec<D> xs, hn::Vec<D> row_part, hn::Vec<D> dzdx, hn::Vec<D> error,
+                                 hn::Vec<D> z_vertex_min, hn::Vec<D> lower, M in_interval) {
+    const auto lowered = hn::Sub(hn::Add(row_part, hn::Mul(dzdx, xs)), error);
+    const auto bound = hn::Mul(hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered), lower);
+    const auto old = hn::LoadU(df, depth);
+    // std::max(old, bound): bound where old < bound.
+    hn::StoreU(hn::IfThenElse(hn::And(in_interval, hn::Lt(old, bound)), bound, old), df, depth);
+}
+
 // update_sample_depth for one subtile row, the samples of a sample row as lanes: each lane
 // evaluates conservative_depth with the same float operations (the row's part, a + dzdy y,
 // once per row: the same rounding for every sample) and keeps the larger. Whole vectors are
@@ -272,13 +286,7 @@ HWY_INLINE void UpdateSampleDepth(const SubtilePlanes& planes, int ty, const std
         // integer plus a half below 2^23, exact in float, so the steps round nothing.
         auto xs = hn::Add(hn::ConvertTo(df, hn::Add(lane, hn::Set(di, first[j]))), half);
         const auto step = hn::Set(df, float(lanes));
-        const auto update = [&](int x, auto in_interval) {
-            const auto lowered = hn::Sub(hn::Add(row_part, hn::Mul(dzdx, xs)), error);
-            const auto bound = hn::Mul(hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered), lower);
-            const auto old = hn::LoadU(df, depth + x);
-            // std::max(old, bound): bound where old < bound.
-            hn::StoreU(hn::IfThenElse(hn::And(in_interval, hn::Lt(old, bound)), bound, old), df, depth + x);
-        };
+        const auto update = [&](int x, auto in_interval) { RaiseSampleDepth(df, depth + x, xs, row_part, dzdx, error, z_vertex_min, lower, in_interval); };
         int x = first[j];
         for (; x + lanes - 1 <= last[j]; x += lanes, xs = hn::Add(xs, step)) update(x, hn::FirstN(df, std::size_t(lanes)));
         if (x <= last[j]) update(x, hn::FirstN(df, std::size_t(last[j] - x + 1)));
@@ -434,11 +442,7 @@ HWY_INLINE void ApplyDepthRecord(const SampleDepthTiles& t, const std::int32_t* 
         for (int x = x0 + (lo - x0) / lanes * lanes; x <= hi; x += lanes) {
             const auto column = hn::Add(lane, hn::Set(di, x));
             const auto in_interval = hn::RebindMask(df, hn::And(hn::Not(hn::Lt(column, lo_v)), hn::Not(hn::Gt(column, hi_v))));
-            const auto xs = hn::Add(hn::ConvertTo(df, column), half);
-            const auto lowered = hn::Sub(hn::Add(row_part, hn::Mul(dzdx, xs)), error);
-            const auto bound = hn::Mul(hn::IfThenElse(hn::Lt(lowered, z_vertex_min), z_vertex_min, lowered), lower);
-            const auto old = hn::LoadU(df, depth + x);
-            hn::StoreU(hn::IfThenElse(hn::And(in_interval, hn::Lt(old, bound)), bound, old), df, depth + x);
+            RaiseSampleDepth(df, depth + x, hn::Add(hn::ConvertTo(df, column), half), row_part, dzdx, error, z_vertex_min, lower, in_interval);
         }
     }
 }
