@@ -160,7 +160,7 @@ void detail::BufferState::configure(const BufferConfig& config) {
     depth_words_.resize(z.depth_words);
     depth_entries_.resize(z.depth_entries);
     depth_tiles_ = {};
-    depth_tiles_.sample_width = z.sample_width, depth_tiles_.sample_height = z.sample_height;
+    depth_tiles_.sample_height = z.sample_height;
     depth_tiles_.units_x = z.depth_units_x, depth_tiles_.units_y = z.depth_units_y;
     depth_tiles_.tiles_x = z.depth_tiles_x, depth_tiles_.tiles_y = z.depth_tiles_y, depth_tiles_.groups = z.depth_groups;
     depth_tiles_.word_capacity = z.depth_word_capacity, depth_tiles_.entry_capacity = z.depth_entry_capacity;

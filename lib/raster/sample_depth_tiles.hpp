@@ -78,7 +78,7 @@ using FillDepthUnitKernel = void (*)(const SampleDepthTiles& tiles, int ux, int 
 struct SampleDepthTiles {
     float* depth;          // per sample, rows `stride` apart (padded by kMaxSimdLanes)
     std::size_t stride;
-    int sample_width, sample_height;
+    int sample_height;
     int units_x, units_y, tiles_x, tiles_y, groups;
     std::uint8_t* unit_state;      // per unit, row-major
     std::uint32_t* tile_head;      // per tile, row-major: its first entry (in its group's arena)
