@@ -112,8 +112,9 @@ public:
     // config_.sample_depth and deferred_sample_depth_enabled() at configure: its units' states, its
     // tiles' lists, and per group of rows the records and list entries with their counts.
     bool deferred_sample_depth_ = false;
-    Vector<std::uint8_t> depth_unit_state_, depth_group_filled_;
-    Vector<std::uint32_t> depth_tile_head_, depth_group_words_, depth_group_entries_;
+    Vector<std::uint8_t> depth_unit_state_;
+    Vector<std::uint32_t> depth_tile_head_;
+    Vector<DepthGroupCursor> depth_groups_;
     Vector<std::int32_t> depth_words_;
     Vector<DepthTileEntry> depth_entries_;
     SampleDepthTiles depth_tiles_{};  // points into the arrays above (set by configure and reserve)
@@ -186,6 +187,11 @@ public:
     std::size_t task_list_vertices_ = 0;        // the most vertices of a cluster recorded (the band caches' size)
     Vector<ClusteredInput> recorded_draws_;  // PlacedCluster::draw numbers them
     Vector<std::uint8_t> band_ran_;     // per band: its task ran (finish_tasks checks them all)
+    // Task i of a closed list draws band band_order_[i]: the bands by their time in the last task
+    // list (band_seconds_), longest first, so that threads taking tasks in turn finish together.
+    Vector<std::uint32_t> band_order_;
+    Vector<float> band_seconds_;
+    void run_band(std::size_t band) noexcept;
     Vector<RasterTriangle> setup_triangles_;  // each ClusterSetup's room, one after the other
     // Where a cluster's box lands (in view, outside, or no triangles). In job-system tasks: noexcept.
     void place_cluster(const OccluderCluster& c, std::uint32_t number, const std::array<float, 16>& model_to_clip, Backface backface,

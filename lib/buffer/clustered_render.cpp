@@ -13,6 +13,8 @@
 #include "raster/triangle_batch.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <new>
 #include <string>
 #include <thread>
@@ -169,17 +171,17 @@ struct detail::BufferState::ClusterPass {
         row_end = std::min(row_begin + kBandSubtileRows, b.subtiles_y_);
     }
     // Whether a band draws a cluster (its box reaches the band and is not hidden there),
-    // counting the answer in the band's statistics.
-    bool draws(const PlacedCluster& p, std::size_t band, const detail::SubtilePlanes& planes) const {
+    // counting the answer in the band's statistics `stats`.
+    bool draws(const PlacedCluster& p, std::size_t band, const detail::SubtilePlanes& planes, RasterStats& stats) const {
         int row_begin, row_end;
         band_rows(band, row_begin, row_end);
         int ty0, ty1;
         if (!detail::subtile_rows_within(p.j0, p.j1, row_begin, row_end, ty0, ty1)) return false;
         if (p.testable && hidden_test(planes, p.i0 / kW, p.i1 / kW, ty0, ty1, p.d_near)) {
-            ++b.band_stats_[band].cluster_bands_hidden;
+            ++stats.cluster_bands_hidden;
             return false;
         }
-        ++b.band_stats_[band].cluster_bands_drawn;
+        ++stats.cluster_bands_drawn;
         return true;
     }
     // No per-triangle hidden test in the setup (drawn_into null): the cluster's box just passed
@@ -201,8 +203,18 @@ void detail::BufferState::render_clusters(const ClusteredInput& in, const Parall
         begin_tasks(clear_first);
         try {
             record(in, parallel);
-            const std::size_t tasks = close_tasks();
-            detail::run_tasks(parallel, tasks, [](void* self, std::size_t band) { static_cast<detail::BufferState*>(self)->run_task(band); }, this);
+            // As many tasks as threads, each taking the next band from a counter: the longest
+            // bands first (close_tasks), each thread one when it is free.
+            struct Job {
+                detail::BufferState* self;
+                std::size_t tasks;
+                std::atomic<std::size_t> next{0};
+            } job{this, close_tasks()};
+            const std::size_t takers = parallel.threads == 0 ? job.tasks : std::min(job.tasks, parallel.threads);
+            detail::run_tasks(parallel, takers, [](void* data, std::size_t) {
+                Job& j = *static_cast<Job*>(data);
+                for (std::size_t i = j.next++; i < j.tasks; i = j.next++) j.self->run_task(i);
+            }, &job);
         } catch (...) {
             finish_tasks(std::nothrow);  // what ran stays, with a pyramid to match
             throw;
@@ -237,7 +249,7 @@ void detail::BufferState::render_clusters(const ClusteredInput& in, const Parall
         runs.clear();
         std::uint64_t drawn = 0;
         for (std::size_t band = std::size_t(p.j0 / kH / kBandSubtileRows); band <= std::size_t(p.j1 / kH / kBandSubtileRows); ++band) {
-            if (!pass.draws(p, band, whole.planes)) continue;
+            if (!pass.draws(p, band, whole.planes, band_stats_[band])) continue;
             ++drawn;
             int row_begin, row_end;
             pass.band_rows(band, row_begin, row_end);
@@ -295,6 +307,11 @@ std::size_t detail::BufferState::close_tasks() {
     if (cluster_setups_.size() < placed_clusters_.size()) cluster_setups_.resize(placed_clusters_.size());
     band_stats_.assign(bands, RasterStats{});
     band_ran_.assign(bands, 0);
+    band_order_.resize(bands);
+    for (std::size_t band = 0; band < bands; ++band) band_order_[band] = std::uint32_t(band);
+    std::sort(band_order_.begin(), band_order_.end(), [&](std::uint32_t a, std::uint32_t b) {  // std::stable_sort would allocate
+        return band_seconds_[a] > band_seconds_[b] || (band_seconds_[a] == band_seconds_[b] && a < b);
+    });
 
     std::size_t first = 0;
     for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
@@ -311,12 +328,21 @@ std::size_t detail::BufferState::close_tasks() {
     return bands;
 }
 
+// Task `index` draws the index-th longest band of the last task list (close_tasks' order): the
+// bands cost what their rows hold, which moves little from frame to frame, and threads that take
+// the tasks in turn then finish together (on castle view C0 the longest of the six bands took
+// 30 % of the render, and taken last it left the other thread idle).
+void detail::BufferState::run_task(std::size_t index) noexcept {
+    if (task_list_ != TaskList::closed || index >= band_order_.size()) return;  // finish_tasks reports the bands that did not run
+    run_band(band_order_[index]);
+}
+
 // Band `band` walks the clusters in order and decides on its own rows, as the serial loop does.
 // A cluster is set up by the first band that draws it, its triangles kept for the others (which
 // wait for them: a band setting one up depends on no other task, so the wait is short and cannot
 // deadlock): no bins, and no cluster set up twice unless it outgrows its room.
-void detail::BufferState::run_task(std::size_t band) noexcept {
-    if (task_list_ != TaskList::closed || band >= band_ran_.size()) return;  // finish_tasks reports the bands that did not run
+void detail::BufferState::run_band(std::size_t band) noexcept {
+    const auto start = std::chrono::steady_clock::now();
     const detail::StandardFloatMode mode;
     const ClusterPass pass{*this};
     int row_begin, row_end;
@@ -324,14 +350,19 @@ void detail::BufferState::run_task(std::size_t band) noexcept {
     if (task_list_clears_) clear_rows(row_begin, row_end);
     const detail::RasterTarget target = raster_target(row_begin, row_end);
     const detail::VertexClip cache = pass.cache(band);
-    RasterStats& stats = band_stats_[band];
+    // Counted here and stored once at the end: the bands' statistics lie side by side, and a
+    // count per triangle in them would bounce their cache lines between the threads.
+    RasterStats stats;
     const auto draw = [&](const detail::RasterTriangle& tri) { stats.subtiles_updated += target.kernel(target, tri); };
     for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
         const PlacedCluster& p = placed_clusters_[k];
-        if (!pass.draws(p, band, target.planes)) continue;
+        if (!pass.draws(p, band, target.planes, stats)) continue;
         ClusterSetup& s = cluster_setups_[k];
-        int expected = ClusterSetup::kNotSetUp;
-        if (s.state.compare_exchange_strong(expected, ClusterSetup::kSettingUp, std::memory_order_acquire)) {
+        // Read before the exchange: most clusters a band draws are set up already, and an
+        // exchange would take the line from the thread that set it up.
+        int expected = s.state.load(std::memory_order_acquire);
+        if (expected == ClusterSetup::kNotSetUp &&
+            s.state.compare_exchange_strong(expected, ClusterSetup::kSettingUp, std::memory_order_acquire)) {
             std::size_t made = 0;
             pass.set_up(p, cache, s.stats, [&](const detail::RasterTriangle& tri) {
                 if (made < s.room) setup_triangles_[s.first + made] = tri;
@@ -341,7 +372,10 @@ void detail::BufferState::run_task(std::size_t band) noexcept {
             expected = made <= s.room ? ClusterSetup::kReady : ClusterSetup::kEach;
             s.state.store(expected, std::memory_order_release);
         } else {
-            while ((expected = s.state.load(std::memory_order_acquire)) == ClusterSetup::kSettingUp) std::this_thread::yield();
+            while (expected == ClusterSetup::kSettingUp) {
+                std::this_thread::yield();
+                expected = s.state.load(std::memory_order_acquire);
+            }
         }
         if (expected == ClusterSetup::kEach) {  // set up again here, drawn as it comes
             RasterStats own;
@@ -352,8 +386,10 @@ void detail::BufferState::run_task(std::size_t band) noexcept {
         stats += s.stats;  // the setup's counts once per band that draws the cluster, as on one thread
         for (std::size_t t = 0; t < s.count; ++t) draw(setup_triangles_[s.first + t]);
     }
+    band_stats_[band] = stats;
     build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(levels_.size()) - 1));
     band_ran_[band] = 1;
+    band_seconds_[band] = std::chrono::duration<float>(std::chrono::steady_clock::now() - start).count();
 }
 
 std::size_t detail::BufferState::finish_tasks(std::nothrow_t) noexcept {

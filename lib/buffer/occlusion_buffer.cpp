@@ -118,10 +118,9 @@ void detail::BufferState::reserve_arrays(const detail::BufferSizes& z) {
     d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
     sample_depth_.reserve(z.sample_depth);
     depth_unit_state_.reserve(z.depth_units), depth_tile_head_.reserve(z.depth_tiles);
-    depth_group_words_.reserve(std::size_t(z.depth_groups)), depth_group_entries_.reserve(std::size_t(z.depth_groups));
-    depth_group_filled_.reserve(std::size_t(z.depth_groups));
+    depth_groups_.reserve(std::size_t(z.depth_groups));
     depth_words_.reserve(z.depth_words), depth_entries_.reserve(z.depth_entries);
-    band_updated_.reserve(z.bands);
+    band_updated_.reserve(z.bands), band_seconds_.reserve(z.bands);
     levels_.reserve(z.levels), level_offset_.reserve(z.levels), level_width_.reserve(z.levels);
     pyramid_.reserve(z.pyramid);
     reference_cells_.reserve(z.cells);
@@ -154,9 +153,7 @@ void detail::BufferState::configure(const BufferConfig& config) {
     deferred_sample_depth_ = config.sample_depth && detail::deferred_sample_depth_enabled();
     depth_unit_state_.assign(z.depth_units, detail::kDepthUnitStale);
     depth_tile_head_.assign(z.depth_tiles, detail::kNoDepthEntry);
-    depth_group_words_.assign(std::size_t(z.depth_groups), 0u);
-    depth_group_filled_.assign(std::size_t(z.depth_groups), 0);
-    depth_group_entries_.assign(std::size_t(z.depth_groups), 0u);
+    depth_groups_.assign(std::size_t(z.depth_groups), detail::DepthGroupCursor{});
     depth_words_.resize(z.depth_words);
     depth_entries_.resize(z.depth_entries);
     depth_tiles_ = {};
@@ -165,6 +162,7 @@ void detail::BufferState::configure(const BufferConfig& config) {
     depth_tiles_.tiles_x = z.depth_tiles_x, depth_tiles_.tiles_y = z.depth_tiles_y, depth_tiles_.groups = z.depth_groups;
     depth_tiles_.word_capacity = z.depth_word_capacity, depth_tiles_.entry_capacity = z.depth_entry_capacity;
     band_updated_.assign(z.bands, 0);
+    band_seconds_.assign(z.bands, 0.0f);
     levels_.clear();
     levels_.push_back({subtiles_x_, subtiles_y_, 0});  // level 0: a contiguous copy of the subtiles' d0
     std::size_t size = std::size_t(subtiles_x_) * std::size_t(subtiles_y_);
@@ -196,9 +194,7 @@ void detail::BufferState::point_depth_tiles() {
     t.tile_head = kept ? depth_tile_head_.data() : nullptr;
     t.words = kept ? depth_words_.data() : nullptr;
     t.entries = kept ? depth_entries_.data() : nullptr;
-    t.group_words = kept ? depth_group_words_.data() : nullptr;
-    t.group_entries = kept ? depth_group_entries_.data() : nullptr;
-    t.group_filled = kept ? depth_group_filled_.data() : nullptr;
+    t.group = kept ? depth_groups_.data() : nullptr;
     t.fill_unit = kernels_->raster.fill_depth_unit;
 }
 
@@ -264,7 +260,7 @@ void detail::BufferState::reserve(const BufferReserve& r) {
     placed_clusters_.reserve(std::max(r.max_clusters, r.max_task_list_clusters));
     recorded_draws_.reserve(std::max<std::size_t>(1, r.max_task_list_draws));
     band_stats_.reserve(z.bands);
-    band_ran_.reserve(z.bands);
+    band_ran_.reserve(z.bands), band_order_.reserve(z.bands);
     cluster_row_runs_.reserve(z.bands);
     if (r.max_clusters > 0 || r.max_task_list_clusters > 0) {
         const std::size_t plane = r.max_cluster_vertices + detail::kVertexClipPadding;

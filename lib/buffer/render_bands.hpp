@@ -108,7 +108,8 @@ struct detail::BufferState::ClusterPlace {
 // room in setup_triangles_ ([first, first + room): its triangle count), and drawn from there by
 // the others (each waits until it is ready). When clipping gives it more triangles than its room,
 // every band drawing it sets it up itself (kEach): the same triangles, so the same bits.
-struct detail::BufferState::ClusterSetup {
+// A line of its own: the band tasks read and set the states of neighbouring clusters at once.
+struct alignas(64) detail::BufferState::ClusterSetup {
     std::size_t first = 0, room = 0, count = 0;
     RasterStats stats;          // the setup's counts
     std::atomic<int> state{0};  // kNotSetUp, kSettingUp, kReady or kEach

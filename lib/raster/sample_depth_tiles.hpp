@@ -69,6 +69,14 @@ struct DepthRowsRecord {
 };
 constexpr std::uint32_t kDepthRecordHeaderWords = (sizeof(DepthRowsRecord) + 3) / 4;
 
+// A group's arena cursor and flag. Every record written moves the cursor; the bands of one render
+// run on different threads, so each group's lies in a cache line of its own (side by side, the
+// groups' counts shared a line that the threads took from each other at every record).
+struct alignas(64) DepthGroupCursor {
+    std::uint32_t words = 0, entries = 0;  // taken in the group's arena
+    std::uint8_t filled = 0;               // whether a query may have filled one of its units since its rows were last reset
+};
+
 struct SampleDepthTiles;
 // Applies every record of a unit's tile that reaches the unit to its samples (this instruction
 // set's kernel).
@@ -84,9 +92,7 @@ struct SampleDepthTiles {
     std::uint32_t* tile_head;      // per tile, row-major: its first entry (in its group's arena)
     std::int32_t* words;           // the records, group g's from g * word_capacity
     DepthTileEntry* entries;       // group g's from g * entry_capacity
-    std::uint32_t* group_words;    // per group: words taken
-    std::uint32_t* group_entries;  // per group: entries taken
-    std::uint8_t* group_filled;    // per group: whether a query may have filled one of its units since its rows were last reset
+    DepthGroupCursor* group;       // per group
     std::uint32_t word_capacity, entry_capacity;
     FillDepthUnitKernel fill_unit;
 
@@ -111,7 +117,7 @@ inline void reset_sample_depth_rows(const SampleDepthTiles& t, int row_begin, in
     for (int ty = row_begin / kDepthTileSubtilesY; ty < tile_row_end; ++ty)
         std::fill_n(t.tile_head + std::size_t(ty) * std::size_t(t.tiles_x), t.tiles_x, kNoDepthEntry);
     const int group_end = std::min(t.groups, (row_end + kDepthGroupSubtileRows - 1) / kDepthGroupSubtileRows);
-    for (int g = row_begin / kDepthGroupSubtileRows; g < group_end; ++g) t.group_words[g] = 0, t.group_entries[g] = 0, t.group_filled[g] = 0;
+    for (int g = row_begin / kDepthGroupSubtileRows; g < group_end; ++g) t.group[g] = DepthGroupCursor{};
 }
 
 // Zeroes a unit's samples (the last column of units ends at the rows' padding).
@@ -164,7 +170,7 @@ inline void ensure_depth_unit(const SampleDepthTiles& t, int ux, int uy) {
         if (__atomic_compare_exchange_n(state, &seen, kDepthUnitFilling, false, __ATOMIC_ACQUIRE, __ATOMIC_ACQUIRE)) {
             // Written once per group and frame: a store per fill would bounce the line between
             // the querying threads.
-            std::uint8_t* filled = &t.group_filled[uy * kDepthUnitSubtilesY / kDepthGroupSubtileRows];
+            std::uint8_t* filled = &t.group[uy * kDepthUnitSubtilesY / kDepthGroupSubtileRows].filled;
             if (!__atomic_load_n(filled, __ATOMIC_RELAXED)) __atomic_store_n(filled, std::uint8_t(1), __ATOMIC_RELAXED);
             if (seen == kDepthUnitStale) zero_depth_unit(t, ux, uy);
             t.fill_unit(t, ux, uy);
@@ -200,7 +206,7 @@ inline bool list_sample_depth(const SampleDepthTiles& t, const RasterTriangle& t
         // A chunk boundary may split the group's rows into two records.
         const std::uint32_t words = 2 * kDepthRecordHeaderWords + 2 * std::uint32_t(std::max(rows, 0));
         const std::uint32_t entries = 2 * std::uint32_t((gy1 / kDepthTileSubtilesY - gy0 / kDepthTileSubtilesY + 1) * (tx1 - tx0 + 1));
-        room = t.group_words[group] + words <= t.word_capacity && t.group_entries[group] + entries <= t.entry_capacity;
+        room = t.group[group].words + words <= t.word_capacity && t.group[group].entries + entries <= t.entry_capacity;
     }
     if (room) return true;
     const int ux0 = tri.i0 / kDepthUnitWidth, ux1 = std::min(t.units_x - 1, tri.i1 / kDepthUnitWidth);
@@ -228,10 +234,11 @@ void record_sample_depth(const SampleDepthTiles& t, const PreparedTriangle& plan
     for (int r = begin; r < end;) {
         const int row = row0 + r, group = row / kGroupRows;
         const int n = std::min(end - r, (group + 1) * kGroupRows - row);
-        const bool any_filled = t.group_filled[group] != 0;
+        DepthGroupCursor& cursor = t.group[group];
+        const bool any_filled = cursor.filled != 0;
         std::int32_t* words = t.words + std::size_t(group) * t.word_capacity;
-        const std::uint32_t record = t.group_words[group];
-        t.group_words[group] = record + kDepthRecordHeaderWords + 2 * std::uint32_t(n);
+        const std::uint32_t record = cursor.words;
+        cursor.words = record + kDepthRecordHeaderWords + 2 * std::uint32_t(n);
         const DepthRowsRecord header{plane, row, n};
         std::memcpy(words + record, &header, sizeof header);
         std::memcpy(words + record + kDepthRecordHeaderWords, first + r, sizeof(std::int32_t) * std::size_t(n));
@@ -243,7 +250,7 @@ void record_sample_depth(const SampleDepthTiles& t, const PreparedTriangle& plan
                 const int bx0 = tx * kDepthTileSubtilesX, by0 = ty * kDepthTileSubtilesY;
                 const int x0 = std::max(sx0, bx0), x1 = std::min(sx1, bx0 + kDepthTileSubtilesX - 1);
                 const int y0 = std::max(sy0, by0), y1 = std::min(sy1, by0 + kDepthTileSubtilesY - 1);
-                const std::uint32_t e = t.group_entries[group]++;
+                const std::uint32_t e = cursor.entries++;
                 std::uint32_t& head = t.tile_head[std::size_t(ty) * std::size_t(t.tiles_x) + std::size_t(tx)];
                 entries[e] = {record, head, std::uint8_t(x0 - bx0), std::uint8_t(x1 - bx0), std::uint8_t(y0 - by0), std::uint8_t(y1 - by0)};
                 head = e;

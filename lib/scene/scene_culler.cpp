@@ -139,7 +139,10 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     task_tallies_.resize(64);
     subtrees_.reserve(hierarchy_.nodes.size());
     next_subtrees_.reserve(hierarchy_.nodes.size());
-    task_stack_room_ = hierarchy_depth(hierarchy_) + 1;
+    // Rounded up to whole cache lines and one line more, so that two tasks' stacks, pushed and
+    // popped at every node, share no line (the vector's start need not be a line's).
+    constexpr std::size_t kLineWords = 64 / sizeof(std::uint32_t);
+    task_stack_room_ = (hierarchy_depth(hierarchy_) + 1 + kLineWords - 1) / kLineWords * kLineWords + kLineWords;
     task_stacks_.resize(task_tallies_.size() * task_stack_room_);
 
     // Approximate mode: each part would tolerate the holes again, so no parts.

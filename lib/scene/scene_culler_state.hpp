@@ -125,7 +125,9 @@ public:
     void traverse(const Frame& frame, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel);
     OccludeeAnswer box_answer(const Frame& frame, const Aabb& box) const;
     // What object tests count, per task when they run in parallel (then added to work_ and exits_).
-    struct TestTally {
+    // Each task counts into its own tally, written at every test: a cache line of its own, or
+    // the two threads' tallies would share one and bounce it between the cores.
+    struct alignas(64) TestTally {
         std::size_t nodes = 0, objects = 0, parts = 0, solid_parts = 0;
         std::uint64_t exits[7] = {};
     };

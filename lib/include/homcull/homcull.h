@@ -255,7 +255,8 @@ HOMCULL_API homcull_result homcull_buffer_set_job_system(homcull_buffer* buffer,
  *     homcull_buffer_draw_mesh(buffer, ...);    any number: recorded on the calling thread
  *     homcull_buffer_close_tasks(buffer, &count);
  *     homcull_buffer_run_task(buffer, i);        for every i < count, once each, on any threads,
- *                                                at once, in any order
+ *                                                at once, in any order (best taken in turn:
+ *                                                the bands slowest last time come first)
  *     homcull_buffer_finish_tasks(buffer);       after every run_task returned
  * The buffer then holds the same bits as those draws made one after another without a list.
  * A task never allocates and never fails; after a reserve (max_task_list_*) nothing in the list

@@ -208,7 +208,8 @@ public:
     //     begin_tasks();                      // clear_first: as render_frame
     //     record(draw) for each draw;         // on the calling thread: nothing drawn yet
     //     n = close_tasks();                  // one task per band of subtile rows
-    //     run_task(i) for every i < n, once each, on any threads, at once, in any order;
+    //     run_task(i) for every i < n, once each, on any threads, at once, in any order
+    //                                         // (best in turn: the longest bands come first);
     //     finish_tasks();                     // after every run_task returned
     // The buffer then holds the same bits as render(draw) called for each draw in turn, on one
     // thread or with a job system: each band takes the draws in their order, and a draw's
