@@ -215,9 +215,10 @@ public:
     // thread or with a job system: each band takes the draws in their order, and a draw's
     // clusters nearest first, as those renders do. record() places the draw's clusters (in
     // tasks of `parallel`, when given) and throws homcull::Error, like render(), before
-    // recording anything. A task allocates nothing and throws nothing: a cluster is set up by
-    // the first band that draws it, into room for its own triangle count, which the others
-    // then draw; one that clipping makes larger is set up by each band that draws it instead.
+    // recording anything. A task allocates nothing, throws nothing and never waits for another:
+    // a cluster is set up by the first band that draws it, into room for its own triangle
+    // count, which the bands coming to it later draw; a band coming to it while it is being
+    // set up, or one that clipping makes larger than its room, sets it up for itself.
     // Between begin_tasks and finish_tasks the buffer must not be rendered into, cleared or
     // queried. finish_tasks throws homcull::Error when close_tasks' tasks did not all run (the
     // buffer then holds the bands that ran, which is conservative, with a pyramid to match).
