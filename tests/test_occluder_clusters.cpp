@@ -342,6 +342,35 @@ TEST(ClusteredRender, SameBitsOnEveryIsaAndWithAnyThreads) {
     }
 }
 
+// Bands racing on two threads, frame after frame at full size: bands that share the horizon's
+// clusters come to them at once (one sets a cluster up, the other sets up the next ones
+// meanwhile, or the same one again for itself), and each frame takes the bands in the order of
+// the last one's times. Whatever the race, the serial render's bits and statistics.
+TEST(ClusteredRender, BandsRacingFrameAfterFrameGiveTheSerialBits) {
+    const CastleOccluders* c = castle();
+    if (!c) GTEST_SKIP() << "intel_castle.glb is missing from " << test::shared_scenes_dir();
+    const OccluderClusters clusters = test::cluster_world(c->world);
+    const ParallelFor tbb = test::parallel_jobs(), threads = test::thread_jobs(2);
+    const BufferConfig config = test::buffer_config(1280, 720, 1, float(c->views.frames[0].near_plane), true);
+    OcclusionBuffer serial(config), with_tbb(config), with_threads(config);
+    for (int round = 0; round < 3; ++round)
+        for (std::size_t view = 0; view < c->views.frames.size(); ++view) {
+            const ClusteredInput in{&clusters, clip_from_world(c->views.frames[view], 1280.0 / 720.0), Backface::cw};
+            serial.render_frame(in);
+            with_tbb.render_frame(in, tbb);
+            with_threads.render_frame(in, threads);
+            for (const OcclusionBuffer* b : {&with_tbb, &with_threads}) {
+                const std::string what = (b == &with_tbb ? "TBB" : "two threads") + std::string(", round ") + std::to_string(round) + ", view " +
+                                         std::to_string(view);
+                EXPECT_TRUE(serial.stats() == b->stats()) << what;
+                EXPECT_TRUE(test::same_subtiles(serial, *b)) << what;
+                EXPECT_TRUE(test::same_pyramid(serial, *b)) << what;
+                for (const float x : {-0.9f, -0.3f, 0.2f, 0.7f})  // the per-sample depth where queries read it
+                    EXPECT_EQ(serial.test_rect(x, -0.2f, x + 0.1f, 0.1f, 2.0f), b->test_rect(x, -0.2f, x + 0.1f, 0.1f, 2.0f)) << what;
+            }
+        }
+}
+
 // ClusteredInput::backfaces: each cluster drawn with its own backface mode. All of them cw is
 // the draw's cw; a mix (cw for every other cluster listed) gives the same bits on every
 // instruction set, serial or in tasks, and culls fewer triangles than all cw and more than none.

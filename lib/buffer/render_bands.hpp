@@ -26,6 +26,9 @@ constexpr int kBandSubtileRows = 32;
 constexpr int kBandPyramidLevels = 5;
 static_assert((1 << kBandPyramidLevels) == kBandSubtileRows, "a band's rows hold whole cells of its levels");
 
+// How far past a cluster being set up by another band a band looks for one to set up meanwhile
+// (clustered_render.cpp, run_band).
+constexpr std::size_t kSetUpAheadClusters = 16;
 // render_binned's chunks: triangles set up per task, and each chunk's room for its set-up
 // triangles (clipping at the near plane or the guard band may give a triangle more than one; a
 // chunk that needs more sets up again in every band). Waves hold at most kMaxWaveChunks chunks,
