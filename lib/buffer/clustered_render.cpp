@@ -401,7 +401,11 @@ void detail::BufferState::run_band(std::size_t band) noexcept {
             continue;
         }
         stats += s.stats;  // the setup's counts once per band that draws the cluster, as on one thread
-        for (std::size_t t = 0; t < s.count; ++t) draw(setup_triangles_[s.first + t]);
+        const detail::RasterTriangle* triangles = setup_triangles_.data() + s.first;
+        for (std::size_t t = 0; t < s.count; ++t) {
+            if (t + kPrefetchTriangles < s.count) prefetch_triangle(triangles[t + kPrefetchTriangles]);
+            draw(triangles[t]);
+        }
     }
     band_stats_[band] = stats;
     build_pyramid_rows(row_begin, row_end, std::min(kBandPyramidLevels, int(levels_.size()) - 1));

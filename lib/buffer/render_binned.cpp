@@ -7,7 +7,6 @@
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 
-#include <hwy/cache_control.h>
 
 #include <algorithm>
 
@@ -24,17 +23,6 @@ using detail::kMaxWaveChunks;
 // to kMaxWaveChunks. S1 at 1080p, two threads: one wave
 // 6.88 ms; a first wave of 2, 4 or 8 chunks 5.06, 5.07, 5.18 ms.
 constexpr std::size_t kFirstWaveChunks = 4;
-// A band reads its bins' triangles in order, but they were written by whichever thread set up
-// their chunk, and a kernel call per triangle is too short for the hardware prefetcher to
-// follow: they are prefetched this many triangles ahead (S1 at 1080p, two threads: 14.0 ->
-// 13.2 ms; 2, 8 and 16 ahead were within noise of each other).
-constexpr std::size_t kPrefetchTriangles = 8;
-
-void prefetch_triangle(const detail::RasterTriangle& tri) {
-    const char* bytes = reinterpret_cast<const char*>(&tri);
-    for (std::size_t offset = 0; offset < sizeof tri; offset += 64) hwy::Prefetch(bytes + offset);
-}
-
 }  // namespace
 
 // Room for waves of `slots` chunks over `bands` bands (render_binned), kept when it is enough.
