@@ -120,10 +120,12 @@ struct detail::BufferState::ClusterPlace {
     static constexpr std::uint8_t kInView = 0, kOutside = 1, kEmpty = 2;  // kEmpty: no triangles
 };
 
-// In a task list, a cluster in view is set up once, by the first band that draws it, into its
-// room in setup_triangles_ ([first, first + room): its triangle count), and drawn from there by
-// the others (each waits until it is ready). When clipping gives it more triangles than its room,
-// every band drawing it sets it up itself (kEach): the same triangles, so the same bits.
+// In a task list, a cluster in view is set up by the first band that claims it (state kNotSetUp
+// -> kSettingUp), into its room in setup_triangles_ ([first, first + room): its triangle count),
+// and drawn from there by the bands that find it kReady. A band finding it kSettingUp sets up
+// later clusters meanwhile, or with none left sets it up for itself; when clipping gives it
+// more triangles than its room, every band drawing it sets it up itself (kEach): the same
+// triangles, so the same bits.
 // A line of its own: the band tasks read and set the states of neighbouring clusters at once.
 struct alignas(64) detail::BufferState::ClusterSetup {
     std::size_t first = 0, room = 0, count = 0;

@@ -7,7 +7,6 @@
 #include "raster/rasterize.hpp"
 #include "raster/triangle_batch.hpp"
 
-
 #include <algorithm>
 
 namespace homcull {

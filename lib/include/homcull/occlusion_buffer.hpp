@@ -216,9 +216,10 @@ public:
     // clusters nearest first, as those renders do. record() places the draw's clusters (in
     // tasks of `parallel`, when given) and throws homcull::Error, like render(), before
     // recording anything. A task allocates nothing, throws nothing and never waits for another:
-    // a cluster is set up by the first band that draws it, into room for its own triangle
-    // count, which the bands coming to it later draw; a band coming to it while it is being
-    // set up, or one that clipping makes larger than its room, sets it up for itself.
+    // a cluster is set up by the first band that comes to it, into room for its own triangle
+    // count, which the bands coming to it later draw; a band coming to it while it is being set
+    // up sets up the next clusters meanwhile, or with none left sets it up for itself, as every
+    // band does with a cluster that clipping makes larger than its room.
     // Between begin_tasks and finish_tasks the buffer must not be rendered into, cleared or
     // queried. finish_tasks throws homcull::Error when close_tasks' tasks did not all run (the
     // buffer then holds the bands that ran, which is conservative, with a pyramid to match).
