@@ -531,6 +531,12 @@ TEST(OcclusionMaps, InvalidConfigurationsAreErrors) {
         EXPECT_THROW(unbuilt.build_pyramid(), Error);
         EXPECT_THROW(unbuilt.opacity(0, 0, 0), Error);
     }
+    // A near plane must be finite and positive; a refused one changes nothing.
+    {
+        OcclusionMaps maps(buffer, maps_config(buffer));
+        for (const float near_w : {0.0f, -1.0f, NAN, INFINITY}) EXPECT_THROW(maps.set_near_w(near_w), Error) << near_w;
+        EXPECT_NO_THROW(maps.set_near_w(0.5f));
+    }
     // A 1 x 1 buffer is a one-level pyramid.
     const OcclusionBuffer tiny = buffer_of(1, 1, 4, Occluders{1, 1, {}, {}, {}});
     OcclusionMaps maps(tiny, maps_config(tiny));

@@ -19,6 +19,7 @@ public:
     // The calls of OcclusionMaps, with its contracts.
     MapsState(const OcclusionBuffer& buffer, const OcclusionMapsConfig& config);
     void clear();
+    void set_near_w(float near_w);
     void add_occluder_box(const Aabb& box, const std::array<float, 16>& model_to_clip);
     void build(const OcclusionBuffer& buffer);
     OccludeeAnswer test_rect(const ScreenRect& rect) const;

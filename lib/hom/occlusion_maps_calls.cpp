@@ -11,6 +11,7 @@ OcclusionMaps::OcclusionMaps(OcclusionMaps&&) noexcept = default;
 OcclusionMaps& OcclusionMaps::operator=(OcclusionMaps&&) noexcept = default;
 
 void OcclusionMaps::clear() { state_->clear(); }
+void OcclusionMaps::set_near_w(float near_w) { state_->set_near_w(near_w); }
 void OcclusionMaps::add_occluder_box(const Aabb& box, const std::array<float, 16>& model_to_clip) { state_->add_occluder_box(box, model_to_clip); }
 void OcclusionMaps::build(const OcclusionBuffer& buffer) { state_->build(buffer); }
 void OcclusionMaps::build_pyramid() { state_->build_pyramid(); }

@@ -14,6 +14,7 @@
 //     occludee between them is hidden there while visible (a test builds exactly that case).
 //     With one sample per pixel it equals hzb.
 // In approximate mode holes are tolerated, and the depth maps ignore uncovered samples.
+#include <homcull/error.hpp>
 #include <homcull/occlusion_maps.hpp>
 
 #include "buffer/buffer_state.hpp"
@@ -37,6 +38,12 @@ int deb_cell(int i, int samples, int cells) { return int(std::int64_t(i) * cells
 }  // namespace
 
 void detail::MapsState::clear() { std::fill(deb_.begin(), deb_.end(), INFINITY); }
+
+void detail::MapsState::set_near_w(float near_w) {
+    if (!(near_w > 0.0f) || !std::isfinite(near_w)) throw Error("occlusion maps: the near plane must be finite and positive");
+    near_w_ = near_w;
+    clear();
+}
 
 // Zhang 6.2.1: the far rectangle of an occluder's box, the box's screen rectangle at its
 // farthest depth, lowers every depth estimation buffer cell it touches to that depth.

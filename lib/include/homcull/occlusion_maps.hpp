@@ -122,6 +122,10 @@ public:
     void clear();
     void add_occluder_box(const Aabb& box, const std::array<float, 16>& model_to_clip);
     void build(const OcclusionBuffer& buffer);
+    // A new near plane, the buffer's after its set_near_w (occluder boxes are clipped there):
+    // forgets the occluder boxes as clear() does; allocates nothing. Throws homcull::Error
+    // unless near_w is finite and positive.
+    void set_near_w(float near_w);
     // The pyramids of the last build()'s buffer, when build() left them out
     // (PyramidBuild::lazy); nothing to do when they are made. The tests then run the overlap
     // test as with PyramidBuild::always. Throws homcull::Error before the first build().

@@ -4,7 +4,7 @@
 // through a hierarchy of boxes, front to back, skipping what lies under a hidden node.
 // One SceneCuller is reused frame after frame: the buffer, the maps, the hierarchy and the
 // candidate occluders' triangles are set up once, and a frame allocates nothing once its
-// scratch has grown (the first frames).
+// scratch has grown (the first frames), whatever the camera's near plane.
 #include <homcull/object_hierarchy.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occluder_lod.hpp>
