@@ -85,6 +85,9 @@ void run_walk(const WalkCommandOptions& o) {
     TruthOptions truth_options;
     truth_options.resolution = config.display;
     const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+    // TBB starts its worker threads at its first parallel loop: started here, so that frame 0
+    // does not count their start (an engine's job system has its threads already).
+    if (parallel.run) parallel.run(parallel.user, 64, [](void*, std::size_t) {}, nullptr);
 
     nlohmann::json frames = nlohmann::json::array();
     std::vector<WalkFrame> measured;
