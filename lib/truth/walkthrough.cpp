@@ -2,12 +2,17 @@
 
 #include <homcull/frustum.hpp>
 
+#include <chrono>
+
 namespace homcull {
 
 WalkFrame measure_walk_frame(const Scene& scene, SceneCuller& culler, const Camera& camera, const TruthResult* truth,
                              std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+    const auto start = std::chrono::steady_clock::now();
     culler.cull(camera, answers, parallel);
+    const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     WalkFrame f;
+    f.frame_ms = frame_ms;
     f.ms = culler.timings();
     f.work = culler.work();
     f.has_truth = truth != nullptr;

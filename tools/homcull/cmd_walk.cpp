@@ -50,7 +50,8 @@ std::vector<std::pair<const char*, double>> frame_figures(const WalkFrame& f) {
         {"render_ms", f.ms.render_ms},
         {"maps_ms", f.ms.maps_ms},
         {"tests_ms", f.ms.test_ms},
-        {"cull_ms", f.ms.select_ms + f.ms.render_ms + f.ms.maps_ms + f.ms.test_ms}};
+        {"cull_ms", f.ms.select_ms + f.ms.render_ms + f.ms.maps_ms + f.ms.test_ms},
+        {"frame_ms", f.frame_ms}};
     if (f.has_truth) {
         v.insert(v.end(), {{"objects_exactly_visible", double(f.objects.exactly_visible)},
                            {"triangles_exactly_visible", double(f.triangles.exactly_visible)},

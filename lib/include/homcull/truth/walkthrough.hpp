@@ -26,6 +26,9 @@ struct WalkFrame {
     // and missed culls, ties. Its stage times are in `ms`, not here.
     CullingTally truth;
     SceneCullTimings ms;
+    // The whole cull() call, as an engine pays it: the stages in `ms` and what lies between
+    // them (the answers' reset, a new near plane).
+    double frame_ms = 0.0;
     SceneCullWork work;
     double truth_ms = 0.0;
 };
