@@ -68,7 +68,7 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
         config.height = 97;
         config.samples = samples;
         config.near_w = 1.0f;
-        const test::ScopedIsa reference_isa("scalar");
+        config.isa = "scalar";
         OcclusionBuffer buffer(config);
         buffer.render(test::clip_space_input(xyzw));
         std::vector<Visibility> expected, expected_boxes;
@@ -80,11 +80,14 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
         EXPECT_GT(std::count(expected.begin(), expected.end(), Visibility::visible), 2000);
 
         for (const std::string& isa : available_isas()) {
-            const test::ScopedIsa selected(isa);
-            const std::vector<Visibility> single = test::rect_answers(buffer, rects);
+            // A buffer takes its kernels when it is made: one per instruction set.
+            config.isa = isa.c_str();
+            OcclusionBuffer isa_buffer(config);
+            isa_buffer.render(test::clip_space_input(xyzw));
+            const std::vector<Visibility> single = test::rect_answers(isa_buffer, rects);
             std::vector<Visibility> batch(rects.size()), box_batch(boxes.size());
-            buffer.test_rects(rects.data(), rects.size(), batch.data());
-            buffer.test_aabbs(boxes.data(), boxes.size(), m, box_batch.data());
+            isa_buffer.test_rects(rects.data(), rects.size(), batch.data());
+            isa_buffer.test_aabbs(boxes.data(), boxes.size(), m, box_batch.data());
             std::size_t single_wrong = 0, batch_wrong = 0, box_wrong = 0;
             for (std::size_t k = 0; k < rects.size(); ++k) {
                 single_wrong += single[k] != expected[k];
@@ -94,6 +97,51 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
             EXPECT_EQ(single_wrong, 0u) << isa << ", samples " << samples;
             EXPECT_EQ(batch_wrong, 0u) << isa << ", samples " << samples;
             EXPECT_EQ(box_wrong, 0u) << isa << ", samples " << samples;
+        }
+    }
+}
+
+// A wall over the screen's left part, left of x = edge, and rectangles from the left border
+// to just before the edge (hidden) or just past it (seen there only): every instruction set's
+// single and batched tests must scan rows to their last subtile, past a vector's width (rows
+// of 42 subtiles), in short rectangles (rows scanned directly) and tall ones (through the
+// pyramid's cells).
+TEST(OccludeeBatches, WideRectanglesAreScannedToTheirLastSubtile) {
+    for (int samples : {1, 2, 4}) {
+        BufferConfig config;
+        config.width = 333;
+        config.height = 77;
+        config.samples = samples;
+        config.near_w = 1.0f;
+        for (float edge = -0.9f; edge < 0.95f; edge += 0.05f) {
+            const float w = 2.0f;
+            // One triangle (a shared edge may leave its samples to neither side): its right edge
+            // vertical at x = edge, reaching far beyond the other borders.
+            const std::vector<float> wall = {edge * w, -3.0f * w, 0, w, edge * w, 3.0f * w, 0, w, -9.0f * w, 0, 0, w};
+            std::vector<ScreenRect> rects;
+            std::vector<Visibility> designed;
+            for (float height : {0.04f, 0.3f, 1.9f})
+                for (float y0 : {-0.95f, -0.2f}) {
+                    if (y0 + height > 1.0f) continue;
+                    rects.push_back({-0.99f, y0, edge - 0.03f, y0 + height, 10.0f});
+                    designed.push_back(Visibility::occluded);
+                    rects.push_back({-0.99f, y0, edge + 0.03f, y0 + height, 10.0f});
+                    designed.push_back(Visibility::visible);
+                }
+            for (const std::string& isa : available_isas()) {
+                config.isa = isa.c_str();  // a buffer takes its kernels when it is made
+                OcclusionBuffer buffer(config);
+                buffer.render(test::clip_space_input(wall));
+                const std::vector<Visibility> single = test::rect_answers(buffer, rects);
+                std::vector<Visibility> batch(rects.size());
+                buffer.test_rects(rects.data(), rects.size(), batch.data());
+                const std::vector<Visibility> exhaustive = test::rect_answers(buffer, rects, true);
+                for (std::size_t k = 0; k < rects.size(); ++k) {
+                    EXPECT_EQ(single[k], designed[k]) << isa << ", samples " << samples << ", edge " << edge << ", rectangle " << k;
+                    EXPECT_EQ(batch[k], designed[k]) << isa << ", samples " << samples << ", edge " << edge << ", rectangle " << k;
+                    EXPECT_EQ(exhaustive[k], designed[k]) << isa << ", samples " << samples << ", edge " << edge << ", rectangle " << k;
+                }
+            }
         }
     }
 }

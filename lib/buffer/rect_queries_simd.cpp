@@ -158,33 +158,44 @@ HWY_INLINE std::size_t CoarseRectTests(const CoarseRectView& view, const ScreenR
     return open_count;
 }
 
-// The exact stage on the subtiles [sx0, sx1] x [sy0, sy1] of the rectangle, row by row, a
-// vector of subtiles at a time: false when one shows it. A subtile with d0 > d_near hides it
-// whatever its mask; one with d0 <= d_near shows it if it is interior (all its samples in the
-// rectangle, so its bound is d0), and otherwise is decided by subtile_hides.
-HWY_INLINE bool SubtilesHide(const SubtileView& view, const RectQuery& q, const InteriorSubtiles& interior, int sx0, int sx1, int sy0,
-                             int sy1) {
+// The exact stage on the subtiles [sx0, sx1] x [sy0, sy1] of the rectangle, a vector of
+// subtiles of a row at a time: false when one shows it. Every lane computes what
+// subtile_unhidden_samples computes for its subtile, without a branch: the samples of the
+// subtile in the rectangle (a byte of sample columns per lane, repeated over the sample rows the
+// rectangle covers there), shown where d_near is not below d0 and, in the working layer's mask,
+// not below max(d0, d1). One branch per row and vector, taken when some lane shows the
+// rectangle: a branch per showing subtile was mispredicted about as often as not.
+HWY_INLINE bool SubtilesHide(const SubtileView& view, const RectQuery& q, int sx0, int sx1, int sy0, int sy1) {
+    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    static_assert(kW == 8 && kH == 4, "a subtile's samples are 4 rows of a byte");
     const hn::CappedTag<float, kMaxSimdLanes> df;  // rows are padded for this many (rasterize.hpp)
     const hn::RebindToSigned<decltype(df)> di;
+    const hn::RebindToUnsigned<decltype(df)> du;
     const int lanes = int(hn::Lanes(df));
     const auto d_near = hn::Set(df, q.d_near);
-    const auto lane = hn::Iota(di, 0);  // once: Highway's Iota goes through memory
-    for (int ty = sy0; ty <= sy1; ++ty) {
-        const float* row = view.d0 + std::size_t(ty) * view.stride;
-        const bool interior_row = ty >= interior.iy0 && ty <= interior.iy1;
-        for (int tx = sx0; tx <= sx1; tx += lanes) {
-            // Lanes past sx1 read the row's padding or its next subtiles: masked out.
-            const auto reached = hn::FirstN(df, std::size_t(sx1 - tx + 1));
-            const auto shows = hn::And(reached, hn::Not(hn::Lt(d_near, hn::LoadU(df, row + tx))));
-            if (hn::AllFalse(df, shows)) continue;
-            if (interior_row) {
-                const auto column = hn::Add(lane, hn::Set(di, tx));
-                const auto inside =
-                    hn::And(hn::Not(hn::Lt(column, hn::Set(di, interior.ix0))), hn::Not(hn::Gt(column, hn::Set(di, interior.ix1))));
-                if (!hn::AllFalse(df, hn::And(shows, hn::RebindMask(df, inside)))) return false;
-            }
-            for (std::uint32_t bits = LaneBits(df, shows); bits != 0; bits &= bits - 1)
-                if (!subtile_hides(view, tx + __builtin_ctz(bits), ty, q)) return false;
+    const auto lane_first_sample = hn::ShiftLeft<3>(hn::Iota(di, 0));  // once: Highway's Iota goes through memory
+    const auto byte = hn::Set(du, 0xFFu);
+    for (int tx = sx0; tx <= sx1; tx += lanes) {
+        // The sample columns [lo, hi] of each lane's subtile in the rectangle. Lanes past sx1 read
+        // the row's padding or its next subtiles: their hi is clamped to -1 (no column).
+        const auto first = hn::Sub(hn::Set(di, q.i0 - tx * kW), lane_first_sample);
+        const auto last = hn::Sub(hn::Set(di, std::min(q.i1, sx1 * kW + kW - 1) - tx * kW), lane_first_sample);
+        const auto lo = hn::BitCast(du, hn::Max(first, hn::Zero(di)));
+        const auto hi = hn::BitCast(du, hn::Min(hn::Max(last, hn::Set(di, -1)), hn::Set(di, kW - 1)));
+        const auto columns = hn::And(hn::Shl(byte, lo), hn::Shr(byte, hn::Sub(hn::Set(du, kW - 1), hi)));
+        const auto column_rows = hn::Or(columns, hn::ShiftLeft<8>(columns));
+        const auto all_rows = hn::Or(column_rows, hn::ShiftLeft<16>(column_rows));
+        for (int ty = sy0; ty <= sy1; ++ty) {
+            const int r0 = std::max(0, q.j0 - ty * kH), r1 = std::min(kH - 1, q.j1 - ty * kH);
+            const std::uint32_t rows = (0xFFFFFFFFu << (kW * r0)) & (0xFFFFFFFFu >> (kW * (kH - 1 - r1)));
+            const std::size_t at = std::size_t(ty) * view.stride + std::size_t(tx);
+            const auto d0 = hn::LoadU(df, view.d0 + at);
+            const auto layer = hn::LoadU(du, view.mask + at);
+            const auto samples = hn::And(all_rows, hn::Set(du, rows));
+            const auto above_d0 = hn::RebindMask(du, hn::Lt(d_near, d0));
+            const auto above_layers = hn::RebindMask(du, hn::Lt(d_near, hn::Max(d0, hn::LoadU(df, view.d1 + at))));
+            const auto shown = hn::IfThenZeroElse(above_d0, hn::IfThenElse(above_layers, hn::AndNot(layer, samples), samples));
+            if (!hn::AllTrue(du, hn::Eq(shown, hn::Zero(du)))) return false;
         }
     }
     return true;
@@ -200,9 +211,8 @@ HWY_INLINE Visibility ScanRect(const SubtileView& view, const RectQuery& q) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     constexpr int kCellLevel = 2, kCell = 1 << kCellLevel;
     const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
-    const InteriorSubtiles interior = interior_subtiles(q);
     if (ty1 - ty0 < kCell || view.level_count <= kCellLevel)
-        return SubtilesHide(view, q, interior, tx0, tx1, ty0, ty1) ? Visibility::occluded : Visibility::visible;
+        return SubtilesHide(view, q, tx0, tx1, ty0, ty1) ? Visibility::occluded : Visibility::visible;
 
     const hn::CappedTag<float, kMaxSimdLanes> df;
     const int lanes = int(hn::Lanes(df));
@@ -219,12 +229,60 @@ HWY_INLINE Visibility ScanRect(const SubtileView& view, const RectQuery& q) {
             if (hn::AllFalse(df, open)) continue;
             for (std::uint32_t bits = LaneBits(df, open); bits != 0; bits &= bits - 1) {
                 const int c = cx + __builtin_ctz(bits);
-                if (!SubtilesHide(view, q, interior, std::max(tx0, c * kCell), std::min(tx1, c * kCell + kCell - 1), sy0, sy1))
+                if (!SubtilesHide(view, q, std::max(tx0, c * kCell), std::min(tx1, c * kCell + kCell - 1), sy0, sy1))
                     return Visibility::visible;
             }
         }
     }
     return Visibility::occluded;
+}
+
+// prepare_rect for a rectangle that needs the buffer, in SIMD lanes: false for those it leaves
+// to prepare_rect (invalid, before the near plane, outside the view: one branch for all, rarely
+// taken), else the query prepare_rect makes, with the same double operations (a pair of lanes
+// per axis: x's (min, max), y's (max, min), both giving (first, last) samples), which the
+// rectangle's empty span checks afterwards.
+HWY_INLINE bool PrepareRectInLanes(const CoarseRectView& view, const ScreenRect& rect, RectQuery& q) {
+#if HWY_TARGET == HWY_SCALAR  // one lane: prepare_rect does it all (a kernel the scalar choice never runs)
+    (void)view, (void)rect, (void)q;
+    return false;
+#else
+    const hn::FixedTag<float, 4> df;
+    const hn::FixedTag<double, 2> dd;
+    const hn::Rebind<std::int32_t, decltype(dd)> di;
+    static_assert(sizeof(ScreenRect) == 5 * sizeof(float), "rectangles are 5 packed floats");
+    const auto bounds = hn::LoadU(df, &rect.ndc_min_x);  // min x, min y, max x, max y
+    const auto maxima = hn::Shuffle1032(bounds);           // max x, max y, min x, min y
+    const auto finite = hn::Lt(hn::Abs(bounds), hn::Set(df, INFINITY));
+    const auto ordered = hn::Or(hn::Le(bounds, maxima), hn::Not(hn::FirstN(df, 2)));  // lanes 0 and 1: min <= max
+    // Outside the view: min > 1 (lanes 0, 1) or -max > 1 (lanes 2, 3).
+    alignas(16) static constexpr float kSigns[4] = {1.0f, 1.0f, -1.0f, -1.0f};
+    const auto inside = hn::Not(hn::Gt(hn::Mul(bounds, hn::Load(df, kSigns)), hn::Set(df, 1.0f)));
+    const bool near_enough = std::fabs(rect.w_min) < INFINITY && !(rect.w_min < view.near_w);
+    if (!(hn::AllTrue(df, hn::And(hn::And(finite, ordered), inside)) & near_enough)) return false;
+
+    const auto paired = hn::InterleaveLower(df, bounds, maxima);  // min x, max x, min y, max y
+    const auto x = hn::PromoteTo(dd, hn::LowerHalf(paired));
+    const auto y = hn::Shuffle01(hn::PromoteTo(dd, hn::UpperHalf(hn::Half<decltype(df)>(), paired)));  // max y, min y
+    const auto one = hn::Set(dd, 1.0), half = hn::Set(dd, 0.5), minus_one = hn::Set(dd, -1.0);
+    const auto width = hn::Set(dd, double(view.sample_width)), height = hn::Set(dd, double(view.sample_height));
+    const auto span = [&](hn::Vec<decltype(dd)> edges, hn::Vec<decltype(dd)> count) {  // sample_span, both ends
+        edges = hn::Min(hn::Max(edges, minus_one), hn::Add(count, one));
+        const auto shifted = hn::Sub(edges, half);
+        auto sample = hn::OddEven(hn::Floor(shifted), hn::Ceil(shifted));  // lane 0 first, lane 1 last
+        sample = hn::Min(hn::Max(sample, hn::OddEven(hn::Set(dd, -INFINITY), hn::Zero(dd))),
+                         hn::OddEven(hn::Sub(count, one), hn::Set(dd, INFINITY)));
+        return hn::DemoteTo(di, sample);
+    };
+    const auto xs = span(hn::Mul(hn::Mul(hn::Add(x, one), half), width), width);
+    const auto ys = span(hn::Mul(hn::Mul(hn::Sub(one, y), half), height), height);
+    q.i0 = hn::GetLane(xs);
+    q.i1 = hn::ExtractLane(xs, 1);
+    q.j0 = hn::GetLane(ys);
+    q.j1 = hn::ExtractLane(ys, 1);
+    q.d_near = nearest_depth_bound(rect.w_min);
+    return true;
+#endif
 }
 
 // Both stages for one rectangle (single test_rect calls): one dispatch, and prepare_rect and
@@ -233,7 +291,11 @@ Visibility TestOneRect(const BufferState& buffer, const ScreenRect& rect) {
     const CoarseRectView view = buffer.coarse_view();
     RectQuery q;
     Visibility decided;
-    if (!prepare_rect(view, rect, q, decided)) return decided;
+    if (!PrepareRectInLanes(view, rect, q)) {
+        if (!prepare_rect(view, rect, q, decided)) return decided;
+    } else if (q.i0 > q.i1 || q.j0 > q.j1) {
+        return Visibility::occluded;  // covers no sample (prepare_rect's answer)
+    }
     if (coarse_rect_hides(view, q)) return Visibility::occluded;
     return ScanRect(buffer.subtile_view(), q);
 }
