@@ -10,6 +10,8 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/glm.hpp>
 
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -340,6 +342,133 @@ TEST(CApi, FrontFaceWindingDecidesWhatIsCulled) {
 
 // Each context runs its own instruction set, leaving the process-wide choice alone, and all give
 // the same answers.
+// A cube of half-size 1 around the origin, 12 triangles whose (b - a) x (c - a) points out.
+struct Cube {
+    std::vector<float> positions;
+    std::vector<std::uint16_t> indices;
+    Cube() {
+        for (int i = 0; i < 8; ++i) positions.insert(positions.end(), {i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f});
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                // The face's corners in order around it: the two other axes' bits.
+                const int u = 1 << ((axis + 1) % 3), v = 1 << ((axis + 2) % 3), base = side << axis;
+                const std::uint16_t q[4] = {std::uint16_t(base), std::uint16_t(base | u), std::uint16_t(base | u | v), std::uint16_t(base | v)};
+                for (const auto& t : {std::array<std::uint16_t, 3>{q[0], q[1], q[2]}, std::array<std::uint16_t, 3>{q[0], q[2], q[3]}}) {
+                    const glm::vec3 a = corner(t[0]), n = glm::cross(corner(t[1]) - a, corner(t[2]) - a);
+                    const bool out = glm::dot(n, a) > 0.0f;  // the centre is the origin
+                    indices.insert(indices.end(), {t[0], out ? t[1] : t[2], out ? t[2] : t[1]});
+                }
+            }
+    }
+    glm::vec3 corner(int i) const { return {positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]}; }
+    homcull_triangles triangles() const { return {positions.data(), 12, positions.size() / 3, indices.data(), 2, 0, indices.size() / 3}; }
+    // Whether triangle t faces a point p (in the cube's space).
+    bool faces(std::size_t t, glm::vec3 p) const {
+        const glm::vec3 a = corner(indices[3 * t]);
+        return glm::dot(glm::cross(corner(indices[3 * t + 1]) - a, corner(indices[3 * t + 2]) - a), p - a) > 0.0f;
+    }
+};
+
+// homcull_buffer_test_triangles_ex: the deciding triangle as next frame's start (the same
+// answer from any start, fewer samples counted), closed solids (the same answers, the triangles
+// seen from behind passed over), and its errors, which answer visible.
+TEST(CApi, TriangleTestsStartWhereAskedAndPassOverAClosedSolidsBackFaces) {
+    const Scene scene;
+    const Cube cube;
+    const homcull_triangles triangles = cube.triangles();
+    ErrorLog log;
+    Culler culler(scene, make_context(nullptr, HOMCULL_ISA_BEST, &log));
+    homcull_triangle_test_result result;
+    EXPECT_EQ(homcull_buffer_test_triangles_ex(culler.buffer, &triangles, nullptr, nullptr, &result), HOMCULL_ERROR_INVALID_OPERATION);
+    EXPECT_EQ(result.visibility, HOMCULL_VISIBLE);
+    ASSERT_EQ(culler.frame(scene, engine_view(Engine::opengl)), scene.expected);
+
+    // The cube moved by a column-major model matrix; the eye (the world's origin) in its space.
+    const auto model = [](glm::vec3 at) {
+        std::array<float, 16> m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, at.x, at.y, at.z, 1};
+        return m;
+    };
+    const auto test = [&](const std::array<float, 16>& m, const homcull_triangle_test_desc* desc) {
+        homcull_triangle_test_result r;
+        r.visibility = 99;
+        EXPECT_EQ(homcull_buffer_test_triangles_ex(culler.buffer, &triangles, m.data(), desc, &r), HOMCULL_OK) << homcull_last_error();
+        return r;
+    };
+    const glm::vec3 behind(-2, 2, -15), in_front(-2, 2, -7);
+    for (const glm::vec3 at : {behind, in_front}) {
+        const std::array<float, 16> m = model(at);
+        const glm::vec3 eye = -at;
+        homcull_visibility plain = 99;
+        ASSERT_EQ(homcull_buffer_test_triangles(culler.buffer, &triangles, m.data(), &plain), HOMCULL_OK);
+        EXPECT_EQ(plain, at == behind ? HOMCULL_OCCLUDED : HOMCULL_VISIBLE);
+        const homcull_triangle_test_result from_start = test(m, nullptr);
+        EXPECT_EQ(from_start.visibility, plain);
+        EXPECT_GT(from_start.samples, 0u);
+
+        homcull_triangle_test_desc closed{};
+        closed.flags = HOMCULL_TRIANGLES_CLOSED_SOLID;
+        closed.orientation = 1;
+        closed.eye[0] = eye.x, closed.eye[1] = eye.y, closed.eye[2] = eye.z;
+        const homcull_triangle_test_result solid = test(m, &closed);
+        EXPECT_EQ(solid.visibility, plain);
+        if (at == behind) {
+            EXPECT_EQ(from_start.deciding_triangle, 0u);
+            EXPECT_LT(solid.samples, from_start.samples);  // every triangle counted, but those facing away
+            EXPECT_GT(solid.samples, 0u);
+            continue;
+        }
+        EXPECT_TRUE(cube.faces(solid.deciding_triangle, eye)) << solid.deciding_triangle;
+        // Next frame, from the deciding triangle: found at once, with no more samples counted.
+        homcull_triangle_test_desc next{};
+        next.first_triangle = from_start.deciding_triangle;
+        const homcull_triangle_test_result again = test(m, &next);
+        EXPECT_EQ(again.visibility, HOMCULL_VISIBLE);
+        EXPECT_EQ(again.deciding_triangle, from_start.deciding_triangle);
+        EXPECT_LE(again.samples, from_start.samples);
+        // Each start gives the same answer, decided by the start itself where it faces the eye
+        // (the cube is in front of everything); one past the last starts from the first.
+        for (std::size_t first = 0; first < cube.indices.size() / 3; ++first) {
+            next.first_triangle = first;
+            const homcull_triangle_test_result r = test(m, &next);
+            EXPECT_EQ(r.visibility, HOMCULL_VISIBLE) << first;
+            if (cube.faces(first, eye)) EXPECT_EQ(r.deciding_triangle, first);
+        }
+        next.first_triangle = cube.indices.size() / 3 + 5;
+        EXPECT_EQ(test(m, &next).deciding_triangle, from_start.deciding_triangle);
+        // A tolerance of all the samples the cube may cover hides it (approximate culling).
+        next.first_triangle = 0;
+        next.tolerated_samples = ~std::uint64_t(0);
+        EXPECT_EQ(test(m, &next).visibility, HOMCULL_OCCLUDED);
+    }
+
+    // Errors answer visible, with a message.
+    const std::array<float, 16> m = model(behind);
+    homcull_triangle_test_desc bad{};
+    bad.flags = HOMCULL_TRIANGLES_CLOSED_SOLID;
+    bad.orientation = 0;
+    const auto refused = [&](const homcull_triangle_test_desc& d, const char* says) {
+        homcull_triangle_test_result r;
+        r.visibility = 99;
+        EXPECT_EQ(homcull_buffer_test_triangles_ex(culler.buffer, &triangles, m.data(), &d, &r), HOMCULL_ERROR_INVALID_ARGUMENT);
+        EXPECT_EQ(r.visibility, HOMCULL_VISIBLE);
+        EXPECT_NE(std::string(homcull_last_error()).find(says), std::string::npos) << homcull_last_error();
+    };
+    refused(bad, "orientation must be +1 or -1");
+    bad.orientation = -1;
+    bad.eye[1] = std::nan("");
+    refused(bad, "eye must be finite");
+    bad.flags = 2;
+    refused(bad, "unknown flags");
+    EXPECT_EQ(homcull_buffer_test_triangles_ex(culler.buffer, &triangles, m.data(), nullptr, nullptr), HOMCULL_ERROR_INVALID_ARGUMENT);
+    const homcull_view ortho = engine_view(Engine::opengl_ortho);
+    ASSERT_EQ(homcull_buffer_begin_frame(culler.buffer, &ortho), HOMCULL_OK);
+    bad = homcull_triangle_test_desc{};
+    bad.flags = HOMCULL_TRIANGLES_CLOSED_SOLID;
+    bad.orientation = 1;
+    refused(bad, "closed solids need a perspective view");
+    EXPECT_EQ(log.messages.size(), 6u);
+}
+
 TEST(CApi, InstructionSetsArePerContext) {
     const Scene scene;
     const std::string process_wide = homcull::selected_isa();

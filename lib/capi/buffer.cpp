@@ -131,6 +131,41 @@ homcull_visibility as_c(Visibility v) {
     return v == Visibility::occluded ? HOMCULL_OCCLUDED : v == Visibility::view_culled ? HOMCULL_VIEW_CULLED : HOMCULL_VISIBLE;
 }
 
+// Both triangle tests: the answer (visible unless the test says otherwise) into `result`.
+homcull_result test_triangles(const homcull_buffer* b, const homcull_triangles* triangles, const float* model_matrix,
+                              const homcull_triangle_test_desc& options, homcull_triangle_test_result& result, const char* fn) {
+    result = homcull_triangle_test_result{};
+    result.visibility = HOMCULL_VISIBLE;
+    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
+    const homcull_context* context = b->account.context;
+    if (options.flags & ~std::uint32_t(HOMCULL_TRIANGLES_CLOSED_SOLID))
+        return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: unknown flags 0x%x", fn, unsigned(options.flags));
+    const bool closed = (options.flags & HOMCULL_TRIANGLES_CLOSED_SOLID) != 0;
+    if (closed) {
+        if (options.orientation != 1 && options.orientation != -1)
+            return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: a closed solid's orientation must be +1 or -1, got %d", fn,
+                                int(options.orientation));
+        if (!std::isfinite(options.eye[0]) || !std::isfinite(options.eye[1]) || !std::isfinite(options.eye[2]))
+            return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: a closed solid's eye must be finite", fn);
+        if (b->buffer.config().orthographic)
+            return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: closed solids need a perspective view (this frame's is orthographic)",
+                                fn);
+    }
+    TriangleInput in;
+    if (homcull_result r = triangle_input(*b, triangles, model_matrix, fn, in); r != HOMCULL_OK) return r;
+    return capi::guarded(b->account, fn, [&]() -> homcull_result {
+        const OcclusionBuffer::TriangleTest test =
+            closed ? b->buffer.test_triangles(in, options.tolerated_samples, options.first_triangle,
+                                              OcclusionBuffer::ClosedSolid{{options.eye[0], options.eye[1], options.eye[2]}, int(options.orientation)})
+                   : b->buffer.test_triangles(in, options.tolerated_samples, options.first_triangle);
+        result.visibility = as_c(test.visibility);
+        result.deciding_triangle = test.visibility == Visibility::visible ? test.deciding_triangle : 0;
+        result.samples = test.samples;
+        result.visible_samples = test.visible_samples;
+        return HOMCULL_OK;
+    });
+}
+
 void all_visible(homcull_visibility* visibility, std::size_t count) {
     if (visibility) std::fill(visibility, visibility + count, homcull_visibility(HOMCULL_VISIBLE));
 }
@@ -442,14 +477,17 @@ homcull_result homcull_buffer_test_triangles(const homcull_buffer* b, const homc
                                              homcull_visibility* visibility) {
     const char* const fn = "homcull_buffer_test_triangles";
     if (!visibility) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: visibility is null", fn);
-    *visibility = HOMCULL_VISIBLE;
-    if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
-    TriangleInput in;
-    if (homcull_result r = triangle_input(*b, triangles, model_matrix, fn, in); r != HOMCULL_OK) return r;
-    return capi::guarded(b->account, fn, [&]() -> homcull_result {
-        *visibility = as_c(b->buffer.test_triangles(in).visibility);
-        return HOMCULL_OK;
-    });
+    homcull_triangle_test_result result;
+    const homcull_result r = test_triangles(b, triangles, model_matrix, homcull_triangle_test_desc{}, result, fn);
+    *visibility = result.visibility;
+    return r;
+}
+
+homcull_result homcull_buffer_test_triangles_ex(const homcull_buffer* b, const homcull_triangles* triangles, const float* model_matrix,
+                                                const homcull_triangle_test_desc* desc, homcull_triangle_test_result* result) {
+    const char* const fn = "homcull_buffer_test_triangles_ex";
+    if (!result) return capi::report(b ? b->account.context : nullptr, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: result is null", fn);
+    return test_triangles(b, triangles, model_matrix, desc ? *desc : homcull_triangle_test_desc{}, *result, fn);
 }
 
 homcull_result homcull_buffer_frame_stats(const homcull_buffer* b, homcull_frame_stats* stats) {

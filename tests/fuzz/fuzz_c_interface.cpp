@@ -131,6 +131,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         for (homcull_rect& r : rects) r = {in.take<float>(), in.take<float>(), in.take<float>(), in.take<float>(), in.take<float>()};
         check_query(homcull_buffer_test_rects(buffer, rects, 2, answers), answers, 2);
         check_query(homcull_buffer_test_triangles(buffer, &tris, in.flag() ? nullptr : models[1], answers), answers, 1);
+        homcull_triangle_test_desc test_desc{};
+        test_desc.first_triangle = in.below(8);
+        test_desc.tolerated_samples = in.flag() ? in.below(64) : 0;
+        test_desc.flags = std::uint32_t(in.below(4));  // 2 and 3: unknown flags
+        test_desc.orientation = int(in.below(4)) - 2;
+        for (double& e : test_desc.eye) e = in.flag() ? double(in.take<float>()) : double(int(in.below(41)) - 20);
+        homcull_triangle_test_result tested;
+        const homcull_result r = homcull_buffer_test_triangles_ex(buffer, &tris, in.flag() ? nullptr : models[1], in.flag() ? nullptr : &test_desc, &tested);
+        check_query(r, &tested.visibility, 1);
+        if (r == HOMCULL_OK && tested.visible_samples > tested.samples) __builtin_trap();
         homcull_frame_stats stats;
         check(homcull_buffer_frame_stats(buffer, &stats));
     }

@@ -34,7 +34,7 @@
 
 #define HOMCULL_VERSION_MAJOR 0
 #define HOMCULL_VERSION_MINOR 2
-#define HOMCULL_VERSION_PATCH 0
+#define HOMCULL_VERSION_PATCH 1
 /* major * 10000 + minor * 100 + patch, as homcull_version() returns it. */
 #define HOMCULL_VERSION (HOMCULL_VERSION_MAJOR * 10000 + HOMCULL_VERSION_MINOR * 100 + HOMCULL_VERSION_PATCH)
 
@@ -335,6 +335,51 @@ HOMCULL_API homcull_result homcull_buffer_test_rects(const homcull_buffer* buffe
  * triangles may cover (either side facing) has no occluder certainly nearer. */
 HOMCULL_API homcull_result homcull_buffer_test_triangles(const homcull_buffer* buffer, const homcull_triangles* triangles,
                                                          const float* model_matrix, homcull_visibility* visibility);
+
+enum {
+    /* The occludee is a closed solid seen from outside: every edge of its triangles is shared
+     * with another of them in opposite order, each connected piece encloses a volume, and the
+     * whole occludee lies beyond the near plane. Its first surface along any ray is then a
+     * triangle seen from the front, so the test passes over the triangles the eye certainly sees
+     * from behind (about half). The caller vouches for it: an occludee that is only partly such
+     * a solid may be found hidden where a back face shows. */
+    HOMCULL_TRIANGLES_CLOSED_SOLID = 1u
+};
+
+/* What homcull_buffer_test_triangles_ex adds to homcull_buffer_test_triangles. All zero: the
+ * same test. */
+typedef struct homcull_triangle_test_desc {
+    /* The triangle the scan starts from, wrapping around (none past the last: 0). The answer is
+     * the same from any start; last frame's deciding_triangle finds a visible occludee's visible
+     * triangle first (frame-to-frame coherence: most visible occludees then cost one triangle). */
+    size_t first_triangle;
+    /* Samples the occludee may show and still be answered occluded (approximate culling);
+     * 0: conservative. */
+    uint64_t tolerated_samples;
+    uint32_t flags;       /* HOMCULL_TRIANGLES_* */
+    /* HOMCULL_TRIANGLES_CLOSED_SOLID: +1 when each triangle (a, b, c)'s (b - a) x (c - a) points
+     * out of the solid, -1 when into it (in the positions' own space, whatever the view's
+     * front_face). */
+    int32_t orientation;
+    /* HOMCULL_TRIANGLES_CLOSED_SOLID: the eye (the view's centre of projection) in the
+     * positions' space, the model space of model_matrix. Perspective views only. */
+    double eye[3];
+} homcull_triangle_test_desc;
+
+typedef struct homcull_triangle_test_result {
+    homcull_visibility visibility;
+    uint8_t reserved[7];
+    size_t deciding_triangle;   /* visible: the triangle found visible (next frame's first_triangle); else 0 */
+    uint64_t samples;           /* samples the triangles may cover, counted up to the answer (partial when visible) */
+    uint64_t visible_samples;   /* of those, the samples with no occluder certainly nearer */
+} homcull_triangle_test_result;
+
+/* homcull_buffer_test_triangles with a start triangle, a tolerance and closed solids (desc; null:
+ * all zero), answering with what decided it (since 0.2.1). Errors (a closed solid in an orthographic view, an
+ * orientation other than +1 or -1, an eye not finite, unknown flags) answer HOMCULL_VISIBLE. */
+HOMCULL_API homcull_result homcull_buffer_test_triangles_ex(const homcull_buffer* buffer, const homcull_triangles* triangles,
+                                                            const float* model_matrix, const homcull_triangle_test_desc* desc,
+                                                            homcull_triangle_test_result* result);
 
 /* What the frame drew so far. */
 typedef struct homcull_frame_stats {
