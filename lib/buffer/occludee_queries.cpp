@@ -55,7 +55,7 @@ Visibility detail::BufferState::test_prepared_rect(const detail::RectQuery& q) c
     // Exact range check on d0 alone: if no subtile in the range has d0 <= d_near, every bound
     // (>= d0) is above d_near and the rectangle is hidden. Most hidden rectangles end here.
     const int level_count = int(levels_.size());
-    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+    const auto [tx0, tx1, ty0, ty1] = detail::subtile_range(q);
     if (detail::min_pyramid_range_above(pyramid_.data(), levels_.data(), level_count, tx0, ty0, tx1, ty1, q.d_near))
         return Visibility::occluded;
 

@@ -52,6 +52,17 @@ inline float nearest_depth_bound(float w_min) {
     return up * (1.0f + 0x1.0p-20f);
 }
 
+// The subtiles [tx0, tx1] x [ty0, ty1] a prepared rectangle reaches. Its samples are never
+// negative (prepare_rect clamps them at 0), so the division is a shift, not the few instructions
+// of a signed division, on single test_rect calls' path to their coarse check.
+struct SubtileRange {
+    int tx0, tx1, ty0, ty1;
+};
+inline SubtileRange subtile_range(const RectQuery& q) {
+    constexpr unsigned kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
+    return {int(unsigned(q.i0) / kW), int(unsigned(q.i1) / kW), int(unsigned(q.j0) / kH), int(unsigned(q.j1) / kH)};
+}
+
 // What the rectangle tests do before reading the buffer (detail::BufferState::prepare, and
 // the single test_rect's SIMD kernel, which inlines it compiled for its instruction set): the
 // samples whose centres lie in the rectangle and its nearest 1/w, rounded up and raised by a
@@ -89,8 +100,7 @@ inline bool prepare_rect(const CoarseRectView& view, const ScreenRect& r, RectQu
 // without a branch; a repeated one changes no minimum) is at most any covered subtile's bound,
 // so d_near below it hides the rectangle. The batches' SIMD coarse stage reads the same cells.
 inline bool coarse_rect_hides(const CoarseRectView& view, const RectQuery& q) {
-    constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+    const auto [tx0, tx1, ty0, ty1] = subtile_range(q);
     const int level = coarse_level(tx0, tx1, ty0, ty1, view.levels);
     const int x0 = tx0 >> level, x1 = tx1 >> level, y0 = ty0 >> level, y1 = ty1 >> level;
     const float* cells = view.pyramid + view.level_offset[level];
