@@ -108,11 +108,7 @@ TEST(OccludeeBatches, EveryInstructionSetAnswersAsTheExhaustiveDefinition) {
 // pyramid's cells).
 TEST(OccludeeBatches, WideRectanglesAreScannedToTheirLastSubtile) {
     for (int samples : {1, 2, 4}) {
-        BufferConfig config;
-        config.width = 333;
-        config.height = 77;
-        config.samples = samples;
-        config.near_w = 1.0f;
+        BufferConfig config = test::buffer_config(333, 77, samples, 1.0f);
         for (float edge = -0.9f; edge < 0.95f; edge += 0.05f) {
             const float w = 2.0f;
             // One triangle (a shared edge may leave its samples to neither side): its right edge
