@@ -431,7 +431,9 @@ TEST(CApi, TriangleTestsStartWhereAskedAndPassOverAClosedSolidsBackFaces) {
             next.first_triangle = first;
             const homcull_triangle_test_result r = test(m, &next);
             EXPECT_EQ(r.visibility, HOMCULL_VISIBLE) << first;
-            if (cube.faces(first, eye)) EXPECT_EQ(r.deciding_triangle, first);
+            if (cube.faces(first, eye)) {
+                EXPECT_EQ(r.deciding_triangle, first);
+            }
         }
         next.first_triangle = cube.indices.size() / 3 + 5;
         EXPECT_EQ(test(m, &next).deciding_triangle, from_start.deciding_triangle);
