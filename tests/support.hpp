@@ -49,16 +49,20 @@ OccluderClusters cluster_world(const WorldTriangles& w, const ClusterLimits& lim
 ParallelFor parallel_jobs();
 
 // An instruction set selected (select_isa: the default of buffers made without naming one)
-// while the object lives, and "best" again when it goes, also when a failed ASSERT leaves the
-// test early, so that no later test runs on the wrong one. Tests that run on every
-// instruction set make one per iteration, and their buffers inside it:
+// while the object lives, and the one selected before it again when it goes, also when a failed
+// ASSERT leaves the test early, so that no later test runs on the wrong one; nested, an inner
+// one gives the outer one's back. A buffer keeps the instruction set it was made with, so tests
+// that run on every instruction set make one per iteration, and their buffers inside it:
 //     for (const std::string& isa : available_isas()) { const test::ScopedIsa selected(isa); ... }
 class ScopedIsa {
 public:
-    explicit ScopedIsa(const std::string& name) { select_isa(name); }
-    ~ScopedIsa() { select_isa("best"); }
+    explicit ScopedIsa(const std::string& name) : previous_(selected_isa()) { select_isa(name); }
+    ~ScopedIsa() { select_isa(previous_); }
     ScopedIsa(const ScopedIsa&) = delete;
     ScopedIsa& operator=(const ScopedIsa&) = delete;
+
+private:
+    std::string previous_;
 };
 // A plain job system: each run starts `threads` - 1 std::threads that take task numbers from
 // an atomic counter with the calling thread, and joins them.
