@@ -165,7 +165,7 @@ struct InteriorSubtiles {
 };
 inline InteriorSubtiles interior_subtiles(const RectQuery& q) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
-    const int tx0 = q.i0 / kW, tx1 = q.i1 / kW, ty0 = q.j0 / kH, ty1 = q.j1 / kH;
+    const auto [tx0, tx1, ty0, ty1] = subtile_range(q);
     return {q.i0 % kW == 0 ? tx0 : tx0 + 1, q.i1 % kW == kW - 1 ? tx1 : tx1 - 1, q.j0 % kH == 0 ? ty0 : ty0 + 1,
             q.j1 % kH == kH - 1 ? ty1 : ty1 - 1};
 }
