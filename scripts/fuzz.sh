@@ -29,7 +29,9 @@ for t in "${targets[@]}"; do
   if ! "build-fuzz/tests/fuzz/$t" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=4096 -print_final_stats=1 \
        -artifact_prefix="build-fuzz/crashes/$t/" "build-fuzz/corpus/$t" "tests/fuzz/corpus/$t" 2>"build-fuzz/$t.log"; then
     echo "fuzz: $t FAILED (build-fuzz/$t.log, inputs in build-fuzz/crashes/$t):" >&2
-    tail -40 "build-fuzz/$t.log" >&2
+    # The report's head (the error and its stacks), then the end (the input written).
+    sed -n '/ERROR: \|runtime error:\|deadly signal/,$p' "build-fuzz/$t.log" | head -60 >&2 || true
+    tail -6 "build-fuzz/$t.log" >&2
     status=1
   else
     grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "build-fuzz/$t.log" | sed "s/^/fuzz: $t: /" >&2 || true

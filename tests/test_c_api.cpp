@@ -176,10 +176,10 @@ struct Culler {
     homcull_context* context = nullptr;
     homcull_mesh* mesh = nullptr;
     homcull_buffer* buffer = nullptr;
-    explicit Culler(const Scene& scene, homcull_context* c, int width = 320, int height = 180) : context(c) {
+    explicit Culler(const Scene& scene, homcull_context* c, int width = 320, int height = 180, std::uint32_t buffer_flags = 0) : context(c) {
         const homcull_mesh_desc md = scene.mesh_desc();
         EXPECT_EQ(homcull_mesh_create(context, &md, &mesh), HOMCULL_OK) << homcull_last_error();
-        homcull_buffer_desc bd{width, height, 1, float(kNear), 0, 0};
+        homcull_buffer_desc bd{width, height, 1, float(kNear), buffer_flags, 0};
         EXPECT_EQ(homcull_buffer_create(context, &bd, &buffer), HOMCULL_OK) << homcull_last_error();
     }
     ~Culler() {
@@ -659,6 +659,75 @@ TEST(CApi, OutOfMemoryAtEveryAllocation) {
         EXPECT_EQ(memory.live, 0u) << "failing allocation " << k;
     }
     EXPECT_EQ(failures_seen, total);  // every allocation failed once, and was reported
+}
+
+// An answer with the samples it counted (0 for a box).
+struct CountedAnswer {
+    homcull_visibility visibility;
+    std::uint64_t samples, visible_samples;
+    bool operator==(const CountedAnswer& o) const { return visibility == o.visibility && samples == o.samples && visible_samples == o.visible_samples; }
+    friend std::ostream& operator<<(std::ostream& out, const CountedAnswer& a) {
+        return out << int(a.visibility) << " (" << a.visible_samples << " of " << a.samples << " samples)";
+    }
+};
+
+// A reserve or a resolution change that runs out of memory part way leaves the buffer as it
+// was: its next frames answer, and count samples, as a buffer's that never failed, the
+// per-sample depth computed where queries read it included (it is kept in arrays the failed
+// call may have moved before it failed).
+TEST(CApi, ReserveOrResolutionChangeThatRunsOutOfMemoryLeavesTheBufferAsItWas) {
+    const Scene scene;
+    const Cube cube;
+    const homcull_triangles triangles = cube.triangles();
+    const auto view_from = [](glm::dvec3 eye) {
+        homcull_view v = engine_view(Engine::opengl);
+        store(glm::perspectiveRH_NO(kFovY, kAspect, kNear, kFar) * glm::lookAtRH(eye, eye + glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0)),
+              v.layout, v.world_to_clip);
+        return v;
+    };
+    // Cubes behind the wall, just behind it and in front of it, some across its edge.
+    std::vector<std::array<float, 16>> models;
+    for (const float z : {-7.0f, -11.5f, -13.0f, -25.0f})
+        for (const float x : {-4.0f, 0.0f, 4.5f, 6.0f}) models.push_back({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, x, 1.0f, z, 1});
+    const auto frame = [&](Culler& c, const homcull_view& view) {
+        std::vector<CountedAnswer> answers;
+        const std::vector<homcull_visibility> boxes = c.frame(scene, view);
+        for (const homcull_visibility v : boxes) answers.push_back({v, 0, 0});
+        for (const auto& m : models) {
+            homcull_triangle_test_result r{};
+            EXPECT_EQ(homcull_buffer_test_triangles_ex(c.buffer, &triangles, m.data(), nullptr, &r), HOMCULL_OK) << homcull_last_error();
+            answers.push_back({r.visibility, r.samples, r.visible_samples});
+        }
+        return answers;
+    };
+    const homcull_view near_view = view_from({0, 0, 0}), far_view = view_from({0.3, -0.2, 6});
+    const homcull_reserve_desc reserve{1280, 720, 64, 64, 4, 256, 0, 0};
+    for (const bool resolution_change : {false, true}) {
+        std::size_t failures = 0;
+        for (std::size_t k = 1;; ++k) {
+            EngineMemory memory;
+            Culler failing(scene, make_context(&memory), 320, 180, HOMCULL_BUFFER_SAMPLE_DEPTH);
+            Culler reference(scene, make_context(), 320, 180, HOMCULL_BUFFER_SAMPLE_DEPTH);
+            ASSERT_EQ(frame(failing, near_view), frame(reference, near_view));  // the per-sample depth read, so written
+            memory.fail_at = memory.calls + k;
+            const homcull_result r = resolution_change ? homcull_buffer_set_resolution(failing.buffer, 1280, 720)
+                                                       : homcull_buffer_reserve(failing.buffer, &reserve);
+            memory.fail_at = 0;  // the frames below allocate where the call did not
+            if (r == HOMCULL_OK) {
+                ASSERT_EQ(resolution_change ? homcull_buffer_set_resolution(reference.buffer, 1280, 720) : homcull_buffer_reserve(reference.buffer, &reserve),
+                          HOMCULL_OK);
+            } else {
+                ASSERT_EQ(r, HOMCULL_ERROR_OUT_OF_MEMORY) << homcull_result_name(r);
+                ++failures;
+            }
+            // Then frames from farther back, where last frame's per-sample depth would hide what is
+            // in front of the wall, and from the first place again.
+            EXPECT_EQ(frame(failing, far_view), frame(reference, far_view)) << "allocation " << k << " of the call failing";
+            EXPECT_EQ(frame(failing, near_view), frame(reference, near_view)) << "allocation " << k << " of the call failing";
+            if (r == HOMCULL_OK) break;
+        }
+        EXPECT_GT(failures, 3u) << (resolution_change ? "set_resolution" : "reserve") << " allocates its arrays one by one";
+    }
 }
 
 }  // namespace

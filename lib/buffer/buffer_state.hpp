@@ -117,7 +117,7 @@ public:
     Vector<DepthGroupCursor> depth_groups_;
     Vector<std::int32_t> depth_words_;
     Vector<DepthTileEntry> depth_entries_;
-    SampleDepthTiles depth_tiles_{};  // points into the arrays above (set by configure and reserve)
+    SampleDepthTiles depth_tiles_{};  // points into the arrays above (set by point_depth_tiles whenever they may have moved)
     void point_depth_tiles();
     std::size_t at(int tx, int ty) const { return std::size_t(ty) * stride_ + std::size_t(tx); }
     RasterStats stats_;

@@ -114,7 +114,13 @@ detail::BufferSizes buffer_sizes(const BufferConfig& config) {
 }  // namespace
 
 // Room in the arrays whose size follows the configuration (reserve keeps their contents).
+// depth_tiles_ points into some of them, and a reserve that throws part way through may have
+// moved those before it: however this ends, depth_tiles_ points at the arrays as they are.
 void detail::BufferState::reserve_arrays(const detail::BufferSizes& z) {
+    struct PointDepthTilesOnExit {
+        BufferState& state;
+        ~PointDepthTilesOnExit() { state.point_depth_tiles(); }
+    } point_on_exit{*this};
     d0_.reserve(z.plane), d1_.reserve(z.plane), mask_.reserve(z.plane), covered_.reserve(z.plane);
     sample_depth_.reserve(z.sample_depth);
     depth_unit_state_.reserve(z.depth_units), depth_tile_head_.reserve(z.depth_tiles);
@@ -195,7 +201,7 @@ void detail::BufferState::point_depth_tiles() {
     t.words = kept ? depth_words_.data() : nullptr;
     t.entries = kept ? depth_entries_.data() : nullptr;
     t.group = kept ? depth_groups_.data() : nullptr;
-    t.fill_unit = kernels_->raster.fill_depth_unit;
+    t.fill_unit = kernels_ ? kernels_->raster.fill_depth_unit : nullptr;  // none before the first configure's end
 }
 
 void detail::BufferState::set_near_w(float near_w) {
@@ -216,7 +222,6 @@ void detail::BufferState::reserve(const BufferReserve& r) {
     validate_config(largest);
     const detail::BufferSizes z = buffer_sizes(largest);
     reserve_arrays(z);
-    point_depth_tiles();  // the arrays may have moved
 
     const auto at_least = [](auto& v, std::size_t n) {
         if (v.size() < n) v.resize(n);
