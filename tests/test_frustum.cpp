@@ -91,5 +91,38 @@ TEST(Frustum, ExactAgainstClippingOracleOnRandomBoxes) {
     EXPECT_GT(plane_test_keeps_outside, 0) << "expected boxes near frustum edges that only the exact test rejects";
 }
 
+// frustum_axes with a margin separates only boxes that intersects() finds apart, and keeps a box
+// moved apart by less than the margin; without one it is intersects().
+TEST(Frustum, AxesWithAMarginSeparateLessThanTheExactTest) {
+    Camera c;
+    c.eye = {3, 1, -2};
+    c.target = {10, 2, -30};
+    c.near_plane = 0.5;
+    c.far_plane = 80.0;
+    const Frustum f = make_frustum(c, 1.6);
+    const FrustumAxes exact = frustum_axes(f), widened = frustum_axes(f, 0x1.0p-20);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> pos(-90.0, 90.0), size(0.1, 30.0);
+    int apart = 0, kept_by_margin = 0;
+    for (int k = 0; k < 20000; ++k) {
+        const glm::vec3 lo(glm::dvec3(pos(rng), pos(rng), pos(rng)));
+        const Aabb b{lo, lo + glm::vec3(glm::dvec3(size(rng), size(rng), size(rng)))};
+        const bool meets = intersects(f, b);
+        EXPECT_EQ(separated(exact, b), !meets);
+        if (separated(widened, b)) {
+            EXPECT_FALSE(meets);
+            ++apart;
+        }
+        kept_by_margin += !meets && !separated(widened, b);
+    }
+    EXPECT_GT(apart, 1000);
+    EXPECT_LT(kept_by_margin, 10);  // the margin is far below these boxes' distances
+    // A small box around the eye lies before the near plane, apart either way; so is an empty box.
+    const Aabb at_eye{glm::vec3(c.eye - 0.01), glm::vec3(c.eye + 0.01)};
+    EXPECT_TRUE(separated(exact, at_eye));
+    EXPECT_TRUE(separated(widened, at_eye));
+    EXPECT_TRUE(separated(exact, Aabb{}));
+}
+
 }  // namespace
 }  // namespace homcull

@@ -9,10 +9,13 @@
 #include <homcull/object_hierarchy.hpp>
 #include <homcull/occluder_selection.hpp>
 #include <homcull/tbb_parallel_for.hpp>
+#include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/occluder_lod_build.hpp>
+#include <homcull/truth/ray_scene.hpp>
 #include <homcull/truth/walk_path.hpp>
 #include <homcull/truth/walkthrough.hpp>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -409,6 +412,58 @@ TEST(SceneCulling, TemporalDrawsAnOccluderThatComesIntoViewAtOnce) {
     EXPECT_EQ(answers[box].visibility, Visibility::occluded) << "the far wall, hidden last frame, was not drawn";
     EXPECT_EQ(temporal.work().occluder_objects, 2u);
     EXPECT_EQ(temporal.work().renders, 2u);  // the second pass
+}
+
+// A box beside the view that reaches behind the eye has its corners behind it, so the buffer's
+// screen rectangle of the box covers the screen, though the box does not meet the frustum: it
+// is answered view-culled (without a triangle test), in every occludee shape, as ground truth
+// finds it outside the frustum; a box beside it that reaches into the frustum is not, nor is
+// one in view. A wall hides nothing of them.
+TEST(SceneCulling, BoxesBesideTheFrustumAreViewCulledThoughTheirRectangleCoversTheScreen) {
+    Scene scene;
+    const std::uint32_t wall = test::add_quad(scene, "wall", {-50, -50, -60}, {50, -50, -60}, {50, 50, -60}, {-50, 50, -60});
+    // At depth 20 the view (60 degrees, 16:9) is 20.5 wide either side of the axis.
+    const std::uint32_t beside = test::add_box(scene, "beside the view", {30, -1, -20}, {31, 3, 20});
+    const std::uint32_t reaching = test::add_box(scene, "reaching into it", {15, -1, -20}, {16, 3, 20});
+    const std::uint32_t ahead = test::add_box(scene, "ahead", {-1, -1, -12}, {1, 1, -10});
+    scene.finalize();
+    const Camera camera = test::camera_down_minus_z(60.0, 0.1, 1000.0);
+    const Resolution display{160, 90};
+    const RayScene rays(scene);
+    TruthOptions options;
+    options.resolution = display;
+    const TruthResult truth = compute_ground_truth(rays, scene, camera, options);
+    ASSERT_FALSE(truth.objects[beside].in_frustum);
+    ASSERT_TRUE(truth.objects[reaching].in_frustum);
+    ASSERT_GT(truth.objects[reaching].visible_samples, 0u);
+    ASSERT_GT(truth.objects[ahead].visible_samples, 0u);
+    for (const OccludeeShape shape : {OccludeeShape::box, OccludeeShape::rectangles, OccludeeShape::samples}) {
+        SceneCullerConfig config;
+        config.display = display;
+        config.occludees = shape;
+        SceneCuller culler(scene, {wall}, config);
+        std::vector<OccludeeAnswer> answers;
+        culler.cull(camera, answers);
+        EXPECT_EQ(answers[beside].visibility, Visibility::view_culled) << int(shape);
+        EXPECT_EQ(answers[reaching].visibility, Visibility::visible) << int(shape);
+        EXPECT_EQ(answers[ahead].visibility, Visibility::visible) << int(shape);
+        EXPECT_EQ(answers[wall].visibility, Visibility::visible) << int(shape);
+    }
+    // The same far from the world's origin (the culler tests boxes relative to its anchor).
+    const glm::dvec3 far_away(3.0e5, -2.0e4, 7.0e5);
+    Scene moved = scene;
+    for (Object& object : moved.objects) object.world = glm::translate(glm::dmat4(1.0), far_away) * object.world;
+    moved.finalize();
+    Camera moved_camera = camera;
+    moved_camera.eye += far_away, moved_camera.target += far_away;
+    SceneCullerConfig config;
+    config.display = display;
+    SceneCuller culler(moved, {wall}, config);
+    std::vector<OccludeeAnswer> answers;
+    culler.cull(moved_camera, answers);
+    EXPECT_EQ(answers[beside].visibility, Visibility::view_culled);
+    EXPECT_EQ(answers[reaching].visibility, Visibility::visible);
+    EXPECT_EQ(answers[ahead].visibility, Visibility::visible);
 }
 
 // Closed occluder meshes enclosing a positive volume are drawn without the triangles facing

@@ -50,36 +50,43 @@ bool may_meet(const Frustum& fr, const Aabb& box) {
     return true;
 }
 
-bool intersects(const Frustum& fr, const Aabb& box) {
-    if (box.empty()) return false;
-    const glm::dvec3 lo(box.min), hi(box.max);
-    const glm::dvec3 centre = (lo + hi) * 0.5, half = (hi - lo) * 0.5;
-
-    // The two convex bodies are disjoint iff some axis separates their projections.
-    auto separated_along = [&](const glm::dvec3& axis) {
-        const double scale = glm::length(axis);
-        if (!(scale > 1e-12)) return false;  // degenerate cross product: no axis
-        double fmin = HUGE_VAL, fmax = -HUGE_VAL;
+FrustumAxes frustum_axes(const Frustum& fr, double relative_margin) {
+    FrustumAxes axes;
+    axes.relative_margin = relative_margin;
+    const auto add = [&](const glm::dvec3& axis) {
+        if (!(glm::length(axis) > 1e-12)) return;  // degenerate cross product: no axis
+        double lo = HUGE_VAL, hi = -HUGE_VAL;
         for (const auto& p : fr.corners) {
             const double d = glm::dot(axis, p);
-            fmin = std::min(fmin, d);
-            fmax = std::max(fmax, d);
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
         }
-        const double c = glm::dot(axis, centre);
-        const double r = std::abs(axis.x) * half.x + std::abs(axis.y) * half.y +
-                         std::abs(axis.z) * half.z;
-        return fmax < c - r || c + r < fmin;
+        const int k = axes.count++;
+        axes.axis[std::size_t(k)] = axis, axes.lo[std::size_t(k)] = lo, axes.hi[std::size_t(k)] = hi;
     };
-
-    for (const auto& plane : fr.planes)
-        if (separated_along(glm::dvec3(plane))) return false;
+    for (const auto& plane : fr.planes) add(glm::dvec3(plane));
     const glm::dvec3 box_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (const auto& a : box_axes) add(a);
     for (const auto& a : box_axes)
-        if (separated_along(a)) return false;
-    for (const auto& a : box_axes)
-        for (const auto& e : fr.edge_directions)
-            if (separated_along(glm::cross(a, e))) return false;
-    return true;
+        for (const auto& e : fr.edge_directions) add(glm::cross(a, e));
+    return axes;
 }
+
+bool separated(const FrustumAxes& axes, const Aabb& box) {
+    if (box.empty()) return true;
+    const glm::dvec3 lo(box.min), hi(box.max);
+    const glm::dvec3 centre = (lo + hi) * 0.5, half = (hi - lo) * 0.5;
+    for (int k = 0; k < axes.count; ++k) {
+        const glm::dvec3& a = axes.axis[std::size_t(k)];
+        const double c = glm::dot(a, centre);
+        const double r = std::abs(a.x) * half.x + std::abs(a.y) * half.y + std::abs(a.z) * half.z;
+        const double f_lo = axes.lo[std::size_t(k)], f_hi = axes.hi[std::size_t(k)];
+        const double margin = axes.relative_margin * (std::abs(c) + r + std::abs(f_lo) + std::abs(f_hi));
+        if (f_hi + margin < c - r || c + r + margin < f_lo) return true;
+    }
+    return false;
+}
+
+bool intersects(const Frustum& fr, const Aabb& box) { return !separated(frustum_axes(fr), box); }
 
 }  // namespace homcull

@@ -108,8 +108,9 @@ bool detail::SceneCullerState::node_hidden(const Frame& frame, std::uint32_t nod
                                            TestTally& tally) const {
     const ObjectHierarchy::Node& node = hierarchy_.nodes[node_index];
     if (!config_.hierarchy || node.end - node.begin <= 1) return false;
-    const OccludeeAnswer a = box_answer(frame, node_boxes_[node_index]);
+    OccludeeAnswer a = box_answer(frame, node_boxes_[node_index]);
     ++tally.nodes;
+    if (a.visibility == Visibility::visible && separated(frame.frustum, node_boxes_[node_index])) a.visibility = Visibility::view_culled;
     if (a.visibility == Visibility::visible) return false;
     for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
     tally.exits[a.overlap_exit] += node.end - node.begin;
@@ -193,11 +194,23 @@ OccludeeAnswer detail::SceneCullerState::box_answer(const Frame& frame, const Aa
 }
 
 // The object's box, then, where the box is visible and the object small enough, its triangles.
+//
+// A box (of a node, an object or a part) that the buffer finds visible is then tested against
+// the view frustum exactly (Frame::frustum): the buffer tests the screen rectangle of the box's
+// projected corners, which reaches past the box's silhouette, so that a box beside a corner or
+// an edge of the frustum can overlap the screen without meeting the frustum. On the castle's
+// views such boxes were half the objects the occludee triangle tests went on to prove hidden
+// (their triangles all off the screen), and most of the triangles those tests went through.
 OccludeeAnswer detail::SceneCullerState::test_object(const Frame& frame, std::uint32_t id, TestTally& tally) {
     const Object& object = scene_->objects[id];
     OccludeeAnswer answer = maps_.test_aabb(object_boxes_[id], frame.clip);
     ++tally.objects;
     ++tally.exits[answer.overlap_exit];
+    if (answer.visibility == Visibility::visible && separated(frame.frustum, object_boxes_[id])) {
+        answer.visibility = Visibility::view_culled;
+        answer.level_of_visibility = 0.0f;
+        return answer;
+    }
     if (answer.visibility != Visibility::visible || scene_->triangle_count(object) > config_.triangle_test_limit) return answer;
     const OccludeeShape shape = resolved_occludee_shape(config_);
     if (parts_.count(id) > 0) {
@@ -273,7 +286,8 @@ bool detail::SceneCullerState::parts_hidden(const Frame& frame, std::uint32_t id
     for (std::uint32_t k = 0; k < count; ++k) {
         const std::uint32_t p = (start + k) % count;
         ++tally.parts;
-        if (box_answer(frame, parts_.box(first + p)).visibility != Visibility::visible) continue;
+        if (box_answer(frame, parts_.box(first + p)).visibility != Visibility::visible || separated(frame.frustum, parts_.box(first + p)))
+            continue;
         if (test_triangles) {
             if (!solid_decided) solid = seen_solid(frame, id), solid_decided = true;
             tally.solid_parts += solid.has_value();

@@ -27,6 +27,24 @@ Frustum make_frustum(const Camera& camera, double aspect);
 // usual conservative plane-only test that keeps boxes near frustum corners.
 bool intersects(const Frustum& frustum, const Aabb& box);
 
+// The candidate separating axes of intersects() with the frustum's extent along each, computed
+// once per frustum: every box is axis-aligned, so the axes (the frustum's plane normals, the
+// world axes and their cross products with the frustum's edges) depend on the frustum alone,
+// and a box then costs one projection per axis. Axes of a degenerate cross product are left out.
+struct FrustumAxes {
+    int count = 0;
+    std::array<glm::dvec3, 27> axis;
+    std::array<double, 27> lo, hi;  // the frustum's corners projected on axis[k]
+    // How far apart, relative to the projections' magnitudes, a box and the frustum must lie to
+    // count as separated (0: exact, as intersects()).
+    double relative_margin = 0.0;
+};
+FrustumAxes frustum_axes(const Frustum& frustum, double relative_margin = 0.0);
+
+// True when some axis separates the box from the frustum by more than the margin (a box that
+// is empty is separated).
+bool separated(const FrustumAxes& axes, const Aabb& box);
+
 // Whether a box may meet the frustum: false only when it lies wholly outside one of the six
 // planes. Cheaper than intersects() and conservative (it keeps some boxes near the frustum's
 // edges that intersects() rejects): enough where a spare object only costs time.
