@@ -65,6 +65,7 @@ FrustumAxes frustum_axes(const Frustum& fr, double relative_margin) {
         axes.axis[std::size_t(k)] = axis, axes.lo[std::size_t(k)] = lo, axes.hi[std::size_t(k)] = hi;
     };
     for (const auto& plane : fr.planes) add(glm::dvec3(plane));
+    axes.plane_count = axes.count;
     const glm::dvec3 box_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     for (const auto& a : box_axes) add(a);
     for (const auto& a : box_axes)
@@ -76,6 +77,7 @@ bool separated(const FrustumAxes& axes, const Aabb& box) {
     if (box.empty()) return true;
     const glm::dvec3 lo(box.min), hi(box.max);
     const glm::dvec3 centre = (lo + hi) * 0.5, half = (hi - lo) * 0.5;
+    bool centre_inside = true;
     for (int k = 0; k < axes.count; ++k) {
         const glm::dvec3& a = axes.axis[std::size_t(k)];
         const double c = glm::dot(a, centre);
@@ -83,6 +85,10 @@ bool separated(const FrustumAxes& axes, const Aabb& box) {
         const double f_lo = axes.lo[std::size_t(k)], f_hi = axes.hi[std::size_t(k)];
         const double margin = axes.relative_margin * (std::abs(c) + r + std::abs(f_lo) + std::abs(f_hi));
         if (f_hi + margin < c - r || c + r + margin < f_lo) return true;
+        // A box whose centre lies within every plane's extent (inside the frustum) meets it:
+        // most boxes tested are in view, and end here without the 21 other axes.
+        centre_inside = centre_inside && f_lo <= c && c <= f_hi;
+        if (k + 1 == axes.plane_count && centre_inside) return false;
     }
     return false;
 }

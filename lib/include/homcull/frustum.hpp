@@ -33,6 +33,7 @@ bool intersects(const Frustum& frustum, const Aabb& box);
 // and a box then costs one projection per axis. Axes of a degenerate cross product are left out.
 struct FrustumAxes {
     int count = 0;
+    int plane_count = 0;  // the first axes: the planes' normals
     std::array<glm::dvec3, 27> axis;
     std::array<double, 27> lo, hi;  // the frustum's corners projected on axis[k]
     // How far apart, relative to the projections' magnitudes, a box and the frustum must lie to
