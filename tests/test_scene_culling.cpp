@@ -466,6 +466,48 @@ TEST(SceneCulling, BoxesBesideTheFrustumAreViewCulledThoughTheirRectangleCoversT
     EXPECT_EQ(answers[ahead].visibility, Visibility::visible);
 }
 
+// An occluder above and beside the view that reaches behind the eye: its box passes the
+// six-plane test (so it is drawn) but does not meet the frustum, and the screen rectangle of its
+// cluster's box covers the screen (corners behind the eye), yet the culler leaves the cluster
+// out (none of its triangles set up). The buffer is the one drawing it gives.
+TEST(SceneCulling, ClustersOutsideTheFrustumAreNotSetUp) {
+    Camera camera = test::camera_down_minus_z(60.0, 0.1, 1000.0);
+    camera.target = {1.0, 0.8, -1.0};
+    const Resolution display{160, 90};
+    const Frustum frustum = make_frustum(camera, display.aspect());
+    const Aabb corner{{-6, 6, 4}, {10, 14, 44}};  // reaching behind the eye
+    ASSERT_TRUE(may_meet(frustum, corner));
+    ASSERT_FALSE(intersects(frustum, corner));
+    Scene scene;
+    const std::uint32_t beside = test::add_box(scene, "beside a corner", corner.min, corner.max);
+    // A wall facing the eye, 20 units down the view.
+    const CameraBasis basis = camera_basis(camera);
+    const glm::vec3 centre(camera.eye + 20.0 * basis.forward), right(4.0 * basis.right), up(4.0 * basis.up);
+    const std::uint32_t wall = test::add_quad(scene, "wall", centre - right - up, centre + right - up, centre + right + up, centre - right + up);
+    scene.finalize();
+    SceneCullerConfig config;
+    config.display = display;
+    config.occludees = OccludeeShape::box;
+    std::vector<OccludeeAnswer> answers;
+    SceneCuller both(scene, {wall, beside}, config);
+    both.cull(camera, answers);
+    EXPECT_NE(answers[beside].visibility, Visibility::visible);
+    EXPECT_EQ(answers[wall].visibility, Visibility::visible);
+    EXPECT_EQ(both.work().occluder_objects, 2u);  // selected by the plane test, then its cluster left out
+    SceneCuller wall_alone(scene, {wall}, config);
+    wall_alone.cull(camera, answers);
+    EXPECT_GT(wall_alone.buffer().stats().rasterized, 0u);
+    EXPECT_EQ(both.buffer().stats().triangles_in, wall_alone.buffer().stats().triangles_in);
+    config.occluder_clusters = false;
+    SceneCuller as_triangles(scene, {wall, beside}, config);
+    as_triangles.cull(camera, answers);
+    EXPECT_GT(as_triangles.buffer().stats().triangles_in, both.buffer().stats().triangles_in);
+    std::vector<float> depth_both, depth_triangles;
+    both.buffer().read_depth(depth_both);
+    as_triangles.buffer().read_depth(depth_triangles);
+    EXPECT_EQ(depth_both, depth_triangles);
+}
+
 // Closed occluder meshes enclosing a positive volume are drawn without the triangles facing
 // away from the eye (SceneCullerConfig::skip_closed_back_faces): left out at selection, or, as
 // clusters, culled by the rasterizer; open meshes and closed ones wound inside out keep every

@@ -254,7 +254,7 @@ void detail::SceneCullerState::select_occluders(const Frame& frame) {
     for (std::size_t i = 0; i < ranked_.size() && every_candidate_in_frustum; ++i)
         every_candidate_in_frustum = !draws_lod(ranked_[i], *frame.camera);
     const EdgeFlags flags = every_candidate_in_frustum ? EdgeFlags::across_objects : EdgeFlags::own_object;
-    for (std::uint32_t id : ranked_) append_occluder(id, *frame.camera, flags);
+    for (std::uint32_t id : ranked_) append_occluder(id, frame, flags);
     timings_.select_ms += ms_since(start);
 }
 
@@ -313,6 +313,14 @@ void detail::SceneCullerState::build_clusters() {
                                                               own_shared_edges_.data() + first, local_apexes.data());
         add_candidate_clusters(k, part);
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
+    }
+    cluster_boxes_.clear();
+    for (const OccluderCluster& c : clusters_.clusters) {
+        Aabb box;
+        for (std::uint32_t v = c.first_vertex; v < c.first_vertex + c.vertex_count; ++v)
+            box.extend(glm::vec3(clusters_.positions[3 * std::size_t(v)], clusters_.positions[3 * std::size_t(v) + 1],
+                                 clusters_.positions[3 * std::size_t(v) + 2]));
+        cluster_boxes_.push_back(box);
     }
     frame_clusters_.reserve(clusters_.clusters.size());
     frame_cluster_backfaces_.reserve(clusters_.clusters.size());
@@ -407,7 +415,8 @@ bool detail::SceneCullerState::draws_lod(std::uint32_t id, const Camera& camera)
     return lod_first_[k] < lod_first_[k + 1] && lod_usable(scene_->objects[id].world_bounds, camera);
 }
 
-void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& camera, EdgeFlags edge_flags) {
+void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& frame, EdgeFlags edge_flags) {
+    const Camera& camera = *frame.camera;
     const std::uint32_t k = candidate_of_[id];
     const bool lod = draws_lod(id, camera);
     const bool own = edge_flags == EdgeFlags::own_object;
@@ -427,7 +436,15 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Camera& c
         const Backface backface = closed_[k] ? Backface::cw : config_.backface;
         // A batch not rendered yet takes the cross-object flags only if all its clusters may.
         frame_clusters_cross_ = (frame_clusters_.size() == frame_clusters_rendered_ || frame_clusters_cross_) && !own;
+        // A cluster whose box misses the frustum (Frame::frustum) is left out. The buffer places
+        // a cluster by the screen rectangle of its box's corners, which covers part of the screen
+        // for a cluster beside the view that reaches behind the eye or past a corner of the
+        // frustum, then sets up every triangle to find each outside (on castle views C1-C3, most
+        // of the triangles set up). Such a cluster claims no sample in front of the far plane,
+        // and leaves no hole where it is left out: an edge a neighbour shares with it lies in its
+        // box, outside the frustum, half a sample from every sample centre.
         for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) {
+            if (separated(frame.frustum, cluster_boxes_[c])) continue;
             frame_clusters_.push_back(c);
             frame_cluster_backfaces_.push_back(backface);
         }
@@ -483,7 +500,7 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
         (void)distance;
         const std::size_t n = occluder_triangles_drawn(*scene_, id, *frame.camera, config_.lods);
         if (n > left) continue;
-        append_occluder(id, *frame.camera, EdgeFlags::own_object);
+        append_occluder(id, frame, EdgeFlags::own_object);
         left -= n;
     }
     timings_.select_ms += ms_since(start);

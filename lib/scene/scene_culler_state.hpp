@@ -68,6 +68,7 @@ public:
     // of clusters_, whose flags are own_shared_edges_' (a cluster's apexes are in its own vertices).
     OccluderClusters clusters_;
     std::vector<std::uint32_t> cluster_first_;
+    std::vector<Aabb> cluster_boxes_;  // per cluster, its vertices' box (anchored world): left out of frames whose frustum it misses
     // The same clustered triangles' flags across the whole candidate set (occluders_'), for the
     // frames that may use them (EdgeFlags::across_objects); an apex from another object is a
     // copy among the cluster's vertices, after those of its own triangles and own apexes.
@@ -111,7 +112,7 @@ public:
     enum class EdgeFlags : std::uint8_t { own_object, across_objects };
     // Appends an occluder's triangles (or clusters), its LOD's when it has one usable from this
     // camera, with those flags (an LOD always has its own).
-    void append_occluder(std::uint32_t id, const Camera& camera, EdgeFlags edge_flags);
+    void append_occluder(std::uint32_t id, const Frame& frame, EdgeFlags edge_flags);
     bool draws_lod(std::uint32_t id, const Camera& camera) const;
     void gather_lods();
     void build_clusters();
