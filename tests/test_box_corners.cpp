@@ -112,5 +112,43 @@ TEST(BoxRectangle, KernelsGiveTheScalarRectangle) {
     EXPECT_GT(decided_without, kernels * 1000) << "and boxes decided without one";
 }
 
+// A box crossing the near plane has no screen rectangle; it is view-culled when all its corners
+// lie outside one side plane of the view (beside_the_view), and every point of such a box is
+// then outside the view: checked on random points of random boxes, with some boxes culled.
+TEST(BoxRectangle, BoxesCrossingTheNearPlaneBesideTheViewAreViewCulled) {
+    // A camera at the origin looking down -z (column-major; w = -z, x and y scaled by f).
+    const float f = 1.7f, near_w = 0.1f;
+    const std::array<float, 16> m = {f, 0, 0, 0, 0, f, 0, 0, 0, 0, -1.0f, -1.0f, 0, 0, -0.2f, 0};
+    const auto decide = [&](glm::vec3 lo, glm::vec3 hi) {
+        ScreenRect rect{};
+        Visibility decided = Visibility::occluded;
+        const float box_min[3] = {lo.x, lo.y, lo.z}, box_max[3] = {hi.x, hi.y, hi.z};
+        return detail::box_rectangle(box_min, box_max, m, near_w, false, rect, decided) ? Visibility::occluded : decided;
+    };
+    EXPECT_EQ(decide({30, -1, -20}, {31, 3, 20}), Visibility::view_culled);     // a wall beside the eye, reaching behind it
+    EXPECT_EQ(decide({-31, -1, -20}, {-30, 3, 20}), Visibility::view_culled);   // on the other side
+    EXPECT_EQ(decide({-5, 20, -10}, {5, 21, 10}), Visibility::view_culled);     // a ceiling above it
+    EXPECT_EQ(decide({-1, -1, -5}, {1, 1, 5}), Visibility::visible);            // around the eye
+    EXPECT_EQ(decide({10, -1, -40}, {11, 3, 20}), Visibility::visible);         // beside it, reaching into the view far ahead
+    std::mt19937 random(5);
+    std::uniform_real_distribution<float> position(-40.0f, 40.0f), size(0.1f, 40.0f), unit(0.0f, 1.0f);
+    int culled = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const glm::vec3 lo(position(random), position(random), position(random));
+        const glm::vec3 hi = lo + glm::vec3(size(random), size(random), size(random));
+        if (!(lo.z < -0.1f && hi.z > -0.1f)) continue;  // crossing the near plane (w = -z)
+        if (decide(lo, hi) != Visibility::view_culled) continue;
+        ++culled;
+        for (int k = 0; k < 200; ++k) {
+            const glm::vec3 p = lo + (hi - lo) * glm::vec3(k < 8 ? float(k & 1) : unit(random), k < 8 ? float((k >> 1) & 1) : unit(random),
+                                                         k < 8 ? float((k >> 2) & 1) : unit(random));
+            const double w = -double(p.z), x = double(f) * double(p.x), y = double(f) * double(p.y);
+            ASSERT_FALSE(w >= double(near_w) && std::abs(x) <= w && std::abs(y) <= w)
+                << "trial " << trial << ": a point of a view-culled box is in view";
+        }
+    }
+    EXPECT_GT(culled, 500);
+}
+
 }  // namespace
 }  // namespace homcull

@@ -133,10 +133,30 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
     if (orthographic) error = orthographic_corners(corners, error);
     const ClipBounds b = clip_bounds(corners, 8, double(near_w));
     if (!b.finite || b.behind > 0) {  // nothing to reason with, or crossing the near plane: visible
-        decided = b.finite && b.behind == 8 ? Visibility::view_culled : Visibility::visible;
+        decided = b.finite && (b.behind == 8 || (!orthographic && beside_the_view(corners, error))) ? Visibility::view_culled : Visibility::visible;
         return false;
     }
     return rectangle_from_bounds(b.min_x, b.max_x, b.min_y, b.max_y, b.min_w, error, rect, decided);
+}
+
+// Whether every corner of a box lies outside one side plane of the view (x > w, x < -w, y > w
+// or y < -w in clip space), with room for the corners' error, and 2^-20 of their magnitude for
+// the rounding of the matrix they came through (ground truth and the caller's double matrices
+// are within it). The sides are affine, so the whole box lies outside that side: in front of the
+// eye beside the view, behind it where w <= 0. For a box crossing the near plane, whose screen
+// rectangle cannot be bounded (a wall beside the eye, reaching behind it), the only test there
+// is.
+bool beside_the_view(const glm::dvec4 corners[8], double error) {
+    bool outside[4] = {true, true, true, true};  // right, left, top, bottom
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec4& c = corners[k];
+        const double margin = 2.0 * error + 0x1.0p-20 * (std::abs(c.x) + std::abs(c.y) + std::abs(c.w));
+        outside[0] = outside[0] && c.x - c.w > margin;
+        outside[1] = outside[1] && -c.x - c.w > margin;
+        outside[2] = outside[2] && c.y - c.w > margin;
+        outside[3] = outside[3] && -c.y - c.w > margin;
+    }
+    return outside[0] || outside[1] || outside[2] || outside[3];
 }
 
 bool rectangle_from_bounds(double min_x, double max_x, double min_y, double max_y, double min_w, double error, ScreenRect& rect,

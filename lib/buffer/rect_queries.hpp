@@ -204,11 +204,15 @@ double ndc_error_bound(double error, double max_abs_ndc, double min_w);
 // base corner plus three edge vectors), widened by the corners' error bound and rounded
 // outwards, with its nearest w lowered by that bound and rounded down; or,
 // returning false, the answer when it needs none (non-finite corners: visible; entirely
-// before the near plane: view-culled; crossing it: visible).
+// before the near plane: view-culled; crossing it: view-culled when wholly beside the view
+// (beside_the_view, perspective only), else visible).
 // orthographic: the buffer's BufferConfig::orthographic, whose corners are taken as their
 // orthographic representatives (orthographic_corners).
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,
                    bool orthographic, ScreenRect& rect, Visibility& decided);
+// Whether a box's clip-space corners (box_corners, with their error bound) all lie outside one
+// of the view's four side planes, by more than their error and the matrix's rounding.
+bool beside_the_view(const glm::dvec4 corners[8], double error);
 // box_rectangle's last step, from the corners' NDC bounds and nearest w (every corner finite
 // and at or beyond the near plane) and their error bound: the rectangle widened and rounded
 // outwards, or false (visible) when the bound leaves none. Shared with the SIMD kernel
