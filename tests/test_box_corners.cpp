@@ -148,6 +148,20 @@ TEST(BoxRectangle, BoxesCrossingTheNearPlaneBesideTheViewAreViewCulled) {
         }
     }
     EXPECT_GT(culled, 500);
+
+    // An orthographic view 20 wide and high (x and y scaled by 0.1, w = 1, the near plane at z = -1
+    // of clip space): a box the eye's plane cuts beside its window is view-culled, one in front of
+    // it visible.
+    const std::array<float, 16> ortho = {0.1f, 0, 0, 0, 0, 0.1f, 0, 0, 0, 0, -0.01f, 0, 0, 0, -1.0f, 1.0f};
+    const auto decide_ortho = [&](glm::vec3 lo, glm::vec3 hi) {
+        ScreenRect rect{};
+        Visibility decided = Visibility::occluded;
+        const float box_min[3] = {lo.x, lo.y, lo.z}, box_max[3] = {hi.x, hi.y, hi.z};
+        return detail::box_rectangle(box_min, box_max, ortho, detail::kOrthographicNearW, true, rect, decided) ? Visibility::occluded : decided;
+    };
+    EXPECT_EQ(decide_ortho({12, -1, -20}, {13, 3, 20}), Visibility::view_culled);
+    EXPECT_EQ(decide_ortho({-3, 11, -20}, {3, 12, 20}), Visibility::view_culled);
+    EXPECT_EQ(decide_ortho({8, -1, -20}, {9, 3, 20}), Visibility::visible);
 }
 
 }  // namespace

@@ -473,14 +473,15 @@ TEST(CApi, TriangleTestsStartWhereAskedAndPassOverAClosedSolidsBackFaces) {
 
 // A box crossing the near plane has no screen rectangle; beside the view (a wall along the
 // eye, reaching behind it) it is view-culled, on every instruction set, in front of the eye
-// visible; the same for a reversed-depth left-handed engine.
+// visible; the same for a reversed-depth left-handed engine and orthographic ones (whose
+// window, 80 x 45, is wider than the perspective view at these depths).
 TEST(CApi, BoxesCrossingTheNearPlaneBesideTheViewAreViewCulled) {
     const Scene scene;
-    const homcull_box boxes[3] = {{{30, -1, -20}, {31, 3, 20}}, {{-5, 25, -20}, {5, 26, 20}}, {{-1, -1, -0.5f}, {1, 1, 0.5f}}};
+    const homcull_box boxes[3] = {{{50, -1, -20}, {51, 3, 20}}, {{-5, 25, -20}, {5, 26, 20}}, {{-1, -1, -0.5f}, {1, 1, 0.5f}}};
     const homcull_visibility expected[3] = {HOMCULL_VIEW_CULLED, HOMCULL_VIEW_CULLED, HOMCULL_VISIBLE};
     for (homcull_isa isa = 0; isa < HOMCULL_ISA_COUNT; ++isa) {
         if (!(homcull_supported_isas() & (1u << isa))) continue;
-        for (const Engine e : {Engine::opengl, Engine::d3d_reversed_lh}) {
+        for (const Engine e : {Engine::opengl, Engine::d3d_reversed_lh, Engine::opengl_ortho, Engine::d3d_reversed_ortho_lh}) {
             Culler culler(scene, make_context(nullptr, isa));
             culler.frame(scene, engine_view(e));
             homcull_visibility answers[3] = {99, 99, 99};

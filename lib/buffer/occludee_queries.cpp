@@ -128,12 +128,17 @@ double ndc_error_bound(double error, double max_abs_ndc, double min_w) {
 
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m, float near_w, bool orthographic, ScreenRect& rect,
                    Visibility& decided) {
-    glm::dvec4 corners[8];
-    double error = box_corners(box_min, box_max, m, corners);
-    if (orthographic) error = orthographic_corners(corners, error);
+    glm::dvec4 corners[8], clip[8];
+    const double clip_error = box_corners(box_min, box_max, m, corners);
+    double error = clip_error;
+    if (orthographic) {
+        std::copy(corners, corners + 8, clip);  // the side planes are the clip corners'
+        error = orthographic_corners(corners, error);
+    }
     const ClipBounds b = clip_bounds(corners, 8, double(near_w));
-    if (!b.finite || b.behind > 0) {  // nothing to reason with, or crossing the near plane: visible
-        decided = b.finite && (b.behind == 8 || (!orthographic && beside_the_view(corners, error))) ? Visibility::view_culled : Visibility::visible;
+    if (!b.finite || b.behind > 0) {  // nothing to reason with, or crossing the near plane: visible unless beside the view
+        decided = b.finite && (b.behind == 8 || beside_the_view(orthographic ? clip : corners, clip_error)) ? Visibility::view_culled
+                                                                                                           : Visibility::visible;
         return false;
     }
     return rectangle_from_bounds(b.min_x, b.max_x, b.min_y, b.max_y, b.min_w, error, rect, decided);
@@ -143,9 +148,9 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
 // or y < -w in clip space), with room for the corners' error, and 2^-20 of their magnitude for
 // the rounding of the matrix they came through (ground truth and the caller's double matrices
 // are within it). The sides are affine, so the whole box lies outside that side: in front of the
-// eye beside the view, behind it where w <= 0. For a box crossing the near plane, whose screen
-// rectangle cannot be bounded (a wall beside the eye, reaching behind it), the only test there
-// is.
+// eye beside the view, behind it where w <= 0 (an orthographic view's w is constant: beside its
+// window at every depth). For a box crossing the near plane, whose screen rectangle cannot be
+// bounded (a wall beside the eye, reaching behind it), the only test there is.
 bool beside_the_view(const glm::dvec4 corners[8], double error) {
     bool outside[4] = {true, true, true, true};  // right, left, top, bottom
     for (int k = 0; k < 8; ++k) {

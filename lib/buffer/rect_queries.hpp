@@ -205,7 +205,7 @@ double ndc_error_bound(double error, double max_abs_ndc, double min_w);
 // outwards, with its nearest w lowered by that bound and rounded down; or,
 // returning false, the answer when it needs none (non-finite corners: visible; entirely
 // before the near plane: view-culled; crossing it: view-culled when wholly beside the view
-// (beside_the_view, perspective only), else visible).
+// (beside_the_view), else visible).
 // orthographic: the buffer's BufferConfig::orthographic, whose corners are taken as their
 // orthographic representatives (orthographic_corners).
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,
