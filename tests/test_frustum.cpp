@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -122,6 +123,25 @@ TEST(Frustum, AxesWithAMarginSeparateLessThanTheExactTest) {
     EXPECT_TRUE(separated(exact, at_eye));
     EXPECT_TRUE(separated(widened, at_eye));
     EXPECT_TRUE(separated(exact, Aabb{}));
+    // A box with a coordinate that is not a number, or infinite, is never separated.
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    for (const Aabb& b : {Aabb{{nan, 0, 0}, {1, 1, 1}}, Aabb{{-inf, 0, 0}, {inf, 1, 1}}, Aabb{{200, 200, 200}, {inf, inf, inf}}}) {
+        EXPECT_FALSE(separated(exact, b));
+        EXPECT_FALSE(separated(widened, b));
+    }
+    // A far plane at infinity (the scene culler's widening of one at the largest double) puts the
+    // far corners at infinity: the axes they reach are left out, so a box straight ahead is never
+    // separated (their NaN projections once shrank the extents to the near rectangle).
+    Camera unbounded = c;
+    unbounded.far_plane = std::numeric_limits<double>::infinity();
+    const FrustumAxes no_far = frustum_axes(make_frustum(unbounded, 1.6), 0x1.0p-20);
+    const glm::dvec3 ahead = c.eye + 30.0 * glm::normalize(c.target - c.eye);
+    EXPECT_FALSE(separated(no_far, Aabb{glm::vec3(ahead - 1.0), glm::vec3(ahead + 1.0)}));
+    // A slack in position widens every extent: a box just beyond the far plane is kept.
+    const glm::dvec3 far_point = c.eye + 80.5 * glm::normalize(c.target - c.eye);
+    const Aabb just_beyond{glm::vec3(far_point - 0.1), glm::vec3(far_point + 0.1)};
+    EXPECT_TRUE(separated(exact, just_beyond));
+    EXPECT_FALSE(separated(frustum_axes(f, 0.0, glm::dvec3(1.0)), just_beyond));
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <cstdio>
 
 namespace homcull {
@@ -464,6 +465,15 @@ TEST(SceneCulling, BoxesBesideTheFrustumAreViewCulledThoughTheirRectangleCoversT
     EXPECT_EQ(answers[beside].visibility, Visibility::view_culled);
     EXPECT_EQ(answers[reaching].visibility, Visibility::visible);
     EXPECT_EQ(answers[ahead].visibility, Visibility::visible);
+    // A far plane at the largest double (no far plane): the frustum leaves out the axes its far
+    // corners reach; nothing in view is culled.
+    Camera unbounded = camera;
+    unbounded.far_plane = std::numeric_limits<double>::max();
+    SceneCuller far_culler(scene, {wall}, config);
+    far_culler.cull(unbounded, answers);
+    EXPECT_EQ(answers[reaching].visibility, Visibility::visible);
+    EXPECT_EQ(answers[ahead].visibility, Visibility::visible);
+    EXPECT_EQ(answers[wall].visibility, Visibility::visible);
 }
 
 // An occluder above and beside the view that reaches behind the eye: its box passes the

@@ -137,31 +137,12 @@ bool box_rectangle(const float box_min[3], const float box_max[3], const std::ar
     }
     const ClipBounds b = clip_bounds(corners, 8, double(near_w));
     if (!b.finite || b.behind > 0) {  // nothing to reason with, or crossing the near plane: visible unless beside the view
-        decided = b.finite && (b.behind == 8 || beside_the_view(orthographic ? clip : corners, clip_error)) ? Visibility::view_culled
-                                                                                                           : Visibility::visible;
+        decided = b.finite && (b.behind == 8 || beside_the_view(orthographic ? clip : corners, clip_error, clip_term_bounds(box_min, box_max, m)))
+                      ? Visibility::view_culled
+                      : Visibility::visible;
         return false;
     }
     return rectangle_from_bounds(b.min_x, b.max_x, b.min_y, b.max_y, b.min_w, error, rect, decided);
-}
-
-// Whether every corner of a box lies outside one side plane of the view (x > w, x < -w, y > w
-// or y < -w in clip space), with room for the corners' error, and 2^-20 of their magnitude for
-// the rounding of the matrix they came through (ground truth and the caller's double matrices
-// are within it). The sides are affine, so the whole box lies outside that side: in front of the
-// eye beside the view, behind it where w <= 0 (an orthographic view's w is constant: beside its
-// window at every depth). For a box crossing the near plane, whose screen rectangle cannot be
-// bounded (a wall beside the eye, reaching behind it), the only test there is.
-bool beside_the_view(const glm::dvec4 corners[8], double error) {
-    bool outside[4] = {true, true, true, true};  // right, left, top, bottom
-    for (int k = 0; k < 8; ++k) {
-        const glm::dvec4& c = corners[k];
-        const double margin = 2.0 * error + 0x1.0p-20 * (std::abs(c.x) + std::abs(c.y) + std::abs(c.w));
-        outside[0] = outside[0] && c.x - c.w > margin;
-        outside[1] = outside[1] && -c.x - c.w > margin;
-        outside[2] = outside[2] && c.y - c.w > margin;
-        outside[3] = outside[3] && -c.y - c.w > margin;
-    }
-    return outside[0] || outside[1] || outside[2] || outside[3];
 }
 
 bool rectangle_from_bounds(double min_x, double max_x, double min_y, double max_y, double min_w, double error, ScreenRect& rect,
@@ -176,6 +157,39 @@ bool rectangle_from_bounds(double min_x, double max_x, double min_y, double max_
     }
     rect = {float_down(min_x - ndc), float_down(min_y - ndc), float_up(max_x + ndc), float_up(max_y + ndc), float_down(min_w - error)};
     return true;
+}
+
+// Whether every corner of a box lies outside one side plane of the view (x > w, x < -w, y > w
+// or y < -w in clip space), by more than twice the corners' error and 2^-20 of the rows' terms
+// (clip_term_bounds): the matrix is a rounding of the caller's (or ground truth's) projection,
+// each entry within 2^-24 of it, and terms that cancel in a coordinate still carry their
+// rounding. The sides are affine, so the whole box lies outside that side: in front of the eye
+// beside the view, behind it where w <= 0 (an orthographic view's w is constant: beside its
+// window at every depth). For a box crossing the near plane, whose screen rectangle cannot be
+// bounded (a wall beside the eye, reaching behind it), the only test there is.
+bool beside_the_view(const glm::dvec4 corners[8], double error, const glm::dvec4& terms) {
+    const double margin_x = 2.0 * error + 0x1.0p-20 * (terms.x + terms.w), margin_y = 2.0 * error + 0x1.0p-20 * (terms.y + terms.w);
+    bool outside[4] = {true, true, true, true};  // right, left, top, bottom
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec4& c = corners[k];
+        outside[0] = outside[0] && c.x - c.w > margin_x;
+        outside[1] = outside[1] && -c.x - c.w > margin_x;
+        outside[2] = outside[2] && c.y - c.w > margin_y;
+        outside[3] = outside[3] && -c.y - c.w > margin_y;
+    }
+    return outside[0] || outside[1] || outside[2] || outside[3];
+}
+
+glm::dvec4 clip_term_bounds(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) {
+    glm::dvec4 terms(0.0);
+    for (int row = 0; row < 4; ++row) {
+        double sum = std::abs(double(m[12 + std::size_t(row)]));
+        for (int axis = 0; axis < 3; ++axis)
+            sum += std::abs(double(m[4 * std::size_t(axis) + std::size_t(row)])) *
+                   std::max(std::abs(double(box_min[axis])), std::abs(double(box_max[axis])));
+        terms[row] = sum;
+    }
+    return terms;
 }
 
 }  // namespace detail

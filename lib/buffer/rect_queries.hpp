@@ -211,8 +211,12 @@ double ndc_error_bound(double error, double max_abs_ndc, double min_w);
 bool box_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip, float near_w,
                    bool orthographic, ScreenRect& rect, Visibility& decided);
 // Whether a box's clip-space corners (box_corners, with their error bound) all lie outside one
-// of the view's four side planes, by more than their error and the matrix's rounding.
-bool beside_the_view(const glm::dvec4 corners[8], double error);
+// of the view's four side planes, by more than their error and the matrix's rounding (terms:
+// clip_term_bounds).
+bool beside_the_view(const glm::dvec4 corners[8], double error, const glm::dvec4& terms);
+// Per clip row, the sum of its terms' magnitudes over the box: |m_row,j| max(|min_j|, |max_j|)
+// over j, plus |m_row,3|.
+glm::dvec4 clip_term_bounds(const float box_min[3], const float box_max[3], const std::array<float, 16>& m);
 // box_rectangle's last step, from the corners' NDC bounds and nearest w (every corner finite
 // and at or beyond the near plane) and their error bound: the rectangle widened and rounded
 // outwards, or false (visible) when the bound leaves none. Shared with the SIMD kernel

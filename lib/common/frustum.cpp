@@ -50,19 +50,21 @@ bool may_meet(const Frustum& fr, const Aabb& box) {
     return true;
 }
 
-FrustumAxes frustum_axes(const Frustum& fr, double relative_margin) {
+FrustumAxes frustum_axes(const Frustum& fr, double relative_margin, const glm::dvec3& position_slack) {
     FrustumAxes axes;
     axes.relative_margin = relative_margin;
     const auto add = [&](const glm::dvec3& axis) {
-        if (!(glm::length(axis) > 1e-12)) return;  // degenerate cross product: no axis
+        if (!(glm::length(axis) > 1e-12)) return;  // degenerate cross product (or not finite): no axis
         double lo = HUGE_VAL, hi = -HUGE_VAL;
         for (const auto& p : fr.corners) {
             const double d = glm::dot(axis, p);
+            if (!std::isfinite(d)) return;  // std::min would pass over a NaN and shrink the extent
             lo = std::min(lo, d);
             hi = std::max(hi, d);
         }
+        const double slack = glm::dot(glm::abs(axis), position_slack);
         const int k = axes.count++;
-        axes.axis[std::size_t(k)] = axis, axes.lo[std::size_t(k)] = lo, axes.hi[std::size_t(k)] = hi;
+        axes.axis[std::size_t(k)] = axis, axes.lo[std::size_t(k)] = lo - slack, axes.hi[std::size_t(k)] = hi + slack;
     };
     for (const auto& plane : fr.planes) add(glm::dvec3(plane));
     axes.plane_count = axes.count;
@@ -80,10 +82,12 @@ bool separated(const FrustumAxes& axes, const Aabb& box) {
     bool centre_inside = true;
     for (int k = 0; k < axes.count; ++k) {
         const glm::dvec3& a = axes.axis[std::size_t(k)];
+        const glm::dvec3 abs_a = glm::abs(a);
         const double c = glm::dot(a, centre);
-        const double r = std::abs(a.x) * half.x + std::abs(a.y) * half.y + std::abs(a.z) * half.z;
+        const double r = glm::dot(abs_a, half);
         const double f_lo = axes.lo[std::size_t(k)], f_hi = axes.hi[std::size_t(k)];
-        const double margin = axes.relative_margin * (std::abs(c) + r + std::abs(f_lo) + std::abs(f_hi));
+        // The box's terms without their cancellation (|a| |centre|, not |a . centre|).
+        const double margin = axes.relative_margin * (glm::dot(abs_a, glm::abs(centre)) + r + std::abs(f_lo) + std::abs(f_hi));
         if (f_hi + margin < c - r || c + r + margin < f_lo) return true;
         // A box whose centre lies within every plane's extent (inside the frustum) meets it:
         // most boxes tested are in view, and end here without the 21 other axes.

@@ -43,18 +43,20 @@ std::size_t hierarchy_depth(const ObjectHierarchy& hierarchy) {
 }
 
 // The display's view frustum in anchored world (positions minus `anchor`, as the objects' boxes),
-// for outside_view's exact box test. Ground truth counts a hit at a view depth from near to far
-// (its rays are eye + t d with d's forward component 1, from t = near to far) through a pixel
-// centre, half a pixel inside the screen's edges; the frustum reaches 2^-10 of the depths past
-// both planes and separates only by 2^-20 of the magnitudes, against the rounding of the eye,
-// the boxes and the rays.
+// for the exact box tests of test_object and append_occluder. Ground truth counts a hit at a
+// view depth from near to far (its rays are eye + t d with d's forward component 1, from t = near
+// to far) through a pixel centre, half a pixel inside the screen's edges, from the eye rounded
+// to float relative to the anchor. The frustum reaches 2^-10 of the depths past both planes, its
+// extents are widened by 2^-22 of the eye's coordinates (the rounded eye is within 2^-24), and it
+// separates only by 2^-20 of the terms' magnitudes, against the rounding of the boxes, the rays
+// and the projections. A far plane too far for doubles leaves the axes it reaches out.
 FrustumAxes view_frustum_axes(const Camera& camera, double aspect, const glm::dvec3& anchor) {
     Camera anchored = camera;
     anchored.eye -= anchor;
     anchored.target -= anchor;
     anchored.near_plane = camera.near_plane * (1.0 - 0x1.0p-10);
     anchored.far_plane = camera.far_plane * (1.0 + 0x1.0p-10);
-    return frustum_axes(make_frustum(anchored, aspect), 0x1.0p-20);
+    return frustum_axes(make_frustum(anchored, aspect), 0x1.0p-20, 0x1.0p-22 * glm::abs(anchored.eye));
 }
 
 }  // namespace

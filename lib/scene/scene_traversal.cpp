@@ -110,7 +110,10 @@ bool detail::SceneCullerState::node_hidden(const Frame& frame, std::uint32_t nod
     if (!config_.hierarchy || node.end - node.begin <= 1) return false;
     OccludeeAnswer a = box_answer(frame, node_boxes_[node_index]);
     ++tally.nodes;
-    if (a.visibility == Visibility::visible && separated(frame.frustum, node_boxes_[node_index])) a.visibility = Visibility::view_culled;
+    if (a.visibility == Visibility::visible && separated(frame.frustum, node_boxes_[node_index])) {
+        a.visibility = Visibility::view_culled;
+        a.level_of_visibility = 0.0f;
+    }
     if (a.visibility == Visibility::visible) return false;
     for (std::uint32_t i = node.begin; i < node.end; ++i) answers[hierarchy_.object_ids[i]] = a;
     tally.exits[a.overlap_exit] += node.end - node.begin;

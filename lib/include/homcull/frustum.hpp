@@ -35,12 +35,15 @@ struct FrustumAxes {
     int count = 0;
     int plane_count = 0;  // the first axes: the planes' normals
     std::array<glm::dvec3, 27> axis;
-    std::array<double, 27> lo, hi;  // the frustum's corners projected on axis[k]
-    // How far apart, relative to the projections' magnitudes, a box and the frustum must lie to
-    // count as separated (0: exact, as intersects()).
+    std::array<double, 27> lo, hi;  // the frustum's corners projected on axis[k], widened by position_slack
+    // How far apart, relative to the magnitudes of the box's and the frustum's terms, a box and
+    // the frustum must lie to count as separated (0: exact, as intersects()).
     double relative_margin = 0.0;
 };
-FrustumAxes frustum_axes(const Frustum& frustum, double relative_margin = 0.0);
+// position_slack: how far, along each world axis, the frustum may lie from where its corners say
+// (a copy of it whose eye was rounded, say); each axis's extent is widened by that much. An axis
+// along which a corner's projection is not finite (a far plane at infinity) is left out.
+FrustumAxes frustum_axes(const Frustum& frustum, double relative_margin = 0.0, const glm::dvec3& position_slack = glm::dvec3(0.0));
 
 // True when some axis separates the box from the frustum by more than the margin (a box that
 // is empty is separated).
