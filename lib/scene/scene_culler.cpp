@@ -316,14 +316,6 @@ void detail::SceneCullerState::build_clusters() {
         add_candidate_clusters(k, part);
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
-    cluster_boxes_.clear();
-    for (const OccluderCluster& c : clusters_.clusters) {
-        Aabb box;
-        for (std::uint32_t v = c.first_vertex; v < c.first_vertex + c.vertex_count; ++v)
-            box.extend(glm::vec3(clusters_.positions[3 * std::size_t(v)], clusters_.positions[3 * std::size_t(v) + 1],
-                                 clusters_.positions[3 * std::size_t(v) + 2]));
-        cluster_boxes_.push_back(box);
-    }
     frame_clusters_.reserve(clusters_.clusters.size());
     frame_cluster_backfaces_.reserve(clusters_.clusters.size());
 }
@@ -438,7 +430,8 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
         const Backface backface = closed_[k] ? Backface::cw : config_.backface;
         // A batch not rendered yet takes the cross-object flags only if all its clusters may.
         frame_clusters_cross_ = (frame_clusters_.size() == frame_clusters_rendered_ || frame_clusters_cross_) && !own;
-        // A cluster whose box misses the frustum (Frame::frustum) is left out. The buffer places
+        // A cluster whose box (OccluderCluster::bounds, of its own vertices, in anchored world)
+        // misses the frustum (Frame::frustum) is left out. The buffer places
         // a cluster by the screen rectangle of its box's corners, which covers part of the screen
         // for a cluster beside the view that reaches behind the eye or past a corner of the
         // frustum, then sets up every triangle to find each outside (on castle views C1-C3, most
@@ -446,7 +439,8 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
         // and leaves no hole where it is left out: an edge a neighbour shares with it lies in its
         // box, outside the frustum, half a sample from every sample centre.
         for (std::uint32_t c = cluster_first_[k]; c < cluster_first_[k + 1]; ++c) {
-            if (separated(frame.frustum, cluster_boxes_[c])) continue;
+            const OccluderCluster& cluster = clusters_.clusters[c];
+            if (cluster.bounded && separated(frame.frustum, cluster.bounds)) continue;
             frame_clusters_.push_back(c);
             frame_cluster_backfaces_.push_back(backface);
         }

@@ -16,7 +16,7 @@ struct detail::SceneCullerState::Frame {
     std::array<float, 16> clip;  // anchored world (world minus the anchor) to clip, in float: the buffer's and the maps' input
     glm::dmat4 clip_double;      // world to clip in double, as ground truth transforms
     // The display's view frustum in anchored world (view_frustum_axes), for the exact test of
-    // boxes that the buffer's screen rectangles find visible (outside_view).
+    // the boxes the buffer's screen rectangles find visible and of the occluder clusters.
     FrustumAxes frustum;
 };
 

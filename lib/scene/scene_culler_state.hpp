@@ -68,7 +68,6 @@ public:
     // of clusters_, whose flags are own_shared_edges_' (a cluster's apexes are in its own vertices).
     OccluderClusters clusters_;
     std::vector<std::uint32_t> cluster_first_;
-    std::vector<Aabb> cluster_boxes_;  // per cluster, its vertices' box (anchored world): left out of frames whose frustum it misses
     // The same clustered triangles' flags across the whole candidate set (occluders_'), for the
     // frames that may use them (EdgeFlags::across_objects); an apex from another object is a
     // copy among the cluster's vertices, after those of its own triangles and own apexes.
