@@ -167,26 +167,60 @@ struct SampleCounts {
 };
 
 
+// A screen triangle's outer bounds: its oriented vertices, their rounding (VertexSlack), the
+// padding of its coverage and the samples [i0, i1] x [j0, j1] of its padded bounding box,
+// which hold every sample its outer coverage may reach; its nearest vertex's depth and the
+// relative raise, whose product bounds its depth at any of them.
+struct OuterBounds {
+    OrientedTriangle tri;
+    bool has_area;
+    VertexSlack slack;
+    double pad_x, pad_y;
+    int i0, i1, j0, j1;
+    float z_vertex_max, raise;
+    bool empty() const { return i0 > i1 || j0 > j1; }
+};
+
+OuterBounds outer_bounds(const detail::ScreenTriangle& screen, const ClipError& error, double margin, int sample_width, int sample_height) {
+    OuterBounds b;
+    b.has_area = detail::orient_triangle(screen, b.tri);  // its vertices and depths are set either way
+    b.slack = vertex_slack(error, b.tri, sample_width, sample_height);
+    b.pad_x = b.slack.max_x + margin, b.pad_y = b.slack.max_y + margin;
+    const glm::dvec2* v = b.tri.v;
+    const double min_x = std::min({v[0].x, v[1].x, v[2].x}) - b.pad_x, max_x = std::max({v[0].x, v[1].x, v[2].x}) + b.pad_x;
+    const double min_y = std::min({v[0].y, v[1].y, v[2].y}) - b.pad_y, max_y = std::max({v[0].y, v[1].y, v[2].y}) + b.pad_y;
+    detail::sample_span(min_x, max_x, sample_width, b.i0, b.i1);
+    detail::sample_span(min_y, max_y, sample_height, b.j0, b.j1);
+    b.z_vertex_max = detail::float_up(std::max({b.tri.d[0], b.tri.d[1], b.tri.d[2]}));
+    b.raise = detail::float_up(1.0 + 0x1.0p-20 + b.slack.w_relative);
+    return b;
+}
+
+// Whether the layers hide the triangle's whole bounding box of samples at its nearest vertex's
+// raised depth: a rectangle test (test_prepared_rect) whose samples include every sample the
+// triangle's outer coverage reaches, at a depth no nearer than any bound count_triangle takes
+// there (OccludeeDepth::at is at most z_vertex_max * raise in float, rounded up here), against
+// the same layer bounds (subtile_unhidden_samples). Such a triangle hides nothing that
+// count_triangle would find: its samples are not counted.
+bool bounding_rectangle_hidden(const OuterBounds& b, const detail::BufferState& buffer) {
+    const detail::RectQuery q{b.i0, b.i1, b.j0, b.j1, detail::float_up(double(b.z_vertex_max) * double(b.raise))};
+    return buffer.test_prepared_rect(q) != Visibility::visible;
+}
+
 // Counts one screen triangle's outer-covered samples and those not certainly hidden; stops
 // once more than `tolerated` are visible.
-void count_triangle(const detail::ScreenTriangle& screen, const ClipError& error, const PlaneError& depth_error, double margin,
-                    const detail::SubtileView& view, int sample_width, int sample_height, std::uint64_t tolerated,
+void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const detail::SubtileView& view, int sample_width, int sample_height, std::uint64_t tolerated,
                     const detail::BufferKernels& kernels, SampleCounts& counts) {
-    OrientedTriangle tri;
-    const bool has_area = detail::orient_triangle(screen, tri);  // its vertices and depths are set either way
-    const VertexSlack slack = vertex_slack(error, tri, sample_width, sample_height);
-    const double pad_x = slack.max_x + margin, pad_y = slack.max_y + margin;
-    const glm::dvec2* v = tri.v;
-    const double min_x = std::min({v[0].x, v[1].x, v[2].x}) - pad_x, max_x = std::max({v[0].x, v[1].x, v[2].x}) + pad_x;
-    const double min_y = std::min({v[0].y, v[1].y, v[2].y}) - pad_y, max_y = std::max({v[0].y, v[1].y, v[2].y}) + pad_y;
-    int i0, i1, j0, j1;
-    detail::sample_span(min_x, max_x, sample_width, i0, i1);
-    detail::sample_span(min_y, max_y, sample_height, j0, j1);
-    if (i0 > i1 || j0 > j1) return;
+    if (b.empty()) return;
+    const OrientedTriangle& tri = b.tri;
+    const bool has_area = b.has_area;
+    const VertexSlack& slack = b.slack;
+    const double pad_x = b.pad_x, pad_y = b.pad_y;
+    const int i0 = b.i0, i1 = b.i1, j0 = b.j0, j1 = b.j1;
 
     OccludeeDepth depth;
-    depth.z_vertex_max = detail::float_up(std::max({tri.d[0], tri.d[1], tri.d[2]}));
-    depth.raise = detail::float_up(1.0 + 0x1.0p-20 + slack.w_relative);
+    depth.z_vertex_max = b.z_vertex_max;
+    depth.raise = b.raise;
     TriangleEdges edges{};
     if (has_area) {
         edges = detail::edge_functions(tri);
@@ -339,14 +373,28 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
         if (clip[0].w < near_clip && clip[1].w < near_clip && clip[2].w < near_clip) return false;
         in_frustum = true;
         if (!(near_clip > 0.0)) return true;  // coordinates too large to place the near plane
+        // A triangle that needs no clipping, tested with no tolerance, goes through its bounding
+        // rectangle first: most triangles of hidden occludees are hidden there (castle C3: 93 %),
+        // for a fraction of the set-up and the row scan. The triangle is the one
+        // setup_clip_triangle makes of it (its projection, no clipping); with a tolerance every
+        // sample counts, so the others go through setup.
+        if (tolerated_samples == 0 && !detail::needs_clipping(clip, near_clip) && !detail::too_large_to_clip(clip, near_clip)) {
+            detail::ScreenTriangle screen;
+            for (int k = 0; k < 3; ++k)
+                detail::project_to_samples(clip[k].x, clip[k].y, clip[k].w, sample_width_, sample_height_, screen.p[k], screen.d[k]);
+            const OuterBounds bounds = outer_bounds(screen, error, config_.edge_margin, sample_width_, sample_height_);
+            if (bounds.empty() || bounding_rectangle_hidden(bounds, *this)) return false;
+            count_triangle(bounds, plane_error(clip, error), view, sample_width_, sample_height_, 0, *kernels_, counts);
+            return counts.visible > 0;
+        }
         RasterStats stats;
         const detail::SetupResult setup =
             detail::setup_clip_triangle(clip, 0, Backface::none, near_clip, sample_width_, sample_height_, stats, /*occludee=*/true);
         if (stats.too_large) return true;  // not clipped precisely enough to reason with
         const PlaneError depth_error = plane_error(clip, error);
         for (int k = 0; k < setup.count; ++k) {
-            count_triangle(setup.triangles[k], error, depth_error, config_.edge_margin, view, sample_width_, sample_height_, tolerated_samples,
-                           *kernels_, counts);
+            count_triangle(outer_bounds(setup.triangles[k], error, config_.edge_margin, sample_width_, sample_height_), depth_error, view,
+                           sample_width_, sample_height_, tolerated_samples, *kernels_, counts);
             if (counts.visible > tolerated_samples) return true;
         }
         return false;

@@ -139,11 +139,7 @@ SetupResult setup_clip_triangle(const glm::dvec4 clip[3], std::uint8_t shared_bi
     // Project to sample space (y down) with depth 1/w.
     glm::dvec2 screen[ClipPolygon::kMax];
     double depth[ClipPolygon::kMax];
-    for (int k = 0; k < poly.count; ++k) {
-        const double inv_w = 1.0 / poly.v[k].z;
-        screen[k] = {(poly.v[k].x * inv_w + 1.0) * 0.5 * sample_width, (1.0 - poly.v[k].y * inv_w) * 0.5 * sample_height};
-        depth[k] = inv_w;
-    }
+    for (int k = 0; k < poly.count; ++k) project_to_samples(poly.v[k].x, poly.v[k].y, poly.v[k].z, sample_width, sample_height, screen[k], depth[k]);
     // Fan triangles (0, k, k + 1): their diagonals are shared with each other. A clipped
     // polygon's fan keeps its margin-free edges only as margin_free_edges allows (an unclipped
     // triangle's flags were decided so already, edges_across).

@@ -174,6 +174,15 @@ constexpr double kGuardBand = 32.0;
 // interpolation's parameter rounds to 1), and so a depth in front of the near plane.
 bool too_large_to_clip(const glm::dvec4 clip[3], double near_w);
 
+// A clip-space point (x, y, w > 0) in sample space (y down) with its depth 1/w: the
+// projection of setup_clip_triangle, which the occludee triangle tests repeat for a triangle
+// that needs no clipping.
+inline void project_to_samples(double x, double y, double w, int sample_width, int sample_height, glm::dvec2& screen, double& depth) {
+    const double inv_w = 1.0 / w;
+    screen = {(x * inv_w + 1.0) * 0.5 * sample_width, (1.0 - y * inv_w) * 0.5 * sample_height};
+    depth = inv_w;
+}
+
 // Whether a vertex lies before the near plane or beyond the guard band: the triangle is clipped.
 bool needs_clipping(const glm::dvec4 clip[3], double near_w);
 

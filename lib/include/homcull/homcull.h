@@ -370,7 +370,8 @@ typedef struct homcull_triangle_test_result {
     homcull_visibility visibility;
     uint8_t reserved[7];
     size_t deciding_triangle;   /* visible: the triangle found visible (next frame's first_triangle); else 0 */
-    uint64_t samples;           /* samples the triangles may cover, counted up to the answer (partial when visible) */
+    uint64_t samples;           /* samples the triangles may cover, counted up to the answer (partial when visible; with
+                                   no tolerance, triangles whose bounding rectangle is hidden are passed over uncounted) */
     uint64_t visible_samples;   /* of those, the samples with no occluder certainly nearer */
 } homcull_triangle_test_result;
 
