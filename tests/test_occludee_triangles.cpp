@@ -3,6 +3,7 @@
 // random triangles that the test never hides a triangle seen at a sample of the buffer.
 #include "buffer/buffer_kernels.hpp"
 #include "buffer/occludee_depth.hpp"
+#include "buffer/occludee_rectangles.hpp"
 #include "common/isa_choice.hpp"
 #include "raster/triangle_batch.hpp"
 #include "support.hpp"
@@ -437,6 +438,80 @@ TEST(OccludeeTriangles, PassingOverHiddenRectanglesKeepsEveryAnswer) {
             EXPECT_GT(occluded, 20);
             EXPECT_GT(visible, 20);
         }
+}
+
+// The batch kernel's rectangles against the one-triangle rectangle
+// (occludee_bounding_rectangle), on triangles of a perspective view near and far, tiny and
+// huge, crossing the near plane and the guard band, far from the origin, some with a NaN: every
+// lane the kernel takes is one the one-triangle test sets up without clipping, and its
+// rectangle holds that one's samples at a depth no farther.
+TEST(OccludeeTriangles, BatchRectanglesHoldTheOneTriangleRectangles) {
+    std::mt19937_64 random(23);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-3.0, 3.0);
+    constexpr int kWidth = 317, kHeight = 181;
+    constexpr double kNear = 0.5, kMargin = 1.0 / 1024.0;
+    std::size_t taken = 0, unclipped = 0, compared = 0;
+    for (const std::string& name : available_isas()) {
+        const detail::IsaChoice* choice = detail::find_isa_choice(name.c_str());
+        ASSERT_NE(choice, nullptr) << name;
+        const detail::BufferKernels& kernels = detail::buffer_kernels(*choice);
+        if (!kernels.occludee_rectangles) continue;  // the scalar choice
+        for (int trial = 0; trial < 400; ++trial) {
+            const glm::dvec3 offset = trial % 4 == 3 ? glm::dvec3(3e4, -2e4, 5e4) : glm::dvec3(0.0);
+            const glm::dmat4 clip_from_world = glm::perspective(glm::radians(50.0), double(kWidth) / kHeight, kNear, 1e4) *
+                                               glm::lookAt(offset, offset + glm::dvec3(unit(random), unit(random), -1.0), glm::dvec3(0, 1, 0));
+            std::array<float, 16> m;
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) m[std::size_t(4 * c + r)] = float(clip_from_world[c][r]);
+            std::vector<float> xyz;
+            for (int t = 0; t < detail::TriangleBatch::kSize; ++t) {
+                const double distance = std::pow(10.0, exponent(random) * 0.8 + 0.5), size = std::pow(10.0, exponent(random));
+                const glm::dvec3 centre = offset + glm::dvec3(unit(random) * distance, unit(random) * distance, -distance + unit(random) * 2.0);
+                for (int k = 0; k < 3; ++k)
+                    for (int i = 0; i < 3; ++i) xyz.push_back(float(centre[i] + unit(random) * size));
+            }
+            if (trial % 9 == 4) xyz[std::size_t(random() % xyz.size())] = std::numeric_limits<float>::quiet_NaN();
+            TriangleInput in;
+            in.positions = xyz.data();
+            in.vertex_count = xyz.size() / 3;
+            in.triangle_count = in.vertex_count / 3;
+            in.model_to_clip = m;
+            in.backface = Backface::none;
+            detail::TriangleBatch batch;
+            batch.count = int(in.triangle_count);
+            detail::gather_triangle_batch(in, 0, batch.count, batch);
+            kernels.raster.front_end.transform_batch_plain(in, batch);
+            const detail::OccludeeRectangleParams params{m.data(), kNear, kMargin, kWidth, kHeight};
+            detail::RectQuery rects[detail::TriangleBatch::kSize];
+            const std::uint32_t ready = kernels.occludee_rectangles(batch, batch.count, params, rects);
+            for (int t = 0; t < batch.count; ++t) {
+                glm::dvec4 model[3], clip[3];
+                for (int k = 0; k < 3; ++k) model[k] = {batch.px[k][t], batch.py[k][t], batch.pz[k][t], batch.pw[k][t]}, clip[k] = batch.clip(t, k);
+                detail::RectQuery one{};
+                bool finite = true;
+                for (int k = 0; k < 3; ++k) finite = finite && std::isfinite(clip[k].x) && std::isfinite(clip[k].y) && std::isfinite(clip[k].w);
+                const bool set_up = finite && detail::occludee_bounding_rectangle(m, model, clip, kNear, kMargin, kWidth, kHeight, one);
+                unclipped += set_up;
+                if (!((ready >> t) & 1u)) continue;
+                ++taken;
+                SCOPED_TRACE(name + ", trial " + std::to_string(trial) + ", lane " + std::to_string(t));
+                ASSERT_TRUE(set_up);
+                const detail::RectQuery& r = rects[t];
+                if (one.i0 > one.i1 || one.j0 > one.j1) continue;  // no samples: any rectangle holds them
+                ASSERT_LE(r.i0, one.i0);
+                ASSERT_GE(r.i1, one.i1);
+                ASSERT_LE(r.j0, one.j0);
+                ASSERT_GE(r.j1, one.j1);
+                ASSERT_GE(r.d_near, one.d_near);
+                ASSERT_LE(r.d_near, one.d_near * (1.0f + 0x1.0p-16f));  // no farther, and hardly nearer
+                ++compared;
+            }
+        }
+    }
+    std::printf("taken %zu unclipped %zu compared %zu\n", taken, unclipped, compared);
+    if (taken == 0) GTEST_SKIP() << "no instruction set with the kernel";
+    EXPECT_GT(taken, unclipped * 9 / 10) << "lanes the kernel takes, of those set up without clipping";
+    EXPECT_GT(compared, taken / 4) << "lanes with samples";
 }
 
 // The row kernel against its reference, on depths placed where a rounding decides: each

@@ -11,6 +11,7 @@ BufferKernels resolve_buffer_kernels(const IsaChoice& choice) {
     resolve_occludee_row_kernels(choice, k);
     resolve_rect_query_kernels(choice, k);
     resolve_box_rectangle_kernel(choice, k);
+    resolve_occludee_rectangle_kernel(choice, k);
     return k;
 }
 }  // namespace

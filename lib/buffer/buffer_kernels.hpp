@@ -4,6 +4,7 @@
 // the table of the instruction set it was made with (BufferConfig::isa) and every render,
 // task and query it runs, on any thread, reads its kernels there.
 #include "buffer/occludee_depth.hpp"
+#include "buffer/occludee_rectangles.hpp"
 #include "buffer/rect_queries.hpp"
 #include "raster/raster_kernels.hpp"
 
@@ -19,6 +20,7 @@ struct BufferKernels {
     RectOneKernel rect_one;
     RectPreparedKernel rect_prepared;
     BoxRectangleKernel box_rectangle;
+    OccludeeRectanglesKernel occludee_rectangles;  // occludee_rectangles.hpp
 };
 
 // box_rectangle through a kernel table: its SIMD kernel for a perspective matrix, the scalar
@@ -35,5 +37,6 @@ const BufferKernels& buffer_kernels(const IsaChoice& choice);
 void resolve_occludee_row_kernels(const IsaChoice& choice, BufferKernels& kernels);
 void resolve_rect_query_kernels(const IsaChoice& choice, BufferKernels& kernels);
 void resolve_box_rectangle_kernel(const IsaChoice& choice, BufferKernels& kernels);
+void resolve_occludee_rectangle_kernel(const IsaChoice& choice, BufferKernels& kernels);
 
 }  // namespace homcull::detail

@@ -18,6 +18,7 @@
 #include "buffer/buffer_state.hpp"
 #include "common/float_mode.hpp"
 #include "buffer/occludee_depth.hpp"
+#include "buffer/occludee_rectangles.hpp"
 #include "buffer/raised_vertex_plane.hpp"
 #include "buffer/seen_solid.hpp"
 #include "buffer/rect_queries.hpp"
@@ -196,15 +197,26 @@ OuterBounds outer_bounds(const detail::ScreenTriangle& screen, const ClipError& 
     return b;
 }
 
-// Whether the layers hide the triangle's whole bounding box of samples at its nearest vertex's
-// raised depth: a rectangle test (test_prepared_rect) whose samples include every sample the
-// triangle's outer coverage reaches, at a depth no nearer than any bound count_triangle takes
-// there (OccludeeDepth::at is at most z_vertex_max * raise in float, rounded up here), against
-// the same layer bounds (subtile_unhidden_samples). Such a triangle hides nothing that
-// count_triangle would find: its samples are not counted.
-bool bounding_rectangle_hidden(const OuterBounds& b, const detail::BufferState& buffer) {
-    const detail::RectQuery q{b.i0, b.i1, b.j0, b.j1, detail::float_up(double(b.z_vertex_max) * double(b.raise))};
-    return buffer.test_prepared_rect(q) != Visibility::visible;
+// The outer bounds of a triangle that setup_clip_triangle sets up without clipping (at the near
+// plane near_clip): the screen triangle it makes of it (its projection alone). False for the
+// others.
+bool unclipped_outer_bounds(const glm::dvec4 clip[3], const ClipError& error, double near_clip, double margin, int sample_width,
+                            int sample_height, OuterBounds& bounds) {
+    if (detail::needs_clipping(clip, near_clip) || detail::too_large_to_clip(clip, near_clip)) return false;
+    detail::ScreenTriangle screen;
+    for (int k = 0; k < 3; ++k) detail::project_to_samples(clip[k].x, clip[k].y, clip[k].w, sample_width, sample_height, screen.p[k], screen.d[k]);
+    bounds = outer_bounds(screen, error, margin, sample_width, sample_height);
+    return true;
+}
+
+// The rectangle test of the triangle's whole bounding box of samples at its nearest vertex's
+// raised depth: its samples include every sample the triangle's outer coverage reaches, at a
+// depth no nearer than any bound count_triangle takes there (OccludeeDepth::at is at most
+// z_vertex_max * raise in float, rounded up here), and test_prepared_rect compares them with
+// the same layer bounds (subtile_unhidden_samples). Where it is hidden (or empty), the triangle
+// hides nothing count_triangle would find: its samples are not counted.
+detail::RectQuery bounding_rectangle(const OuterBounds& b) {
+    return {b.i0, b.i1, b.j0, b.j1, detail::float_up(double(b.z_vertex_max) * double(b.raise))};
 }
 
 // Counts one screen triangle's outer-covered samples and those not certainly hidden; stops
@@ -317,6 +329,15 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
 
 }  // namespace
 
+bool detail::occludee_bounding_rectangle(const std::array<float, 16>& model_to_clip, const glm::dvec4 model[3], const glm::dvec4 clip[3],
+                                         double near_w, double edge_margin, int sample_width, int sample_height, RectQuery& rect) {
+    const ClipError error = clip_error(model_to_clip, model);
+    OuterBounds bounds;
+    if (!unclipped_outer_bounds(clip, error, near_w * (1.0 - 0x1.0p-20) - error.w, edge_margin, sample_width, sample_height, bounds)) return false;
+    rect = bounding_rectangle(bounds);
+    return true;
+}
+
 OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const TriangleInput& given, std::uint64_t tolerated_samples,
                                                               std::size_t first_triangle, const OcclusionBuffer::ClosedSolid* solid) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
@@ -378,12 +399,9 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
         // for a fraction of the set-up and the row scan. The triangle is the one
         // setup_clip_triangle makes of it (its projection, no clipping); with a tolerance every
         // sample counts, so the others go through setup.
-        if (tolerated_samples == 0 && !detail::needs_clipping(clip, near_clip) && !detail::too_large_to_clip(clip, near_clip)) {
-            detail::ScreenTriangle screen;
-            for (int k = 0; k < 3; ++k)
-                detail::project_to_samples(clip[k].x, clip[k].y, clip[k].w, sample_width_, sample_height_, screen.p[k], screen.d[k]);
-            const OuterBounds bounds = outer_bounds(screen, error, config_.edge_margin, sample_width_, sample_height_);
-            if (bounds.empty() || bounding_rectangle_hidden(bounds, *this)) return false;
+        OuterBounds bounds;
+        if (tolerated_samples == 0 && unclipped_outer_bounds(clip, error, near_clip, config_.edge_margin, sample_width_, sample_height_, bounds)) {
+            if (bounds.empty() || test_prepared_rect(bounding_rectangle(bounds)) != Visibility::visible) return false;
             count_triangle(bounds, plane_error(clip, error), view, sample_width_, sample_height_, 0, *kernels_, counts);
             return counts.visible > 0;
         }
@@ -409,6 +427,9 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
     constexpr std::size_t kSingleFirst = 1, kSingleRemainder = kBatch / 2;
     const detail::FrontEndKernels& kernels = kernels_->raster.front_end;
     detail::TriangleBatch batch;  // gather_triangle_batch fills every lane
+    const bool rectangles_first = tolerated_samples == 0 && !in.orthographic && kernels_->occludee_rectangles;
+    const detail::OccludeeRectangleParams rectangle_params{in.model_to_clip.data(), near_w, config_.edge_margin, sample_width_, sample_height_};
+    detail::RectQuery rectangles[kBatch];
     std::size_t t = first_triangle < in.triangle_count ? first_triangle : 0;
     for (std::size_t n = 0; n < in.triangle_count;) {
         if (n < kSingleFirst || in.triangle_count - n < kSingleRemainder) {
@@ -431,6 +452,12 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
         // beyond its rounding (beyond_exactly), else taken in order with the others.
         const std::uint32_t passed_over = in.orthographic ? kernels.beyond_side_plane(batch, int(count), 0.0, 0.0)
                                                           : kernels.beyond_side_plane(batch, int(count), rows[0] + rows[3], rows[1] + rows[3]);
+        // The other lanes' bounding rectangles, where shows() would test one first (no
+        // tolerance, perspective, no clipping): each at least as large and as near as shows()'s,
+        // so one found hidden here would be found hidden there, and the lane is passed over as
+        // shows() would pass it over.
+        const std::uint32_t rectangle_ready =
+            rectangles_first ? kernels_->occludee_rectangles(batch, int(count), rectangle_params, rectangles) & ~passed_over : 0u;
         for (std::size_t k = 0; k < count; ++k) {
             if (!in.orthographic && ((passed_over >> k) & 1u)) continue;
             glm::dvec4 model[3], clip[3];
@@ -439,6 +466,16 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
                 clip[v] = batch.clip(int(k), v);
             }
             if (((passed_over >> k) & 1u) && beyond_exactly(model, clip)) continue;
+            if (((rectangle_ready >> k) & 1u) && (rectangles[k].i0 > rectangles[k].i1 || rectangles[k].j0 > rectangles[k].j1 ||
+                                                   test_prepared_rect(rectangles[k]) != Visibility::visible)) {
+                // shows()'s steps before its rectangle decide whether the triangle reaches the
+                // frustum: beyond a side plane, or a closed solid's triangle seen from behind, it
+                // does not; otherwise it does (in front of the near plane: the kernel's condition).
+                if (!beyond_side_plane_exactly(model, clip, rows[0], rows[1], rows[3]) &&
+                    !(solid && detail::certainly_faces_away(glm::dvec3(model[0]), glm::dvec3(model[1]), glm::dvec3(model[2]), *solid)))
+                    in_frustum = true;
+                continue;
+            }
             result.deciding_triangle = t + k;
             if (!((batch.indices_valid >> k) & 1u)) return visible();  // as fetch_clip_triangle
             bool finite = true;
