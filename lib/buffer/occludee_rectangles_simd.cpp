@@ -110,14 +110,16 @@ std::uint32_t OccludeeRectangles(const TriangleBatch& batch, int count, const Oc
             const V room = hn::Add(pad, hn::Mul(tiny, hn::Add(hn::Add(hn::Abs(v), pad), one)));
             return up ? hn::Add(v, room) : hn::Sub(v, room);
         };
+        // Lanes not usable may hold NaN here: zero, so that no conversion sees one.
+        const auto bound = [&](V v, V pad, bool up) { return hn::IfThenElseZero(usable, outward(v, pad, up)); };
         hn::Vec<decltype(di)> first_x, last_x, first_y, last_y;
-        SampleSpans(d, outward(min_x, pad_x, false), outward(max_x, pad_x, true), p.sample_width, first_x, last_x);
-        SampleSpans(d, outward(min_y, pad_y, false), outward(max_y, pad_y, true), p.sample_height, first_y, last_y);
+        SampleSpans(d, bound(min_x, pad_x, false), bound(max_x, pad_x, true), p.sample_width, first_x, last_x);
+        SampleSpans(d, bound(min_y, pad_y, false), bound(max_y, pad_y, true), p.sample_height, first_y, last_y);
         hn::Store(first_x, di, i0), hn::Store(last_x, di, i1), hn::Store(first_y, di, j0), hn::Store(last_y, di, j1);
         // The nearest vertex raised: float_up(z_vertex_max) * float_up(1 + 2^-20 + w_relative),
         // rounded up, is below this by far more than those three roundings (each 2^-23 at most).
         const V raise = hn::Mul(hn::Add(hn::Add(one, hn::Set(d, 0x1.0p-20)), hn::Mul(w_relative, widen)), hn::Set(d, 1.0 + 0x1.0p-19));
-        hn::Store(FloatOutward<true>(d, hn::Mul(d_max, raise)), df, d_near);
+        hn::Store(FloatOutward<true>(d, hn::IfThenElseZero(usable, hn::Mul(d_max, raise))), df, d_near);
         const std::uint32_t bits = LaneBits(d, usable);
         for (int k = 0; k < lanes && g + k < count; ++k)
             if ((bits >> k) & 1u) rects[g + k] = RectQuery{i0[k], i1[k], j0[k], j1[k], d_near[k]};
