@@ -53,48 +53,50 @@ std::uint32_t OccludeeRectangles(const TriangleBatch& batch, int count, const Oc
     const V infinity = hn::Set(d, HUGE_VAL), guard = hn::Set(d, kGuardBand), near_w = hn::Set(d, p.near_w);
     const V half_width = hn::Set(d, 0.5 * p.sample_width), half_height = hn::Set(d, 0.5 * p.sample_height);
     const V error_scale = hn::Set(d, 0x1.0p-22 * (1.0 + 0x1.0p-30));  // clip_error's 2^-22, widened
-    V m[16];
-    for (int i = 0; i < 16; ++i) m[i] = hn::Set(d, double(p.matrix[i]));
+    // No arrays of vectors (SVE's are sizeless): the matrix entries and the clip coordinates are
+    // broadcast or loaded where used.
+    const auto entry = [&](int i) { return hn::Set(d, double(p.matrix[i])); };
     std::uint32_t ready = 0;
     alignas(64) std::int32_t i0[8], i1[8], j0[8], j1[8];
     alignas(64) float d_near[8];
     for (int g = 0; g < count; g += lanes) {
         const std::uint8_t index_bits[8] = {std::uint8_t(batch.indices_valid >> g)};
         M usable = hn::And(hn::FirstN(d, std::size_t(count - g)), hn::LoadMaskBits(d, index_bits));
+        const auto cx = [&](int k) { return hn::Load(d, batch.cx[k] + g); };
+        const auto cy = [&](int k) { return hn::Load(d, batch.cy[k] + g); };
+        const auto cw = [&](int k) { return hn::Load(d, batch.cw[k] + g); };
         // clip_error: per vertex 2^-22 sum_i |m_ri p_i| of rows x, y, w; the largest over the vertices.
-        V ex = zero, ey = zero, ew = zero;
-        V x[3], y[3], w[3];
+        V ex = zero, ey = zero, ew = zero, min_w = infinity, extent = zero;
         for (int k = 0; k < 3; ++k) {
             const V px = hn::Load(d, batch.px[k] + g), py = hn::Load(d, batch.py[k] + g), pz = hn::Load(d, batch.pz[k] + g),
                     pw = hn::Load(d, batch.pw[k] + g);
             const auto magnitude = [&](int row) {
-                V s = hn::Abs(hn::Mul(m[row], px));
-                s = hn::Add(s, hn::Abs(hn::Mul(m[4 + row], py)));
-                s = hn::Add(s, hn::Abs(hn::Mul(m[8 + row], pz)));
-                return hn::Add(s, hn::Abs(hn::Mul(m[12 + row], pw)));
+                V s = hn::Abs(hn::Mul(entry(row), px));
+                s = hn::Add(s, hn::Abs(hn::Mul(entry(4 + row), py)));
+                s = hn::Add(s, hn::Abs(hn::Mul(entry(8 + row), pz)));
+                return hn::Add(s, hn::Abs(hn::Mul(entry(12 + row), pw)));
             };
             ex = hn::Max(ex, hn::Mul(error_scale, magnitude(0)));
             ey = hn::Max(ey, hn::Mul(error_scale, magnitude(1)));
             ew = hn::Max(ew, hn::Mul(error_scale, magnitude(3)));
-            x[k] = hn::Load(d, batch.cx[k] + g), y[k] = hn::Load(d, batch.cy[k] + g), w[k] = hn::Load(d, batch.cw[k] + g);
+            const V x = cx(k), y = cy(k), w = cw(k);
             // What the one-triangle code sets up without clipping (needs_clipping and
             // too_large_to_clip false at its near plane, which lies below near_w), finite, and
             // with depths far from float's denormals.
-            const V extent = hn::Max(hn::Max(hn::Abs(x[k]), hn::Abs(y[k])), hn::Abs(w[k]));
-            usable = hn::And(usable, hn::And(hn::Gt(w[k], near_w), hn::Lt(extent, infinity)));
-            usable = hn::And(usable, hn::And(hn::Not(hn::Gt(hn::Abs(x[k]), hn::Mul(guard, w[k]))), hn::Not(hn::Gt(hn::Abs(y[k]), hn::Mul(guard, w[k])))));
-            usable = hn::And(usable, hn::Lt(w[k], hn::Set(d, 0x1.0p100)));
+            const V vertex_extent = hn::Max(hn::Max(hn::Abs(x), hn::Abs(y)), hn::Abs(w));
+            usable = hn::And(usable, hn::And(hn::Gt(w, near_w), hn::Lt(vertex_extent, infinity)));
+            usable = hn::And(usable, hn::And(hn::Not(hn::Gt(hn::Abs(x), hn::Mul(guard, w))), hn::Not(hn::Gt(hn::Abs(y), hn::Mul(guard, w)))));
+            usable = hn::And(usable, hn::Lt(w, hn::Set(d, 0x1.0p100)));
+            min_w = hn::Min(min_w, w);
+            extent = hn::Max(extent, vertex_extent);
         }
-        V min_w = hn::Min(hn::Min(w[0], w[1]), w[2]);
-        V extent = zero;
-        for (int k = 0; k < 3; ++k) extent = hn::Max(extent, hn::Max(hn::Max(hn::Abs(x[k]), hn::Abs(y[k])), hn::Abs(w[k])));
         usable = hn::And(usable, hn::Not(hn::Gt(extent, hn::Mul(hn::Set(d, 0x1.0p28), min_w))));
         // project_to_samples and vertex_slack, lane by lane.
         V min_x = infinity, max_x = hn::Neg(infinity), min_y = infinity, max_y = hn::Neg(infinity);
         V slack_x = zero, slack_y = zero, w_relative = zero, d_max = zero;
         for (int k = 0; k < 3; ++k) {
-            const V inv_w = hn::Div(one, hn::IfThenElse(usable, w[k], one));
-            const V ndc_x = hn::Mul(x[k], inv_w), ndc_y = hn::Mul(y[k], inv_w);
+            const V inv_w = hn::Div(one, hn::IfThenElse(usable, cw(k), one));
+            const V ndc_x = hn::Mul(cx(k), inv_w), ndc_y = hn::Mul(cy(k), inv_w);
             const V sx = hn::Mul(hn::Mul(hn::Add(ndc_x, one), half), hn::Set(d, double(p.sample_width)));
             const V sy = hn::Mul(hn::Mul(hn::Sub(one, ndc_y), half), hn::Set(d, double(p.sample_height)));
             min_x = hn::Min(min_x, sx), max_x = hn::Max(max_x, sx), min_y = hn::Min(min_y, sy), max_y = hn::Max(max_y, sy);
