@@ -211,6 +211,113 @@ TEST(OccludeeTriangles, BadInputIsVisibleOrRejected) {
     EXPECT_THROW(buffer.test_triangles(too_few), Error);
 }
 
+// A non-finite coordinate in a batch of hidden triangles makes the occludee visible on every
+// instruction set, whichever triangle, vertex and coordinate holds it: for a clip-space input
+// (the identity matrix) and for a model-space one. The batch's rectangles are made in SIMD
+// lanes, where the Max and Min of a NaN give either operand depending on the instruction set.
+TEST(OccludeeTriangles, ANonFiniteCoordinateInABatchIsVisibleOnEveryIsa) {
+    const float bad_values[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                                -std::numeric_limits<float>::infinity()};
+    Soup hidden;  // 17 triangles behind the wall: the first alone, then a batch of 16
+    for (int t = 0; t < 17; ++t) hidden.add_flat(-0.5f + 0.05f * t, -0.5f, 0.5f, -0.5f, 0.0f, 0.5f, 20.0f);
+    std::vector<float> clip_xyzw;  // the same triangles as clip-space positions
+    for (std::size_t v = 0; v < hidden.xyw.size(); v += 3)
+        clip_xyzw.insert(clip_xyzw.end(), {hidden.xyw[v], hidden.xyw[v + 1], 0.0f, hidden.xyw[v + 2]});
+    for (const std::string& isa : available_isas()) {
+        const test::ScopedIsa selected(isa);
+        const OcclusionBuffer buffer = wall_at(10.0f);
+        ASSERT_EQ(answer(buffer, hidden), Visibility::occluded) << isa;
+        for (const int t : {1, 6, 16})
+            for (int k = 0; k < 3; ++k)
+                for (const float bad : bad_values) {
+                    for (int c = 0; c < 4; ++c) {  // clip space: x, y, z, w
+                        std::vector<float> positions = clip_xyzw;
+                        positions[std::size_t(12 * t + 4 * k + c)] = bad;
+                        TriangleInput in;
+                        in.positions = positions.data();
+                        in.position_components = 4;
+                        in.position_stride = 16;
+                        in.vertex_count = positions.size() / 4;
+                        in.triangle_count = in.vertex_count / 3;
+                        in.clip_space = true;
+                        in.backface = Backface::none;
+                        EXPECT_EQ(buffer.test_triangles(in).visibility, Visibility::visible)
+                            << isa << ", clip space, triangle " << t << ", vertex " << k << ", coordinate " << c << ", " << bad;
+                    }
+                    for (int c = 0; c < 3; ++c) {  // model space
+                        Soup occludee = hidden;
+                        occludee.xyw[std::size_t(9 * t + 3 * k + c)] = bad;
+                        EXPECT_EQ(answer(buffer, occludee), Visibility::visible)
+                            << isa << ", model space, triangle " << t << ", vertex " << k << ", coordinate " << c << ", " << bad;
+                    }
+                }
+    }
+}
+
+// Where the transform's rounding bound of w reaches the near plane (error.w >= near_w), the
+// test cannot place that plane and answers visible: on every instruction set, also for the
+// triangles of a batch hidden behind a wall by their rectangles. Under the soup's matrix
+// error.w is 2^-22 w: about 0.95 at w = 4e6, above the near plane's 0.5.
+TEST(OccludeeTriangles, ATriangleTooFarToPlaceTheNearPlaneIsVisibleOnEveryIsa) {
+    Soup far;
+    far.add_flat(-0.5f, -0.5f, 0.5f, -0.5f, 0.0f, 0.5f, 20.0f);  // the first, alone: hidden
+    for (int t = 0; t < 16; ++t) far.add_flat(-0.5f + 0.05f * t, -0.5f, 0.5f, -0.5f, 0.0f, 0.5f, 4e6f);
+    Soup near_enough = far;  // at w = 1e6 (error.w about 0.24): hidden
+    for (std::size_t v = 9; v < near_enough.xyw.size(); ++v) near_enough.xyw[v] *= 0.25f;
+    for (const std::string& isa : available_isas()) {
+        const test::ScopedIsa selected(isa);
+        const OcclusionBuffer buffer = wall_at(10.0f);
+        EXPECT_EQ(answer(buffer, far), Visibility::visible) << isa;
+        EXPECT_EQ(answer(buffer, near_enough), Visibility::occluded) << isa;
+    }
+}
+
+// A closed solid whose only face towards the eye lies before the near plane: a box from depth
+// 0.3 to 20, four times as wide as the view at depth 10 is (x, y in [-5, 5], the view's side
+// planes at x = +-w/2). Its side faces, seen from behind, reach the view beyond depth 10, where
+// a wall at depth 8 hides them. Without the solid the answer is occluded (hidden triangles in
+// the view); with it view_culled (no front face in the view, hidden or not), on every
+// instruction set: the side faces' slices go through the batches, where those behind the wall
+// are passed over on their rectangles.
+TEST(OccludeeTriangles, AClosedSolidsHiddenBackFacesAreNotInTheViewOnEveryIsa) {
+    const glm::dmat4 clip_from_world = glm::perspective(2.0 * std::atan(0.5), 1.0, 0.5, 100.0);
+    std::array<float, 16> m;
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) m[std::size_t(4 * c + r)] = float(clip_from_world[c][r]);
+    std::vector<float> xyz;
+    const auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {  // counter-clockwise seen from outside
+        for (const glm::vec3& p : {a, b, c, a, c, d}) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+    };
+    constexpr float kHalf = 5.0f, kFront = -0.3f, kBack = -20.0f;
+    quad({-kHalf, -kHalf, kFront}, {kHalf, -kHalf, kFront}, {kHalf, kHalf, kFront}, {-kHalf, kHalf, kFront});  // the face towards the eye
+    quad({-kHalf, -kHalf, kBack}, {-kHalf, kHalf, kBack}, {kHalf, kHalf, kBack}, {kHalf, -kHalf, kBack});
+    const float slices[] = {kFront, -1, -2, -3, -4, -5, -6, -7, -8, -9, -10, -11, -12, -13, -14, -15, -16, -17, -18, -19, kBack};
+    for (std::size_t i = 0; i + 1 < std::size(slices); ++i) {
+        const float z0 = slices[i], z1 = slices[i + 1];  // z1 farther
+        quad({kHalf, -kHalf, z0}, {kHalf, -kHalf, z1}, {kHalf, kHalf, z1}, {kHalf, kHalf, z0});      // +x
+        quad({-kHalf, -kHalf, z0}, {-kHalf, kHalf, z0}, {-kHalf, kHalf, z1}, {-kHalf, -kHalf, z1});  // -x
+        quad({-kHalf, kHalf, z0}, {kHalf, kHalf, z0}, {kHalf, kHalf, z1}, {-kHalf, kHalf, z1});      // +y
+        quad({-kHalf, -kHalf, z0}, {-kHalf, -kHalf, z1}, {kHalf, -kHalf, z1}, {kHalf, -kHalf, z0});  // -y
+    }
+    TriangleInput in;
+    in.positions = xyz.data();
+    in.vertex_count = xyz.size() / 3;
+    in.triangle_count = in.vertex_count / 3;
+    in.model_to_clip = m;
+    in.backface = Backface::none;
+    const OcclusionBuffer::ClosedSolid outside{{0.0, 0.0, 0.0}, 1};
+    for (const std::string& isa : available_isas()) {
+        const test::ScopedIsa selected(isa);
+        const OcclusionBuffer buffer = wall_at(8.0f);  // (a 64 x 36 buffer: samples off its diagonal)
+        EXPECT_EQ(buffer.test_triangles(in).visibility, Visibility::occluded) << isa;
+        EXPECT_EQ(buffer.test_triangles(in, 0, 0, outside).visibility, Visibility::view_culled) << isa;
+        EXPECT_EQ(buffer.test_triangles(in, 0, 5, outside).visibility, Visibility::view_culled) << isa << ", from triangle 5";
+        const OcclusionBuffer empty = make_buffer(64, 36);  // nothing hides the back faces: seen without the solid
+        EXPECT_EQ(empty.test_triangles(in).visibility, Visibility::visible) << isa;
+        EXPECT_EQ(empty.test_triangles(in, 0, 0, outside).visibility, Visibility::view_culled) << isa;
+    }
+}
+
 long double edge(long double ax, long double ay, long double bx, long double by, long double px, long double py) {
     return (bx - ax) * (py - ay) - (by - ay) * (px - ax);
 }
@@ -457,7 +564,11 @@ TEST(OccludeeTriangles, BatchRectanglesHoldTheOneTriangleRectangles) {
         const detail::BufferKernels& kernels = detail::buffer_kernels(*choice);
         if (!kernels.occludee_rectangles) continue;  // the scalar choice
         for (int trial = 0; trial < 400; ++trial) {
-            const glm::dvec3 offset = trial % 4 == 3 ? glm::dvec3(3e4, -2e4, 5e4) : glm::dvec3(0.0);
+            // Far from the origin; and farther, where the rounding bound of w reaches the near plane
+            // (the one-triangle test answers visible: no lane may be taken).
+            const glm::dvec3 offset = trial % 8 == 7   ? glm::dvec3(3e6, -2e6, 5e6)
+                                      : trial % 4 == 3 ? glm::dvec3(3e4, -2e4, 5e4)
+                                                       : glm::dvec3(0.0);
             const glm::dmat4 clip_from_world = glm::perspective(glm::radians(50.0), double(kWidth) / kHeight, kNear, 1e4) *
                                                glm::lookAt(offset, offset + glm::dvec3(unit(random), unit(random), -1.0), glm::dvec3(0, 1, 0));
             std::array<float, 16> m;
@@ -508,7 +619,6 @@ TEST(OccludeeTriangles, BatchRectanglesHoldTheOneTriangleRectangles) {
             }
         }
     }
-    std::printf("taken %zu unclipped %zu compared %zu\n", taken, unclipped, compared);
     if (taken == 0) GTEST_SKIP() << "no instruction set with the kernel";
     EXPECT_GT(taken, unclipped * 9 / 10) << "lanes the kernel takes, of those set up without clipping";
     EXPECT_GT(compared, taken / 4) << "lanes with samples";

@@ -82,15 +82,23 @@ std::uint32_t OccludeeRectangles(const TriangleBatch& batch, int count, const Oc
             const V x = cx(k), y = cy(k), w = cw(k);
             // What the one-triangle code sets up without clipping (needs_clipping and
             // too_large_to_clip false at its near plane, which lies below near_w), finite, and
-            // with depths far from float's denormals.
+            // with depths far from float's denormals. Finiteness is tested coordinate by
+            // coordinate: Max and Min of a NaN give either operand, depending on the instruction
+            // set, and every comparison below is one a NaN fails.
+            usable = hn::And(usable, hn::And(hn::IsFinite(x), hn::And(hn::IsFinite(y), hn::IsFinite(w))));
             const V vertex_extent = hn::Max(hn::Max(hn::Abs(x), hn::Abs(y)), hn::Abs(w));
-            usable = hn::And(usable, hn::And(hn::Gt(w, near_w), hn::Lt(vertex_extent, infinity)));
-            usable = hn::And(usable, hn::And(hn::Not(hn::Gt(hn::Abs(x), hn::Mul(guard, w))), hn::Not(hn::Gt(hn::Abs(y), hn::Mul(guard, w)))));
+            usable = hn::And(usable, hn::Gt(w, near_w));
+            usable = hn::And(usable, hn::And(hn::Le(hn::Abs(x), hn::Mul(guard, w)), hn::Le(hn::Abs(y), hn::Mul(guard, w))));
             usable = hn::And(usable, hn::Lt(w, hn::Set(d, 0x1.0p100)));
             min_w = hn::Min(min_w, w);
             extent = hn::Max(extent, vertex_extent);
         }
-        usable = hn::And(usable, hn::Not(hn::Gt(extent, hn::Mul(hn::Set(d, 0x1.0p28), min_w))));
+        usable = hn::And(usable, hn::Le(extent, hn::Mul(hn::Set(d, 0x1.0p28), min_w)));
+        // shows() places its near plane at near_w (1 - 2^-20) - error.w and answers visible
+        // where that is not above zero (the rounding too large to reason with): such lanes are
+        // left to it. The error here is at least error.w; its margin covers the roundings.
+        usable = hn::And(usable, hn::And(hn::IsFinite(ew), hn::And(hn::IsFinite(ex), hn::IsFinite(ey))));
+        usable = hn::And(usable, hn::Lt(hn::Mul(ew, hn::Set(d, 1.0 + 0x1.0p-20)), hn::Set(d, p.near_w * (1.0 - 0x1.0p-19))));
         // project_to_samples and vertex_slack, lane by lane.
         V min_x = infinity, max_x = hn::Neg(infinity), min_y = infinity, max_y = hn::Neg(infinity);
         V slack_x = zero, slack_y = zero, w_relative = zero, d_max = zero;

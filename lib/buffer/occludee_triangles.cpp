@@ -331,9 +331,13 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
 
 bool detail::occludee_bounding_rectangle(const std::array<float, 16>& model_to_clip, const glm::dvec4 model[3], const glm::dvec4 clip[3],
                                          double near_w, double edge_margin, int sample_width, int sample_height, RectQuery& rect) {
+    for (int v = 0; v < 3; ++v)
+        if (!detail::finite_clip(clip[v])) return false;  // test_triangles answers visible
     const ClipError error = clip_error(model_to_clip, model);
+    const double near_clip = near_w * (1.0 - 0x1.0p-20) - error.w;
+    if (!(near_clip > 0.0)) return false;  // shows() answers visible
     OuterBounds bounds;
-    if (!unclipped_outer_bounds(clip, error, near_w * (1.0 - 0x1.0p-20) - error.w, edge_margin, sample_width, sample_height, bounds)) return false;
+    if (!unclipped_outer_bounds(clip, error, near_clip, edge_margin, sample_width, sample_height, bounds)) return false;
     rect = bounding_rectangle(bounds);
     return true;
 }
@@ -456,8 +460,10 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
         // tolerance, perspective, no clipping): each at least as large and as near as shows()'s,
         // so one found hidden here would be found hidden there, and the lane is passed over as
         // shows() would pass it over.
-        const std::uint32_t rectangle_ready =
-            rectangles_first ? kernels_->occludee_rectangles(batch, int(count), rectangle_params, rectangles) & ~passed_over : 0u;
+        const std::uint32_t all_lanes = (std::uint32_t(1) << count) - 1u;  // count <= 16
+        const std::uint32_t rectangle_ready = rectangles_first && (passed_over & all_lanes) != all_lanes
+                                                  ? kernels_->occludee_rectangles(batch, int(count), rectangle_params, rectangles) & ~passed_over
+                                                  : 0u;
         for (std::size_t k = 0; k < count; ++k) {
             if (!in.orthographic && ((passed_over >> k) & 1u)) continue;
             glm::dvec4 model[3], clip[3];
@@ -466,6 +472,13 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
                 clip[v] = batch.clip(int(k), v);
             }
             if (((passed_over >> k) & 1u) && beyond_exactly(model, clip)) continue;
+            // Invalid indices or a non-finite vertex: nothing to reason with, whatever the
+            // rectangles say (a lane is passed over on its rectangle only once it is known finite).
+            result.deciding_triangle = t + k;
+            if (!((batch.indices_valid >> k) & 1u)) return visible();  // as fetch_clip_triangle
+            bool finite = true;
+            for (int v = 0; v < 3; ++v) finite = finite && detail::finite_clip(clip[v]);
+            if (!finite) return visible();
             if (((rectangle_ready >> k) & 1u) && (rectangles[k].i0 > rectangles[k].i1 || rectangles[k].j0 > rectangles[k].j1 ||
                                                    test_prepared_rect(rectangles[k]) != Visibility::visible)) {
                 // shows()'s steps before its rectangle decide whether the triangle reaches the
@@ -476,11 +489,6 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
                     in_frustum = true;
                 continue;
             }
-            result.deciding_triangle = t + k;
-            if (!((batch.indices_valid >> k) & 1u)) return visible();  // as fetch_clip_triangle
-            bool finite = true;
-            for (int v = 0; v < 3; ++v) finite = finite && detail::finite_clip(clip[v]);
-            if (!finite) return visible();
             if (shows(model, clip)) return visible();
         }
         result.deciding_triangle = t + count - 1;  // the batch's last triangle, passed over or not

@@ -270,13 +270,16 @@ public:
     // vertex or an index out of range, or is too large to clip. Degenerate triangles (zero
     // area in clip space) cover nothing. The counts stop with the
     // answer, so they are partial for visible occludees. With no tolerance (0), a triangle that
-    // needs no clipping is first tested by its bounding rectangle of samples at its nearest
-    // depth (as test_rect): where the layers hide that, the triangle shows nothing and its
-    // samples are not counted (the same answer, for a fraction of the work: most triangles of a
-    // hidden occludee end there). No allocation; thread-safe like the other tests.
+    // needs no clipping is first tested by its bounding rectangle of samples at a depth no
+    // farther than any of its own (its nearest vertex, raised by the transform's rounding
+    // bound), against the layers as test_rect's rectangles are: where the layers hide that, the
+    // triangle shows nothing and its samples are not counted (the same answer, for a fraction
+    // of the work: most triangles of a hidden occludee end there), so with no tolerance the
+    // counts are partial for occluded occludees too. No allocation; thread-safe like the other
+    // tests.
     struct TriangleTest {
         Visibility visibility = Visibility::view_culled;
-        std::uint64_t samples = 0;          // samples the triangles may cover
+        std::uint64_t samples = 0;          // samples the triangles counted may cover (see above)
         std::uint64_t visible_samples = 0;  // of those, samples with no occluder certainly nearer
         std::size_t deciding_triangle = 0;  // visible: the triangle that made it so
     };
