@@ -19,7 +19,7 @@ command -v jq >/dev/null || { echo "walk-results: jq is missing (bash scripts/in
 
 echo "| scene | strategy | candidates | efficiency | false culls | occluder tris (mean) | select | render | maps | tests | cull ms mean (max) | kept (mean) | exactly visible (mean) |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-for scene in intel_castle crytek_sponza openarena_oa_thor openarena_pul1duel-oa; do
+for scene in intel_castle crytek_sponza openarena_oa_thor openarena_pul1duel-oa fzk_haus; do
   file=$scenes/$scene.glb
   [ -f "$file" ] || { echo "walk-results: $file missing, skipped" >&2; continue; }
   "$homcull" path --scene "$file" --frames "$frames" --seed 1 --out "$out/$scene.path.json" >&2

@@ -254,7 +254,7 @@ TEST(OccludeeTriangles, ANonFiniteCoordinateInABatchIsVisibleOnEveryIsa) {
     }
 }
 
-// Where the transform's rounding bound of w reaches the near plane (error.w >= near_w), the
+// Where the transform's rounding bound of w reaches the near plane (error.w >= near_w (1 - 2^-20)), the
 // test cannot place that plane and answers visible: on every instruction set, also for the
 // triangles of a batch hidden behind a wall by their rectangles. Under the soup's matrix
 // error.w is 2^-22 w: about 0.95 at w = 4e6, above the near plane's 0.5.
@@ -272,13 +272,14 @@ TEST(OccludeeTriangles, ATriangleTooFarToPlaceTheNearPlaneIsVisibleOnEveryIsa) {
     }
 }
 
-// A closed solid whose only face towards the eye lies before the near plane: a box from depth
-// 0.3 to 20, four times as wide as the view at depth 10 is (x, y in [-5, 5], the view's side
-// planes at x = +-w/2). Its side faces, seen from behind, reach the view beyond depth 10, where
-// a wall at depth 8 hides them. Without the solid the answer is occluded (hidden triangles in
-// the view); with it view_culled (no front face in the view, hidden or not), on every
-// instruction set: the side faces' slices go through the batches, where those behind the wall
-// are passed over on their rectangles.
+// A closed solid's triangles seen from behind, passed over in a batch on their rectangles, leave
+// the occludee out of the view as shows() does. Under ClosedSolid's precondition (the occludee
+// beyond the near plane) a solid with back faces in the view has front faces there too, so the
+// difference shows only outside it: a box whose only face towards the eye lies before the near
+// plane, from depth 0.3 to 20, four times as wide as the view at depth 10 is (x, y in [-5, 5],
+// the side planes at x = +-w/2). Its side faces, seen from behind, reach the view beyond depth
+// 10, where a wall at depth 8 hides them. Without the solid the answer is occluded; with it
+// the reference's view_culled (no front face in the view), on every instruction set.
 TEST(OccludeeTriangles, AClosedSolidsHiddenBackFacesAreNotInTheViewOnEveryIsa) {
     const glm::dmat4 clip_from_world = glm::perspective(2.0 * std::atan(0.5), 1.0, 0.5, 100.0);
     std::array<float, 16> m;

@@ -97,6 +97,8 @@ std::uint32_t OccludeeRectangles(const TriangleBatch& batch, int count, const Oc
         // shows() places its near plane at near_w (1 - 2^-20) - error.w and answers visible
         // where that is not above zero (the rounding too large to reason with): such lanes are
         // left to it. The error here is at least error.w; its margin covers the roundings.
+        // (A second guard only: Max may drop a NaN term. A non-finite model coordinate makes
+        // clip x NaN, which the vertex checks above catch.)
         usable = hn::And(usable, hn::And(hn::IsFinite(ew), hn::And(hn::IsFinite(ex), hn::IsFinite(ey))));
         usable = hn::And(usable, hn::Lt(hn::Mul(ew, hn::Set(d, 1.0 + 0x1.0p-20)), hn::Set(d, p.near_w * (1.0 - 0x1.0p-19))));
         // project_to_samples and vertex_slack, lane by lane.

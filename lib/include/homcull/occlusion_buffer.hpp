@@ -267,7 +267,8 @@ public:
     // Occluded when at most `tolerated_samples` samples (counted per triangle, so overlaps
     // count twice) are not certainly behind an occluder; view-culled when every triangle lies
     // outside the view frustum; visible otherwise, and as soon as a triangle has a non-finite
-    // vertex or an index out of range, or is too large to clip. Degenerate triangles (zero
+    // vertex or an index out of range, is too large to clip, or lies so far from the origin that
+    // the rounding bound of its w reaches the near plane. Degenerate triangles (zero
     // area in clip space) cover nothing. The counts stop with the
     // answer, so they are partial for visible occludees. With no tolerance (0), a triangle that
     // needs no clipping is first tested by its bounding rectangle of samples at a depth no
