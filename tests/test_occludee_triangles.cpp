@@ -55,6 +55,19 @@ struct Soup {
     }
 };
 
+// Model-space triangles (xyz, 9 floats each) under clip_from_model, rounded to float as an
+// engine gives it; no backface culling.
+TriangleInput model_space_input(const std::vector<float>& xyz, const glm::dmat4& clip_from_model) {
+    TriangleInput in;
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) in.model_to_clip[std::size_t(4 * c + r)] = float(clip_from_model[c][r]);
+    in.positions = xyz.data();
+    in.vertex_count = xyz.size() / 3;
+    in.triangle_count = in.vertex_count / 3;
+    in.backface = Backface::none;
+    return in;
+}
+
 OcclusionBuffer make_buffer(int w, int h, int s = 1, bool sample_depth = false) {
     return OcclusionBuffer(test::buffer_config(w, h, s, 0.5f, sample_depth));
 }
@@ -233,15 +246,7 @@ TEST(OccludeeTriangles, ANonFiniteCoordinateInABatchIsVisibleOnEveryIsa) {
                     for (int c = 0; c < 4; ++c) {  // clip space: x, y, z, w
                         std::vector<float> positions = clip_xyzw;
                         positions[std::size_t(12 * t + 4 * k + c)] = bad;
-                        TriangleInput in;
-                        in.positions = positions.data();
-                        in.position_components = 4;
-                        in.position_stride = 16;
-                        in.vertex_count = positions.size() / 4;
-                        in.triangle_count = in.vertex_count / 3;
-                        in.clip_space = true;
-                        in.backface = Backface::none;
-                        EXPECT_EQ(buffer.test_triangles(in).visibility, Visibility::visible)
+                        EXPECT_EQ(buffer.test_triangles(test::clip_space_input(positions)).visibility, Visibility::visible)
                             << isa << ", clip space, triangle " << t << ", vertex " << k << ", coordinate " << c << ", " << bad;
                     }
                     for (int c = 0; c < 3; ++c) {  // model space
@@ -281,10 +286,6 @@ TEST(OccludeeTriangles, ATriangleTooFarToPlaceTheNearPlaneIsVisibleOnEveryIsa) {
 // 10, where a wall at depth 8 hides them. Without the solid the answer is occluded; with it
 // the reference's view_culled (no front face in the view), on every instruction set.
 TEST(OccludeeTriangles, AClosedSolidsHiddenBackFacesAreNotInTheViewOnEveryIsa) {
-    const glm::dmat4 clip_from_world = glm::perspective(2.0 * std::atan(0.5), 1.0, 0.5, 100.0);
-    std::array<float, 16> m;
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) m[std::size_t(4 * c + r)] = float(clip_from_world[c][r]);
     std::vector<float> xyz;
     const auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {  // counter-clockwise seen from outside
         for (const glm::vec3& p : {a, b, c, a, c, d}) xyz.insert(xyz.end(), {p.x, p.y, p.z});
@@ -300,12 +301,7 @@ TEST(OccludeeTriangles, AClosedSolidsHiddenBackFacesAreNotInTheViewOnEveryIsa) {
         quad({-kHalf, kHalf, z0}, {kHalf, kHalf, z0}, {kHalf, kHalf, z1}, {-kHalf, kHalf, z1});      // +y
         quad({-kHalf, -kHalf, z0}, {-kHalf, -kHalf, z1}, {kHalf, -kHalf, z1}, {kHalf, -kHalf, z0});  // -y
     }
-    TriangleInput in;
-    in.positions = xyz.data();
-    in.vertex_count = xyz.size() / 3;
-    in.triangle_count = in.vertex_count / 3;
-    in.model_to_clip = m;
-    in.backface = Backface::none;
+    const TriangleInput in = model_space_input(xyz, glm::perspective(2.0 * std::atan(0.5), 1.0, 0.5, 100.0));
     const OcclusionBuffer::ClosedSolid outside{{0.0, 0.0, 0.0}, 1};
     for (const std::string& isa : available_isas()) {
         const test::ScopedIsa selected(isa);
@@ -572,9 +568,6 @@ TEST(OccludeeTriangles, BatchRectanglesHoldTheOneTriangleRectangles) {
                                                        : glm::dvec3(0.0);
             const glm::dmat4 clip_from_world = glm::perspective(glm::radians(50.0), double(kWidth) / kHeight, kNear, 1e4) *
                                                glm::lookAt(offset, offset + glm::dvec3(unit(random), unit(random), -1.0), glm::dvec3(0, 1, 0));
-            std::array<float, 16> m;
-            for (int c = 0; c < 4; ++c)
-                for (int r = 0; r < 4; ++r) m[std::size_t(4 * c + r)] = float(clip_from_world[c][r]);
             std::vector<float> xyz;
             for (int t = 0; t < detail::TriangleBatch::kSize; ++t) {
                 const double distance = std::pow(10.0, exponent(random) * 0.8 + 0.5), size = std::pow(10.0, exponent(random));
@@ -583,12 +576,8 @@ TEST(OccludeeTriangles, BatchRectanglesHoldTheOneTriangleRectangles) {
                     for (int i = 0; i < 3; ++i) xyz.push_back(float(centre[i] + unit(random) * size));
             }
             if (trial % 9 == 4) xyz[std::size_t(random() % xyz.size())] = std::numeric_limits<float>::quiet_NaN();
-            TriangleInput in;
-            in.positions = xyz.data();
-            in.vertex_count = xyz.size() / 3;
-            in.triangle_count = in.vertex_count / 3;
-            in.model_to_clip = m;
-            in.backface = Backface::none;
+            const TriangleInput in = model_space_input(xyz, clip_from_world);
+            const std::array<float, 16>& m = in.model_to_clip;
             detail::TriangleBatch batch;
             batch.count = int(in.triangle_count);
             detail::gather_triangle_batch(in, 0, batch.count, batch);
