@@ -21,8 +21,9 @@ struct OccludeeRectangleParams {
 // For the lanes [0, count) of a batch transformed by transform_batch_plain (a perspective input):
 // bit t set where lane t's triangle is one that the one-triangle code would set up without
 // clipping (valid indices, finite, every w above near_w, within the guard band, not too large,
-// and a rounding bound of w small enough to place the near plane: error.w below near_w), and then rects[t] holds its samples and depth: every sample outer_bounds' box holds, at a
-// depth no farther than its raised nearest vertex (an empty span, i0 > i1 or j0 > j1, where that
+// and a rounding bound of w small enough to place the near plane: error.w below near_w), and
+// then rects[t] holds its samples and depth: every sample outer_bounds' box holds, at a depth
+// no farther than its raised nearest vertex (an empty span, i0 > i1 or j0 > j1, where that
 // box holds none). A hidden rectangle (test_prepared_rect) so proves the one-triangle
 // rectangle hidden too; a visible one proves nothing. Null for the scalar choice.
 using OccludeeRectanglesKernel = std::uint32_t (*)(const TriangleBatch& batch, int count, const OccludeeRectangleParams& params,

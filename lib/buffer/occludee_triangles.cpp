@@ -331,8 +331,7 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
 
 bool detail::occludee_bounding_rectangle(const std::array<float, 16>& model_to_clip, const glm::dvec4 model[3], const glm::dvec4 clip[3],
                                          double near_w, double edge_margin, int sample_width, int sample_height, RectQuery& rect) {
-    for (int v = 0; v < 3; ++v)
-        if (!detail::finite_clip(clip[v])) return false;  // test_triangles answers visible
+    if (!detail::finite_clip_triangle(clip)) return false;  // test_triangles answers visible
     const ClipError error = clip_error(model_to_clip, model);
     const double near_clip = near_w * (1.0 - 0x1.0p-20) - error.w;
     if (!(near_clip > 0.0)) return false;  // shows() answers visible
@@ -476,9 +475,7 @@ OcclusionBuffer::TriangleTest detail::BufferState::test_triangles(const Triangle
             // rectangles say (a lane is passed over on its rectangle only once it is known finite).
             result.deciding_triangle = t + k;
             if (!((batch.indices_valid >> k) & 1u)) return visible();  // as fetch_clip_triangle
-            bool finite = true;
-            for (int v = 0; v < 3; ++v) finite = finite && detail::finite_clip(clip[v]);
-            if (!finite) return visible();
+            if (!detail::finite_clip_triangle(clip)) return visible();
             if (((rectangle_ready >> k) & 1u) && (rectangles[k].i0 > rectangles[k].i1 || rectangles[k].j0 > rectangles[k].j1 ||
                                                    test_prepared_rect(rectangles[k]) != Visibility::visible)) {
                 // shows()'s steps before its rectangle decide whether the triangle reaches the

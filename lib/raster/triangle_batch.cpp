@@ -134,7 +134,7 @@ std::uint32_t beyond_side_plane_reference(const TriangleBatch& batch, int count,
         double p = 0.0;
         for (int k = 0; k < 3; ++k)
             p = std::max({p, std::abs(batch.px[k][t]), std::abs(batch.py[k][t]), std::abs(batch.pz[k][t]), std::abs(batch.pw[k][t])});
-        if (((batch.indices_valid >> t) & 1u) && finite_clip(clip[0]) && finite_clip(clip[1]) && finite_clip(clip[2]) &&
+        if (((batch.indices_valid >> t) & 1u) && finite_clip_triangle(clip) &&
             outside_side_plane(clip, scale_x * p, scale_y * p))
             bits |= 1u << t;
     }
@@ -178,7 +178,7 @@ void classify_batch_reference(Backface backface, double near_w, TriangleBatch& b
     batch.simple = 0;  // the reference sets every triangle up with setup_clip_triangle
     for (int t = 0; t < batch.count; ++t) {
         const glm::dvec4 clip[3] = {batch.clip(t, 0), batch.clip(t, 1), batch.clip(t, 2)};
-        const bool finite = finite_clip(clip[0]) && finite_clip(clip[1]) && finite_clip(clip[2]);
+        const bool finite = finite_clip_triangle(clip);
         const TriangleFate fate =
             !((batch.indices_valid >> t) & 1u) || !finite ? TriangleFate::invalid : unclipped_fate(clip, backface, near_w);
         switch (fate) {

@@ -95,6 +95,7 @@ inline bool is_identity(const std::array<float, 16>& m) {
 }
 
 inline bool finite_clip(const glm::dvec4& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.w); }
+inline bool finite_clip_triangle(const glm::dvec4 clip[3]) { return finite_clip(clip[0]) && finite_clip(clip[1]) && finite_clip(clip[2]); }
 
 // A position of the input in clip space as the buffer takes it: transform_to_clip (or _plain),
 // then the orthographic representative for an orthographic input.
