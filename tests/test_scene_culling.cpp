@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <cstdio>
 
@@ -110,25 +111,39 @@ TEST(OccluderSelection, RankingKeepsTheFrustumOrderAndTheBudget) {
     EXPECT_EQ(chosen.size(), in_frustum);
 }
 
-TEST(OccluderSelection, ComplexityFilterDropsObjectsDenseForTheirSize) {
+TEST(OccluderSelection, ComplexityFilterDropsObjectsDenseForTheirSurface) {
     Scene scene;
     for (int k = 0; k < 5; ++k) test::add_box(scene, "box", {float(3 * k), 0, 0}, {float(3 * k + 2), 2, 2});
-    // A small object of 600 sliver triangles: 50 times the boxes' triangles per unit of surface.
-    Mesh dense{"dense", {}, {}};
+    const auto add_mesh = [&](const char* name, const std::vector<std::array<glm::vec3, 3>>& triangles) {
+        Mesh mesh{name, {}, {}};
+        for (const auto& t : triangles) {
+            for (const glm::vec3& p : t) mesh.indices.push_back(std::uint32_t(mesh.positions.size())), mesh.positions.push_back(p);
+        }
+        scene.meshes.push_back(mesh);
+        scene.objects.push_back({name, std::uint32_t(scene.meshes.size() - 1), glm::dmat4(1.0), {}, {}});
+    };
+    // The boxes: 12 triangles over 24 units of surface. "dense": 600 slivers of 0.04 each, 50 times
+    // the boxes' triangles per unit of surface, in a box no smaller than theirs.
+    std::vector<std::array<glm::vec3, 3>> slivers, flat;
     for (int t = 0; t < 600; ++t) {
-        const float x = float(t) / 600.0f;
-        dense.positions.insert(dense.positions.end(), {{x, 0, 0}, {x, 1, 0}, {x, 0, 1}});
-        dense.indices.insert(dense.indices.end(), {std::uint32_t(3 * t), std::uint32_t(3 * t + 1), std::uint32_t(3 * t + 2)});
+        const float x = 20.0f + float(t) / 300.0f;
+        slivers.push_back({glm::vec3{x, 0, 0}, glm::vec3{x, 0.2f, 0}, glm::vec3{x, 0, 0.4f}});
     }
-    scene.meshes.push_back(dense);
-    scene.objects.push_back({"dense", std::uint32_t(scene.meshes.size() - 1), glm::dmat4(1.0), {}, {}});
+    add_mesh("dense", slivers);
+    // "flat": a panel of 2 x 2 triangles of 2 units each, as dense as the boxes, in a flat box.
+    for (int t = 0; t < 2; ++t) flat.push_back({glm::vec3{30, 0, 2.0f * float(t)}, glm::vec3{32, 0, 2.0f * float(t)}, glm::vec3{30, 0, 2.0f * float(t) + 2}});
+    add_mesh("flat", flat);
+    // "empty": degenerate triangles only, no surface to hide anything with.
+    add_mesh("empty", {{glm::vec3{40, 0, 0}, glm::vec3{41, 1, 1}, glm::vec3{42, 2, 2}}});
     scene.finalize();
     const std::vector<std::uint32_t> all = occluder_candidates(scene, OccluderFilter::all);
-    ASSERT_EQ(all.size(), 6u);
+    ASSERT_EQ(all.size(), 8u);
     EXPECT_EQ(filter_by_complexity(scene, all, 0.0), all);  // off
-    EXPECT_EQ(filter_by_complexity(scene, all, 1000.0), all);
-    const std::vector<std::uint32_t> kept = filter_by_complexity(scene, all, 16.0);
-    EXPECT_EQ(kept, std::vector<std::uint32_t>(all.begin(), all.begin() + 5));
+    std::vector<std::uint32_t> without_empty(all.begin(), all.begin() + 7);
+    EXPECT_EQ(filter_by_complexity(scene, all, 1000.0), without_empty);
+    std::vector<std::uint32_t> boxes_and_flat(all.begin(), all.begin() + 5);
+    boxes_and_flat.push_back(all[6]);
+    EXPECT_EQ(filter_by_complexity(scene, all, 16.0), boxes_and_flat);
     EXPECT_TRUE(filter_by_complexity(scene, {}, 16.0).empty());
 }
 

@@ -5,6 +5,8 @@
 #include <homcull/world_triangles.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace homcull {
 
@@ -27,11 +29,23 @@ std::vector<std::uint32_t> occluder_candidates(const Scene& scene, OccluderFilte
 
 namespace {
 
-// Triangles per unit of box surface (a flat box counts its two faces).
+// Triangles per unit of the object's own surface (the sum of its world-space triangle areas):
+// the inverse of its mean triangle area. Its box's surface, the first measure, rated thin
+// detailed objects that hide much (FZK-Haus's windows, 500 to 2,200 times the median per unit of
+// box surface) as dense as railings, and dropping them cost culling from outside the house.
 double triangle_density(const Scene& scene, std::uint32_t id) {
-    const glm::dvec3 e(scene.objects[id].world_bounds.extent());
-    const double surface = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
-    return double(scene.triangle_count(scene.objects[id])) / std::max(surface, 1e-30);
+    const Object& object = scene.objects[id];
+    const Mesh& mesh = scene.meshes[object.mesh];
+    double area = 0.0;
+    for (std::size_t k = 0; k + 2 < mesh.indices.size(); k += 3) {
+        const glm::dvec3 a(transform_point(object.world, mesh.positions[mesh.indices[k]]));
+        const glm::dvec3 b(transform_point(object.world, mesh.positions[mesh.indices[k + 1]]));
+        const glm::dvec3 c(transform_point(object.world, mesh.positions[mesh.indices[k + 2]]));
+        area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+    // No area (degenerate triangles only) or a non-finite one: it hides nothing, infinitely dense.
+    if (!(area > 0.0) || !std::isfinite(area)) return std::numeric_limits<double>::infinity();
+    return double(scene.triangle_count(object)) / area;
 }
 
 }  // namespace
@@ -45,7 +59,7 @@ std::vector<std::uint32_t> filter_by_complexity(const Scene& scene, const std::v
     const double limit = factor * sorted[sorted.size() / 2];
     std::vector<std::uint32_t> kept;
     for (std::size_t k = 0; k < candidates.size(); ++k)
-        if (densities[k] <= limit) kept.push_back(candidates[k]);
+        if (densities[k] <= limit && std::isfinite(densities[k])) kept.push_back(candidates[k]);
     return kept;
 }
 

@@ -25,7 +25,7 @@ namespace {
 struct BakeCommandOptions {
     SceneChoice scene;
     std::string occluders = "role", layout = "floors", shard = "0/1", out;
-    double spacing = 0.0, eye_height = 0.0;
+    double spacing = 0.0, eye_height = 0.0, complexity = kDefaultComplexity;
     std::uint32_t rays = 4096, keep = 128;
     int threads = 0;
     std::vector<std::string> merge;
@@ -75,7 +75,7 @@ void run_bake(const BakeCommandOptions& o) {
     if (o.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
     const Scene scene = load_chosen_scene(o.scene);
     BakeOptions b;
-    b.candidates = choose_occluders(scene, o.occluders);
+    b.candidates = choose_occluders(scene, o.occluders, o.complexity);
     b.candidates_name = o.occluders;
     b.layout = o.layout == "volume" ? GridLayout::volume : GridLayout::floors;
     b.spacing = o.spacing;
@@ -104,6 +104,8 @@ void register_bake(CLI::App& app) {
     add_scene_option(*cmd, o->scene, /*required=*/false);
     cmd->add_option("--occluders", o->occluders, "Occluder candidates: role, all, or auto (as for cull)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
+    cmd->add_option("--complexity", o->complexity, "Zhang's complexity filter on the candidates (as for cull); 0: keep all")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
     cmd->add_option("--layout", o->layout, "floors: points at eye height above each floor (walkthroughs); volume: a 3D lattice of "
                                            "free points (flying cameras)")
         ->capture_default_str()->check(CLI::IsMember({"floors", "volume"}));

@@ -71,8 +71,8 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--occluders", o.occluders, "Occluder candidates: role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
     app.add_option("--complexity", o.complexity,
-                   "Drop candidates with more than F times the median triangles per unit of box surface (Zhang's complexity "
-                   "filter); 0: keep all")
+                   "Drop candidates with more than F times the median triangles per unit of their surface (Zhang's "
+                   "complexity filter); 0: keep all")
         ->capture_default_str()->check(CLI::NonNegativeNumber);
     app.add_option("--strategy", o.strategy,
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
