@@ -177,10 +177,10 @@ TruthResult compute_ground_truth(const RayScene& rays, const Scene& scene, const
         v.robust_samples += tied[i] == 0;
     }
     for (std::size_t id = 0; id < scene.objects.size(); ++id) result.objects[id].tie_samples = tie_samples[id].load();
-    const Frustum frustum = make_frustum(camera, aspect);
+    const FrustumAxes frustum = frustum_axes(make_frustum(camera, aspect));  // once, not per object
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.objects.size()), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i < r.end(); ++i)
-            result.objects[i].in_frustum = intersects(frustum, scene.objects[i].world_bounds);
+            result.objects[i].in_frustum = !separated(frustum, scene.objects[i].world_bounds);
     });
     result.rays = ids.size() + tie_rays.load();
     if (options.keep_sample_ids) result.sample_ids = std::move(ids);
