@@ -2,7 +2,8 @@
 # The results table of docs/scene-culling.md: every strategy of `homcull walk` on generated
 # walkthroughs of the shared scenes, with Embree ground truth, as a Markdown table on stdout.
 # Also one-pass under a 4,000-triangle budget ranked by distance and by a baked visibility
-# grid (baked here, per scene), and one-pass with occluder LODs.
+# grid (baked here, per scene), one-pass with occluder LODs, and every object an occluder (no
+# complexity filter either).
 #   bash scripts/walk-results.sh [FRAMES] [RESOLUTION]      (defaults: 120 frames, 1280x720)
 # Needs a build (scripts/build.sh) and ../shared/scenes beside the repository. HOMCULL may
 # name another binary. Progress goes to stderr; each walk's JSON is kept in $OUT (a temp dir).
@@ -31,7 +32,7 @@ for scene in intel_castle crytek_sponza openarena_oa_thor openarena_pul1duel-oa 
   runs=("one-pass|$candidates|" "temporal|$candidates|" "progressive|$candidates|"
         "one-pass|$candidates|--rank distance --budget 4000"
         "one-pass|$candidates|--rank baked --grid $out/$scene.grid.json --budget 4000"
-        "one-pass|$candidates|--lod on" "one-pass|all|")
+        "one-pass|$candidates|--lod on" "one-pass|all|--complexity 0")
   for run in "${runs[@]}"; do
     IFS='|' read -r strategy occluders extra <<<"$run"
     name="$strategy${extra:+ ($extra)}"
