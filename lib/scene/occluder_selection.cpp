@@ -36,11 +36,12 @@ namespace {
 double triangle_density(const Scene& scene, std::uint32_t id) {
     const Object& object = scene.objects[id];
     const Mesh& mesh = scene.meshes[object.mesh];
+    std::vector<float> world;  // each vertex once, as ground truth places it
+    append_world_positions(scene, object, world);
+    const auto vertex = [&](std::uint32_t v) { return glm::dvec3(world[3 * v], world[3 * v + 1], world[3 * v + 2]); };
     double area = 0.0;
     for (std::size_t k = 0; k + 2 < mesh.indices.size(); k += 3) {
-        const glm::dvec3 a(transform_point(object.world, mesh.positions[mesh.indices[k]]));
-        const glm::dvec3 b(transform_point(object.world, mesh.positions[mesh.indices[k + 1]]));
-        const glm::dvec3 c(transform_point(object.world, mesh.positions[mesh.indices[k + 2]]));
+        const glm::dvec3 a = vertex(mesh.indices[k]), b = vertex(mesh.indices[k + 1]), c = vertex(mesh.indices[k + 2]);
         area += 0.5 * glm::length(glm::cross(b - a, c - a));
     }
     // No area (degenerate triangles only) or a non-finite one: it hides nothing, infinitely dense.
