@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 #include <utility>
 #include <vector>
 #include <sys/wait.h>
@@ -418,6 +419,33 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
     expect_refused("bench --workload s1 --walk 3", 1, "--walk and --random are for --workload frame");
     expect_refused("bench --workload frame --scene gen:city --random 2 --repeat -1", 1, "--repeat must be at least 1");
     expect_refused("bench --workload frame --scene /nonexistent.glb --random 2", 1, "/nonexistent.glb");
+}
+
+// bench --workload frame --scaling: one thread, two threads and two single-threaded copies at once
+// (the machine's ceiling), with the ratios' spreads and each kind's stages; and --complexity
+// reaching the culler's configuration. Only the keys and their sense are checked: the figures
+// are the machine's.
+TEST(Cli, FrameBenchScalingReportsTheThreadsBesideTheMachinesCeiling) {
+    expect_refused("bench --workload frame --scene gen:city --random 2 --scaling", 1, "give --threads N with N >= 2, got 1");
+    expect_refused("bench --workload s1 --complexity 2", 1, "--scaling and --complexity are for --workload frame");
+    expect_refused("bench --workload frame --scene gen:city --random 2 --complexity -1", 105, "--complexity");
+    if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one hardware thread: no ceiling to measure";
+    const CliRun r = run_cli("bench --workload frame --scene gen:city:seed=2,blocks=3 --random 2 --resolution 160x90 --repeat 2 "
+                             "--occludees box --threads 2 --scaling --complexity 0 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["config"]["complexity"], 0.0);
+    const nlohmann::json& s = j["scaling"];
+    EXPECT_EQ(s["threads"], 2);
+    EXPECT_EQ(s["rounds"], 2);
+    for (const char* ratio : {"speedup", "ceiling", "speedup_over_ceiling"}) {
+        EXPECT_GT(s[ratio]["min"].get<double>(), 0.0) << ratio;
+        EXPECT_LE(s[ratio]["min"].get<double>(), s[ratio]["median"].get<double>()) << ratio;
+        EXPECT_LE(s[ratio]["median"].get<double>(), s[ratio]["max"].get<double>()) << ratio;
+    }
+    for (const char* kind : {"one_thread", "threads", "copies_at_once"}) EXPECT_GT(s["frame_ms_mean"][kind].get<double>(), 0.0) << kind;
+    for (const char* kind : {"one_thread", "threads"})
+        for (const char* stage : {"select", "render", "maps", "tests"}) EXPECT_GE(s["stages_ms_mean"][kind][stage].get<double>(), 0.0);
 }
 
 TEST(Cli, BadInputExitsWithOneAndSaysWhatIsWrong) {

@@ -1,6 +1,8 @@
 // homcull bench --workload frame (bench_frame.hpp).
 #include "bench_frame.hpp"
 
+#include "bench_scaling.hpp"
+
 #include "cull_report.hpp"
 #include "options.hpp"
 
@@ -60,6 +62,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     if (o.threads < 1 || o.threads > 256) throw Error("bench: --threads must be in [1, 256], got " + std::to_string(o.threads));
     if (int(!o.views.empty()) + int(o.walk > 0) + int(o.random > 0) != 1)
         throw Error("bench --workload frame: give exactly one of --views P, --walk N and --random N");
+    if (o.scaling) check_scaling_threads(o.threads);
     select_isa(o.isa);
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
     const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
@@ -118,6 +121,8 @@ void run_frame_bench(const FrameBenchOptions& o) {
     double mean_frame = 0.0;
     for (const double ms : frame_medians) mean_frame += ms / double(views);
     const double worst_frame = *std::max_element(frame_medians.begin(), frame_medians.end());
+    const nlohmann::json scaling =
+        o.scaling ? measure_thread_scaling(scene, resources.occluders, config, path, o.rounds, o.threads, parallel) : nlohmann::json();
     nlohmann::json summary = {{"views", views},
                               {"frame_ms", {{"mean", mean_frame}, {"max", worst_frame}, {"median", median(frame_medians)}}},
                               {"stages_ms_mean",
@@ -127,7 +132,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     const std::string source = !o.views.empty() ? o.views : o.walk > 0 ? "walk:" + std::to_string(o.walk) + ",seed=" + std::to_string(o.seed)
                                                                         : "random:" + std::to_string(o.random) + ",seed=" + std::to_string(o.seed);
     if (o.json) {
-        const nlohmann::json out = {
+        nlohmann::json out = {
             {"workload", "frame"},
             {"scene", scene.source},
             {"views_from", source},
@@ -139,9 +144,11 @@ void run_frame_bench(const FrameBenchOptions& o) {
             {"rounds", o.rounds},
             {"config", {{"mode", o.cull.mode}, {"depth", o.cull.depth}, {"occludees", o.cull.occludees}, {"clusters", o.cull.clusters},
                         {"strategy", o.cull.strategy}, {"occluders", o.cull.occluders}, {"lod", o.cull.lod},
-                        {"closed_back_faces", o.cull.closed_back_faces}, {"pyramid", o.cull.pyramid}, {"occludee_parts", o.cull.occludee_parts}}},
+                        {"closed_back_faces", o.cull.closed_back_faces}, {"pyramid", o.cull.pyramid}, {"occludee_parts", o.cull.occludee_parts},
+                        {"complexity", o.cull.complexity}}},
             {"per_view", per_view},
             {"summary", summary}};
+        if (o.scaling) out["scaling"] = scaling;
         fmt::print("{}\n", out.dump(1));
         return;
     }
@@ -158,6 +165,17 @@ void run_frame_bench(const FrameBenchOptions& o) {
                "{} false culls\n",
                mean_frame, worst_frame, 100.0 * total.robust_efficiency(), total.hidden_in_frustum - total.hidden_through_ties,
                100.0 * total.efficiency(), total.false_culls);
+    if (o.scaling) {
+        const auto spread = [&](const char* key) {
+            const nlohmann::json& s = scaling.at(key);
+            return fmt::format("{:.2f}x ({:.2f}-{:.2f})", s["median"].get<double>(), s["min"].get<double>(), s["max"].get<double>());
+        };
+        const nlohmann::json& ms = scaling.at("frame_ms_mean");
+        fmt::print("scaling, {} rounds: {} threads {} one thread (mean frame {:.3f} against {:.3f} ms); the machine's ceiling, {} "
+                   "copies at once, {} ({:.3f} ms); the threads' gain over the ceiling {}\n",
+                   o.rounds, o.threads, spread("speedup"), ms["threads"].get<double>(), ms["one_thread"].get<double>(), o.threads,
+                   spread("ceiling"), ms["copies_at_once"].get<double>(), spread("speedup_over_ceiling"));
+    }
 }
 
 }  // namespace homcull::cli

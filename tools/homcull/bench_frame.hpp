@@ -21,12 +21,14 @@ struct FrameBenchOptions {
     std::string isa = "best";
     CullOptions cull;         // the culler's configuration (display: cull.resolution)
     bool json = false;
+    bool scaling = false;     // also measure what the threads gain over one (bench_scaling.hpp)
 };
 
 // Prints, per view and over all, the median whole-frame time (the cull() call, timed around
 // it), each stage's median (SceneCullTimings), and against Embree: the efficiency over the
 // objects hidden outright (DESIGN.md, "coincident surfaces"), the plain efficiency beside it,
-// and the false culls. Throws homcull::Error on bad options.
+// and the false culls. With `scaling`, then also what `threads` threads gain over one, beside
+// the machine's ceiling (measure_thread_scaling). Throws homcull::Error on bad options.
 void run_frame_bench(const FrameBenchOptions& options);
 
 }  // namespace homcull::cli

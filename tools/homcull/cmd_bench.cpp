@@ -32,7 +32,9 @@ struct BenchOptions {
     std::string s1_folder = "../shared/workloads/s1", scene = "../shared/scenes/intel_castle.glb", views;
     int samples = 1, threads = 1, repeat = 0, clusters = 0;
     bool clusters_given = false;  // frame: without --clusters, the culler's default (clusters)
-    bool json = false, sample_depth = false, vs_scalar = false;
+    bool json = false, sample_depth = false, vs_scalar = false, scaling = false;
+    double complexity = kDefaultComplexity;  // frame: the candidates' complexity filter (cull --complexity)
+    bool complexity_given = false;
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
     std::string occludees = "auto", closed_back_faces = "skip", pyramid = "lazy";
@@ -60,6 +62,8 @@ void run_frame_workload(const BenchOptions& o) {
     f.cull.closed_back_faces = o.closed_back_faces;
     f.cull.pyramid = o.pyramid;
     f.cull.occludee_parts = o.occludee_parts;
+    f.cull.complexity = o.complexity;
+    f.scaling = o.scaling;
     run_frame_bench(f);
 }
 
@@ -169,6 +173,7 @@ void run_bench(const BenchOptions& o) {
     if (o.workload == "frame") return run_frame_workload(o);
     if (o.workload != "s1" && o.workload != "castle") throw Error("bench: unknown workload '" + o.workload + "' (s1, castle or frame)");
     if (o.walk != 0 || o.random != 0) throw Error("bench: --walk and --random are for --workload frame");
+    if (o.scaling || o.complexity_given) throw Error("bench: --scaling and --complexity are for --workload frame");
     if (o.clusters != 0 && o.workload != "castle") throw Error("bench: --clusters is for --workload castle");
     if (o.clusters < 0) throw Error("bench: --clusters must be 0 (the triangles as one input) or triangles per cluster, got " +
                                     std::to_string(o.clusters));
@@ -283,6 +288,13 @@ void register_bench(CLI::App& app) {
         ->capture_default_str()->check(CLI::Range(0, 64));
     cmd->add_option("--pyramid", o->pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")
         ->capture_default_str()->check(CLI::IsMember({"lazy", "always"}));
+    cmd->add_option("--complexity", o->complexity,
+                    "frame: drop occluder candidates with more than F times the median triangles per unit of their surface "
+                    "(cull --complexity); 0: keep all")
+        ->capture_default_str()->check(CLI::NonNegativeNumber)->each([o](const std::string&) { o->complexity_given = true; });
+    cmd->add_flag("--scaling", o->scaling,
+                  "frame, --threads N >= 2: also time one thread, N threads and N single-threaded copies at once (the "
+                  "machine's ceiling) in alternation, and report the threads' speed-up beside the ceiling");
     cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");
     cmd->add_flag("--vs-scalar", o->vs_scalar,
                   "Also time the scalar reference path (same threads and runs): \"scalar\" and \"speedup_vs_scalar\" (its median "

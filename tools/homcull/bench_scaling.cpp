@@ -1,0 +1,158 @@
+// homcull bench --workload frame --scaling (bench_scaling.hpp).
+#include "bench_scaling.hpp"
+
+#include "options.hpp"
+
+#include <homcull/error.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <memory>
+#include <string>
+#include <thread>
+
+namespace homcull::cli {
+namespace {
+
+// Every copy of the ceiling waits here until all have come (they start their frames together),
+// or until the line is abandoned (a copy could not start).
+class StartLine {
+public:
+    explicit StartLine(int count) : count_(count) {}
+    // Whether every copy came (false: abandoned).
+    bool arrive_and_wait() {
+        arrived_.fetch_add(1);
+        while (arrived_.load() < count_)
+            if (abandoned_.load()) return false;
+            else std::this_thread::yield();
+        return true;
+    }
+    void abandon() { abandoned_.store(true); }
+
+private:
+    const int count_;
+    std::atomic<int> arrived_{0};
+    std::atomic<bool> abandoned_{false};
+};
+
+// The view culled twice in a row by `culler`; the second cull's time.
+double second_cull_ms(SceneCuller& culler, const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
+    culler.cull(camera, answers, parallel);
+    const long long start = now_ns();
+    culler.cull(camera, answers, parallel);
+    return elapsed_ms(start);
+}
+
+// The ceiling's frame: every copy culls the view twice in a row on its own thread (the calling
+// thread is copy 0), the copies' second culls started together; the slowest copy's time. A copy
+// that throws, or a thread that cannot start, ends the measurement with that error.
+double copies_at_once_ms(std::vector<std::unique_ptr<SceneCuller>>& copies, const Camera& camera) {
+    const int n = int(copies.size());
+    StartLine warm(n), timed(n);
+    std::vector<double> ms(copies.size(), 0.0);
+    std::vector<std::exception_ptr> errors(copies.size());
+    const auto run_copy = [&](int k) {
+        try {
+            std::vector<OccludeeAnswer> answers;
+            if (!warm.arrive_and_wait()) return;
+            copies[std::size_t(k)]->cull(camera, answers);
+            if (!timed.arrive_and_wait()) return;
+            const long long start = now_ns();
+            copies[std::size_t(k)]->cull(camera, answers);
+            ms[std::size_t(k)] = elapsed_ms(start);
+        } catch (...) {
+            errors[std::size_t(k)] = std::current_exception();
+            warm.abandon(), timed.abandon();
+        }
+    };
+    std::vector<std::thread> helpers;
+    try {
+        for (int k = 1; k < n; ++k) helpers.emplace_back(run_copy, k);
+    } catch (...) {
+        warm.abandon(), timed.abandon();
+        for (std::thread& t : helpers) t.join();
+        throw;
+    }
+    run_copy(0);
+    for (std::thread& t : helpers) t.join();
+    for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
+    return *std::max_element(ms.begin(), ms.end());
+}
+
+// A view's stage times over the rounds (SceneCullTimings).
+struct StageTimes {
+    std::vector<double> select, render, maps, tests;
+    void add(const SceneCullTimings& t) {
+        select.push_back(t.select_ms), render.push_back(t.render_ms), maps.push_back(t.maps_ms), tests.push_back(t.test_ms);
+    }
+};
+
+// The mean over the views of each stage's median.
+nlohmann::json stage_means(const std::vector<StageTimes>& views) {
+    double select = 0.0, render = 0.0, maps = 0.0, tests = 0.0;
+    const double n = double(views.size());
+    for (const StageTimes& v : views)
+        select += median(v.select) / n, render += median(v.render) / n, maps += median(v.maps) / n, tests += median(v.tests) / n;
+    return {{"select", select}, {"render", render}, {"maps", maps}, {"tests", tests}};
+}
+
+nlohmann::json spread(std::vector<double> v) {
+    return {{"median", median(v)}, {"min", *std::min_element(v.begin(), v.end())}, {"max", *std::max_element(v.begin(), v.end())}};
+}
+
+}  // namespace
+
+void check_scaling_threads(int threads) {
+    if (threads < 2) throw Error("bench --scaling: give --threads N with N >= 2, got " + std::to_string(threads));
+    const unsigned cores = std::thread::hardware_concurrency();
+    if (cores != 0 && unsigned(threads) > cores)
+        throw Error("bench --scaling: --threads " + std::to_string(threads) + " exceeds this machine's " + std::to_string(cores) +
+                    " hardware threads (the ceiling's copies would share cores)");
+}
+
+nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
+                                      const CameraPath& views, int rounds, int threads, const ParallelFor& parallel) {
+    check_scaling_threads(threads);
+    if (!parallel.run) throw Error("bench --scaling: no job system to run the threads");
+    SceneCuller one(scene, occluders, config), many(scene, occluders, config);
+    std::vector<std::unique_ptr<SceneCuller>> copies;
+    for (int k = 0; k < threads; ++k) copies.push_back(std::make_unique<SceneCuller>(scene, occluders, config));
+
+    const std::size_t count = views.frames.size();
+    std::vector<std::vector<double>> t_one(count), t_many(count), t_copies(count);
+    std::vector<StageTimes> stages_one(count), stages_many(count);
+    std::vector<double> speedup, ceiling, share;  // per round, over the sums of its views' times
+    std::vector<OccludeeAnswer> answers;
+    for (int r = 0; r < rounds; ++r) {
+        double one_sum = 0.0, many_sum = 0.0, copies_sum = 0.0;
+        for (std::size_t v = 0; v < count; ++v) {
+            const Camera& camera = views.frames[v];
+            t_one[v].push_back(second_cull_ms(one, camera, answers, ParallelFor{}));
+            stages_one[v].add(one.timings());
+            t_many[v].push_back(second_cull_ms(many, camera, answers, parallel));
+            stages_many[v].add(many.timings());
+            t_copies[v].push_back(copies_at_once_ms(copies, camera));
+            one_sum += t_one[v].back(), many_sum += t_many[v].back(), copies_sum += t_copies[v].back();
+        }
+        speedup.push_back(one_sum / many_sum);
+        ceiling.push_back(double(threads) * one_sum / copies_sum);
+        share.push_back(speedup.back() / ceiling.back());
+    }
+    double one_mean = 0.0, many_mean = 0.0, copies_mean = 0.0;
+    for (std::size_t v = 0; v < count; ++v) {
+        one_mean += median(t_one[v]) / double(count);
+        many_mean += median(t_many[v]) / double(count);
+        copies_mean += median(t_copies[v]) / double(count);
+    }
+    return {{"threads", threads},
+            {"rounds", rounds},
+            {"frame_ms_mean", {{"one_thread", one_mean}, {"threads", many_mean}, {"copies_at_once", copies_mean}}},
+            {"stages_ms_mean", {{"one_thread", stage_means(stages_one)}, {"threads", stage_means(stages_many)}}},
+            {"speedup", spread(speedup)},
+            {"ceiling", spread(ceiling)},
+            {"speedup_over_ceiling", spread(share)}};
+}
+
+}  // namespace homcull::cli
