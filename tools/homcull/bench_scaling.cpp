@@ -7,10 +7,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <exception>
 #include <memory>
 #include <string>
 #include <thread>
+
+#ifdef __linux__
+#include <sched.h>
+#endif
 
 namespace homcull::cli {
 namespace {
@@ -81,6 +86,42 @@ double copies_at_once_ms(std::vector<std::unique_ptr<SceneCuller>>& copies, cons
     return *std::max_element(ms.begin(), ms.end());
 }
 
+void wait_for(const std::atomic<int>& turn, int value) {
+    // Spinning, but giving way now and then: should both threads share a core, each trip then
+    // costs a switch instead of a time slice.
+    for (unsigned spins = 1; turn.load(std::memory_order_acquire) != value; ++spins)
+        if (spins % 1024 == 0) std::this_thread::yield();
+}
+
+// How long a cache line takes to go from one core to another and back: two threads hand a
+// counter to each other `trips` times. What a second thread gains on work that shares data (a
+// cluster set up on one core and drawn on the other, buffer rows written on one and tested on
+// the other) falls as this rises, and a virtual machine's two cores can be close (one chiplet)
+// or far apart from one minute to the next; the ceiling's copies share nothing and do not show it.
+double cross_core_round_trip_ns(int trips) {
+    // The job system's workers spin a while after their last task before they sleep: sharing a
+    // core with one, a thread here would time the scheduler instead.
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    alignas(64) std::atomic<int> turn{0};
+    StartLine start(2);
+    std::thread other([&] {
+        if (!start.arrive_and_wait()) return;
+        for (int k = 0; k < trips; ++k) {
+            wait_for(turn, 2 * k + 1);
+            turn.store(2 * k + 2, std::memory_order_release);
+        }
+    });
+    start.arrive_and_wait();
+    const long long begin = now_ns();
+    for (int k = 0; k < trips; ++k) {
+        turn.store(2 * k + 1, std::memory_order_release);
+        wait_for(turn, 2 * k + 2);
+    }
+    const double ns = double(now_ns() - begin) / double(trips);
+    other.join();
+    return ns;
+}
+
 // A view's stage times over the rounds (SceneCullTimings).
 struct StageTimes {
     std::vector<double> select, render, maps, tests;
@@ -106,10 +147,14 @@ nlohmann::json spread(std::vector<double> v) {
 
 void check_scaling_threads(int threads) {
     if (threads < 2) throw Error("bench --scaling: give --threads N with N >= 2, got " + std::to_string(threads));
-    const unsigned cores = std::thread::hardware_concurrency();
-    if (cores != 0 && unsigned(threads) > cores)
-        throw Error("bench --scaling: --threads " + std::to_string(threads) + " exceeds this machine's " + std::to_string(cores) +
-                    " hardware threads (the ceiling's copies would share cores)");
+    int cores = int(std::thread::hardware_concurrency());
+#ifdef __linux__
+    cpu_set_t allowed;  // a process limited by taskset has fewer
+    if (sched_getaffinity(0, sizeof allowed, &allowed) == 0) cores = CPU_COUNT(&allowed);
+#endif
+    if (cores != 0 && threads > cores)
+        throw Error("bench --scaling: --threads " + std::to_string(threads) + " exceeds the " + std::to_string(cores) +
+                    " hardware threads this process may use (the ceiling's copies would share cores)");
 }
 
 nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
@@ -123,9 +168,10 @@ nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std:
     const std::size_t count = views.frames.size();
     std::vector<std::vector<double>> t_one(count), t_many(count), t_copies(count);
     std::vector<StageTimes> stages_one(count), stages_many(count);
-    std::vector<double> speedup, ceiling, share;  // per round, over the sums of its views' times
+    std::vector<double> speedup, ceiling, round_trip;  // per round: over the sums of its views' times
     std::vector<OccludeeAnswer> answers;
     for (int r = 0; r < rounds; ++r) {
+        round_trip.push_back(cross_core_round_trip_ns(20000));
         double one_sum = 0.0, many_sum = 0.0, copies_sum = 0.0;
         for (std::size_t v = 0; v < count; ++v) {
             const Camera& camera = views.frames[v];
@@ -138,8 +184,8 @@ nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std:
         }
         speedup.push_back(one_sum / many_sum);
         ceiling.push_back(double(threads) * one_sum / copies_sum);
-        share.push_back(speedup.back() / ceiling.back());
     }
+    // The headline ratios from the views' medians (a round's sum takes every stall of its views).
     double one_mean = 0.0, many_mean = 0.0, copies_mean = 0.0;
     for (std::size_t v = 0; v < count; ++v) {
         one_mean += median(t_one[v]) / double(count);
@@ -150,9 +196,10 @@ nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std:
             {"rounds", rounds},
             {"frame_ms_mean", {{"one_thread", one_mean}, {"threads", many_mean}, {"copies_at_once", copies_mean}}},
             {"stages_ms_mean", {{"one_thread", stage_means(stages_one)}, {"threads", stage_means(stages_many)}}},
-            {"speedup", spread(speedup)},
-            {"ceiling", spread(ceiling)},
-            {"speedup_over_ceiling", spread(share)}};
+            {"speedup", one_mean / many_mean},
+            {"ceiling", double(threads) * one_mean / copies_mean},
+            {"per_round", {{"speedup", spread(speedup)}, {"ceiling", spread(ceiling)}}},
+            {"cross_core_round_trip_ns", spread(round_trip)}};
 }
 
 }  // namespace homcull::cli
