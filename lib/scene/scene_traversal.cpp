@@ -150,7 +150,6 @@ void detail::SceneCullerState::traverse_in_tasks(const Frame& frame, std::vector
     add_tally(top);
 
     const std::size_t tasks = std::min({task_tallies_.size(), 2 * threads, subtrees_.size()});
-    for (std::size_t k = 0; k < tasks; ++k) task_tallies_[k] = TestTally{};
     struct Job {
         SceneCullerState* self;
         const Frame* frame;
@@ -160,7 +159,9 @@ void detail::SceneCullerState::traverse_in_tasks(const Frame& frame, std::vector
     run_tasks(parallel, tasks, [](void* data, std::size_t k) {
         Job& j = *static_cast<Job*>(data);
         SceneCullerState& self = *j.self;
-        TestTally& tally = self.task_tallies_[k];
+        // Counted here and stored once at the end: the tasks' tallies lie side by side, and a
+        // count per test into them would take their shared cache line from the other core each time.
+        TestTally tally;
         std::uint32_t* stack = self.task_stacks_.data() + k * self.task_stack_room_;
         for (std::size_t s = j.next_subtree++; s < self.subtrees_.size(); s = j.next_subtree++) {
             std::size_t depth = 0;  // depth first: at most the hierarchy's depth + 1 waiting
@@ -180,6 +181,7 @@ void detail::SceneCullerState::traverse_in_tasks(const Frame& frame, std::vector
                 }
             }
         }
+        self.task_tallies_[k] = tally;
     }, &job);
     for (std::size_t k = 0; k < tasks; ++k) add_tally(task_tallies_[k]);
 }
