@@ -145,6 +145,9 @@ TEST(OccluderSelection, ComplexityFilterDropsObjectsDenseForTheirSurface) {
     boxes_and_flat.push_back(all[6]);
     EXPECT_EQ(filter_by_complexity(scene, all, 16.0), boxes_and_flat);
     EXPECT_TRUE(filter_by_complexity(scene, {}, 16.0).empty());
+    // Mostly candidates without surface: the median is infinite, every one with a surface stays.
+    EXPECT_EQ(filter_by_complexity(scene, {all[7], all[5], all[7]}, 16.0), std::vector<std::uint32_t>{all[5]});
+    EXPECT_TRUE(filter_by_complexity(scene, {all[7]}, 16.0).empty());
 }
 
 struct StrategyCase {
