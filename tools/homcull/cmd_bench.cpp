@@ -294,7 +294,8 @@ void register_bench(CLI::App& app) {
         ->capture_default_str()->check(CLI::NonNegativeNumber)->each([o](const std::string&) { o->complexity_given = true; });
     cmd->add_flag("--scaling", o->scaling,
                   "frame, --threads N >= 2: also time one thread, N threads and N single-threaded copies at once (the "
-                  "machine's ceiling) in alternation, and report the threads' speed-up beside the ceiling");
+                  "machine's ceiling) in alternation, and report the threads' speed-up beside the ceiling and beside the time a "
+                  "cache line takes between two cores and back");
     cmd->add_flag("--sample-depth", o->sample_depth, "Also keep a depth per sample (BufferConfig::sample_depth)");
     cmd->add_flag("--vs-scalar", o->vs_scalar,
                   "Also time the scalar reference path (same threads and runs): \"scalar\" and \"speedup_vs_scalar\" (its median "
