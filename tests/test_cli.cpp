@@ -446,6 +446,7 @@ TEST(Cli, FrameBenchScalingReportsTheThreadsBesideTheMachinesCeiling) {
         EXPECT_LE((*spread)["median"].get<double>(), (*spread)["max"].get<double>());
     }
     for (const char* kind : {"one_thread", "threads", "copies_at_once"}) EXPECT_GT(s["frame_ms_mean"][kind].get<double>(), 0.0) << kind;
+    for (const char* series : {"speedup", "ceiling", "cross_core_round_trip_ns"}) EXPECT_EQ(s["rounds_in_order"][series].size(), 2u) << series;
     for (const char* kind : {"one_thread", "threads"})
         for (const char* stage : {"select", "render", "maps", "tests"}) EXPECT_GE(s["stages_ms_mean"][kind][stage].get<double>(), 0.0);
 }

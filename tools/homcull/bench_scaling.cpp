@@ -199,6 +199,9 @@ nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std:
             {"speedup", one_mean / many_mean},
             {"ceiling", double(threads) * one_mean / copies_mean},
             {"per_round", {{"speedup", spread(speedup)}, {"ceiling", spread(ceiling)}}},
+            // Each round's figures in order, so that a round's speed-up can be read beside the
+            // round trip measured just before it (the host moves the cores within a run).
+            {"rounds_in_order", {{"speedup", speedup}, {"ceiling", ceiling}, {"cross_core_round_trip_ns", round_trip}}},
             {"cross_core_round_trip_ns", spread(round_trip)}};
 }
 

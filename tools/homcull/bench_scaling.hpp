@@ -30,7 +30,8 @@ void check_scaling_threads(int threads);
 // are alike: the job system's workers are awake and the bands' order (clustered_render.cpp)
 // comes from the same view. Before each round, the time a cache line takes between two cores
 // and back. Returns the mean of the views' median frame times of each kind and their ratios
-// (speed-up and ceiling), the per-round ratios' spreads and the round trips'.
+// (speed-up and ceiling), the per-round ratios' spreads and the round trips', and every
+// round's figures in order.
 nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
                                       const CameraPath& views, int rounds, int threads, const ParallelFor& parallel);
 
