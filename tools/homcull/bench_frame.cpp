@@ -5,6 +5,7 @@
 
 #include "cull_report.hpp"
 #include "options.hpp"
+#include "stage_times.hpp"
 
 #include <homcull/error.hpp>
 #include <homcull/io/camera_path.hpp>
@@ -27,7 +28,7 @@ namespace {
 
 // What one view measured: every round's times, and the answers scored against Embree.
 struct ViewFigures {
-    std::vector<double> frame, select, render, maps, tests;
+    std::vector<double> frame;
     CullingTally tally;
     std::size_t counts[3] = {};  // visible, occluded, view-culled
 };
@@ -78,6 +79,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     // the views interleaved so that the machine's load spreads over all of them alike.
     const std::size_t views = path.frames.size();
     std::vector<ViewFigures> figures(views);
+    std::vector<StageTimes> stages(views);
     std::vector<OccludeeAnswer> answers;
     for (const Camera& camera : path.frames) culler.cull(camera, answers, parallel);
     for (int r = 0; r < o.rounds; ++r)
@@ -88,7 +90,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
             const SceneCullTimings& t = culler.timings();
             ViewFigures& f = figures[v];
             f.frame.push_back(frame_ms);
-            f.select.push_back(t.select_ms), f.render.push_back(t.render_ms), f.maps.push_back(t.maps_ms), f.tests.push_back(t.test_ms);
+            stages[v].add(t);
         }
 
     // The answers of each view, against Embree at the display's pixel centres (not timed).
@@ -97,7 +99,6 @@ void run_frame_bench(const FrameBenchOptions& o) {
     CullingTally total;
     nlohmann::json per_view = nlohmann::json::array();
     std::vector<double> frame_medians;
-    double stage_sums[4] = {};
     for (std::size_t v = 0; v < views; ++v) {
         const Camera& camera = path.frames[v];
         culler.cull(camera, answers, parallel);
@@ -106,14 +107,12 @@ void run_frame_bench(const FrameBenchOptions& o) {
         tally_answers(scene, truth, answers, camera, f.tally);
         for (const OccludeeAnswer& a : answers) ++f.counts[int(a.visibility)];
         total += f.tally;
-        const double stages[4] = {median(f.select), median(f.render), median(f.maps), median(f.tests)};
-        for (int s = 0; s < 4; ++s) stage_sums[s] += stages[s];
         frame_medians.push_back(median(f.frame));
         nlohmann::json view = {{"view", v},
                                {"camera", camera_json(camera)},
                                {"frame_ms", frame_medians.back()},
                                {"frame_min_ms", *std::min_element(f.frame.begin(), f.frame.end())},
-                               {"stages_ms", {{"select", stages[0]}, {"render", stages[1]}, {"maps", stages[2]}, {"tests", stages[3]}}},
+                               {"stages_ms", stages[v].medians()},
                                {"answers", {{"visible", f.counts[0]}, {"occluded", f.counts[1]}, {"view_culled", f.counts[2]}}}};
         view.update(accuracy_json(f.tally));
         per_view.push_back(std::move(view));
@@ -125,9 +124,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
         o.scaling ? measure_thread_scaling(scene, resources.occluders, config, path, o.rounds, o.threads, parallel) : nlohmann::json();
     nlohmann::json summary = {{"views", views},
                               {"frame_ms", {{"mean", mean_frame}, {"max", worst_frame}, {"median", median(frame_medians)}}},
-                              {"stages_ms_mean",
-                               {{"select", stage_sums[0] / double(views)}, {"render", stage_sums[1] / double(views)},
-                                {"maps", stage_sums[2] / double(views)}, {"tests", stage_sums[3] / double(views)}}}};
+                              {"stages_ms_mean", stage_means(stages)}};
     summary.update(accuracy_json(total));
     const std::string source = !o.views.empty() ? o.views : o.walk > 0 ? "walk:" + std::to_string(o.walk) + ",seed=" + std::to_string(o.seed)
                                                                         : "random:" + std::to_string(o.random) + ",seed=" + std::to_string(o.seed);

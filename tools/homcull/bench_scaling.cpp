@@ -2,6 +2,7 @@
 #include "bench_scaling.hpp"
 
 #include "options.hpp"
+#include "stage_times.hpp"
 
 #include <homcull/error.hpp>
 
@@ -120,23 +121,6 @@ double cross_core_round_trip_ns(int trips) {
     const double ns = double(now_ns() - begin) / double(trips);
     other.join();
     return ns;
-}
-
-// A view's stage times over the rounds (SceneCullTimings).
-struct StageTimes {
-    std::vector<double> select, render, maps, tests;
-    void add(const SceneCullTimings& t) {
-        select.push_back(t.select_ms), render.push_back(t.render_ms), maps.push_back(t.maps_ms), tests.push_back(t.test_ms);
-    }
-};
-
-// The mean over the views of each stage's median.
-nlohmann::json stage_means(const std::vector<StageTimes>& views) {
-    double select = 0.0, render = 0.0, maps = 0.0, tests = 0.0;
-    const double n = double(views.size());
-    for (const StageTimes& v : views)
-        select += median(v.select) / n, render += median(v.render) / n, maps += median(v.maps) / n, tests += median(v.tests) / n;
-    return {{"select", select}, {"render", render}, {"maps", maps}, {"tests", tests}};
 }
 
 nlohmann::json spread(std::vector<double> v) {

@@ -33,8 +33,9 @@ std::vector<std::uint32_t> occluder_candidates(const Scene& scene, OccluderFilte
 // area, in world space) are at most `factor` times the median of the candidates' (railings,
 // spiral stairs and finely tessellated patches cover little for their cost); candidates with no
 // surface are dropped (they count in the median as infinitely dense: when they are most of the
-// candidates, every candidate with a surface is kept). factor <= 0 keeps every candidate. Spatial locality, Zhang's third static
-// criterion, is applied per frame instead: distance ranking and the baked grid.
+// candidates, every candidate with a surface is kept). factor <= 0 keeps every candidate.
+// Spatial locality, Zhang's third static criterion, is applied per frame instead: distance
+// ranking and the baked grid.
 std::vector<std::uint32_t> filter_by_complexity(const Scene& scene, const std::vector<std::uint32_t>& candidates, double factor);
 
 enum class OccluderRanking : std::uint8_t {
