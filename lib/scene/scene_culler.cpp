@@ -208,7 +208,7 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_clusters_.clear();
     frame_cluster_backfaces_.clear();
     frame_clusters_rendered_ = 0;
-    frame_clusters_cross_ = false;
+    frame_cluster_flags_ = EdgeFlags::own_object;
     frame_cluster_triangles_waiting_ = 0;
     frame_back_faces_waiting_ = 0;
     frame_started_ = false;
@@ -251,11 +251,12 @@ void detail::SceneCullerState::select_occluders(const Frame& frame) {
     }
     rank_occluders(*scene_, *pool, *frame.camera, config_.display.aspect(), config_.occluder_budget, ranked_, rank_scratch_,
                    config_.lods);
-    // Cross-object flags also need every neighbour drawn as itself, not as an LOD.
-    bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0;
-    for (std::size_t i = 0; i < ranked_.size() && every_candidate_in_frustum; ++i)
-        every_candidate_in_frustum = !draws_lod(ranked_[i], *frame.camera);
-    const EdgeFlags flags = every_candidate_in_frustum ? EdgeFlags::across_objects : EdgeFlags::own_object;
+    // Cross-object flags also need every neighbour drawn as itself, not as an LOD; where some
+    // candidates are left out, the clusters keep the flags of the edges whose neighbour is drawn.
+    bool any_lod = false;
+    for (std::size_t i = 0; i < ranked_.size() && !any_lod; ++i) any_lod = draws_lod(ranked_[i], *frame.camera);
+    const bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0 && !any_lod;
+    const EdgeFlags flags = every_candidate_in_frustum ? EdgeFlags::across_objects : any_lod ? EdgeFlags::own_object : EdgeFlags::drawn_neighbours;
     for (std::uint32_t id : ranked_) append_occluder(id, frame, flags);
     timings_.select_ms += ms_since(start);
 }
@@ -299,6 +300,12 @@ void detail::SceneCullerState::gather_lods() {
 void detail::SceneCullerState::build_clusters() {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
+    cluster_neighbour_first_.assign(1, 0);
+    // Which candidate each vertex of occluders_ belongs to (each object's vertices are its own).
+    std::vector<std::uint32_t> vertex_candidate(occluders_.positions.size() / 3, kNone);
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k)
+        for (std::size_t i = 3 * std::size_t(first_triangle_[k]); i < 3 * std::size_t(first_triangle_[k + 1]); ++i)
+            vertex_candidate[occluders_.indices[i]] = std::uint32_t(k);
     std::vector<std::uint32_t> local, local_apexes;  // the candidate's indices and apexes, relative to its first vertex
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
@@ -313,9 +320,10 @@ void detail::SceneCullerState::build_clusters() {
         const OccluderClusters part = build_occluder_clusters(occluders_.positions.data() + 3 * std::size_t(base), 3 * sizeof(float),
                                                               count ? std::size_t(top - base) + 1 : 0, local.data(), count,
                                                               own_shared_edges_.data() + first, local_apexes.data());
-        add_candidate_clusters(k, part);
+        add_candidate_clusters(k, part, vertex_candidate);
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
+    cluster_neighbour_edges_ = cluster_cross_shared_edges_;
     frame_clusters_.reserve(clusters_.clusters.size());
     frame_cluster_backfaces_.reserve(clusters_.clusters.size());
 }
@@ -325,7 +333,7 @@ void detail::SceneCullerState::build_clusters() {
 // cluster vertex; an apex in another object becomes a vertex of the cluster (found among its
 // vertices by position, or a copy appended), so that either set of flags names apexes among
 // the cluster's own vertices, as the render requires.
-void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const OccluderClusters& part) {
+void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const OccluderClusters& part, const std::vector<std::uint32_t>& vertex_candidate) {
     const std::size_t first = first_triangle_[k];
     const auto triangle_base = std::uint32_t(clusters_.shared_edges.size());
     const std::size_t occluder_vertices = occluders_.positions.size() / 3;
@@ -342,6 +350,8 @@ void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const Occlu
             cluster_cross_shared_edges_.push_back(flags);
             for (std::size_t e = 0; e < 3; ++e) {
                 const std::uint32_t apex = (flags >> e) & 1u ? occluders_.edge_apexes[3 * source + e] : kNoApex;
+                if (apex < occluder_vertices && vertex_candidate[apex] != k)
+                    cluster_neighbours_.push_back({c.first_triangle + i, vertex_candidate[apex], std::uint8_t(1u << e)});
                 if (apex >= occluder_vertices) {  // none (the render drops a flag without an apex)
                     cluster_cross_edge_apexes_.push_back(kNoApex);
                 } else if ((own_shared_edges_[source] >> e) & 1u && own_edge_apexes_[3 * source + e] == apex &&
@@ -361,6 +371,7 @@ void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const Occlu
         c.vertex_count = std::uint32_t(clusters_.positions.size() / 3 - c.first_vertex);
         clusters_.max_cluster_vertices = std::max(clusters_.max_cluster_vertices, c.vertex_count);
         clusters_.clusters.push_back(c);
+        cluster_neighbour_first_.push_back(std::uint32_t(cluster_neighbours_.size()));
     }
     clusters_.indices.insert(clusters_.indices.end(), part.indices.begin(), part.indices.end());
     clusters_.shared_edges.insert(clusters_.shared_edges.end(), part.shared_edges.begin(), part.shared_edges.end());
@@ -413,13 +424,13 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
     const Camera& camera = *frame.camera;
     const std::uint32_t k = candidate_of_[id];
     const bool lod = draws_lod(id, camera);
-    const bool own = edge_flags == EdgeFlags::own_object;
+    const bool own = edge_flags != EdgeFlags::across_objects;  // drawn_neighbours: decided for clusters alone
     const std::vector<std::uint32_t>& indices = lod ? lod_indices_ : occluders_.indices;
     const std::vector<std::uint8_t>& flags = lod ? lod_shared_edges_ : own ? own_shared_edges_ : occluders_.shared_edges;
     const std::vector<std::uint32_t>& apexes = lod ? lod_edge_apexes_ : own ? own_edge_apexes_ : occluders_.edge_apexes;
     const std::uint32_t first = lod ? lod_first_[k] : first_triangle_[k], last = lod ? lod_first_[k + 1] : first_triangle_[k + 1];
     frame_occluders_.push_back(id);
-    drawn_[k] = 1;
+    drawn_[k] = lod ? 2 : 1;
     ++work_.occluder_objects;
     work_.occluder_triangles += last - first;
     work_.occluder_lods += lod;
@@ -428,8 +439,12 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
         // triangles face out counter-clockwise in world space, so its front faces are
         // counter-clockwise in the GL clip space (y up) the culler projects to.
         const Backface backface = closed_[k] ? Backface::cw : config_.backface;
-        // A batch not rendered yet takes the cross-object flags only if all its clusters may.
-        frame_clusters_cross_ = (frame_clusters_.size() == frame_clusters_rendered_ || frame_clusters_cross_) && !own;
+        // A batch not rendered yet takes the cross-object flags only if all its clusters may;
+        // those of drawn neighbours suit either of the two.
+        if (frame_clusters_.size() == frame_clusters_rendered_) frame_cluster_flags_ = edge_flags;
+        else if (frame_cluster_flags_ != edge_flags)
+            frame_cluster_flags_ = frame_cluster_flags_ == EdgeFlags::own_object || edge_flags == EdgeFlags::own_object ? EdgeFlags::own_object
+                                                                                                                       : EdgeFlags::drawn_neighbours;
         // A cluster whose box (OccluderCluster::bounds, of its own vertices, in anchored world)
         // misses the frustum (Frame::frustum) is left out. The buffer places
         // a cluster by the screen rectangle of its box's corners, which covers part of the screen
@@ -496,7 +511,7 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
         (void)distance;
         const std::size_t n = occluder_triangles_drawn(*scene_, id, *frame.camera, config_.lods);
         if (n > left) continue;
-        append_occluder(id, frame, EdgeFlags::own_object);
+        append_occluder(id, frame, EdgeFlags::drawn_neighbours);
         left -= n;
     }
     timings_.select_ms += ms_since(start);
@@ -513,6 +528,22 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
     timings_.test_ms += ms_since(start);
 }
 
+// The flags of the pending clusters frame_clusters_[first_cluster, end_cluster) for
+// EdgeFlags::drawn_neighbours: an edge shared with another candidate keeps its flag only when
+// that candidate is drawn as itself this frame (so far: those drawn later leave it a margin,
+// which only loses occlusion). An edge within the object keeps its flag, as in
+// cluster_cross_shared_edges_, which cluster_neighbour_edges_ starts as.
+void detail::SceneCullerState::keep_drawn_neighbours(std::size_t first_cluster, std::size_t end_cluster) {
+    for (std::size_t i = first_cluster; i < end_cluster; ++i) {
+        const std::uint32_t c = frame_clusters_[i];
+        for (std::uint32_t n = cluster_neighbour_first_[c]; n < cluster_neighbour_first_[c + 1]; ++n) {
+            const ClusterNeighbour& edge = cluster_neighbours_[n];
+            std::uint8_t& flags = cluster_neighbour_edges_[edge.triangle];
+            flags = edge.candidate != kNone && drawn_[edge.candidate] == 1 ? std::uint8_t(flags | edge.edge_bit) : std::uint8_t(flags & ~edge.edge_bit);
+        }
+    }
+}
+
 // The clusters of frame_clusters_ and the triangles of frame_indices_ not rendered yet; the
 // frame's first render clears the buffer (render_frame clears each band where it rasterizes).
 void detail::SceneCullerState::render_pending(const Frame& frame, const ParallelFor& parallel) {
@@ -525,8 +556,12 @@ void detail::SceneCullerState::render_pending(const Frame& frame, const Parallel
         in.cluster_ids = frame_clusters_.data() + frame_clusters_rendered_;
         in.backfaces = frame_cluster_backfaces_.data() + frame_clusters_rendered_;
         in.cluster_count = clusters;
-        if (frame_clusters_cross_) {  // every candidate in the frustum is drawn (select_occluders)
+        if (frame_cluster_flags_ == EdgeFlags::across_objects) {  // every candidate in the frustum is drawn (select_occluders)
             in.shared_edges = cluster_cross_shared_edges_.data();
+            in.edge_apexes = cluster_cross_edge_apexes_.data();
+        } else if (frame_cluster_flags_ == EdgeFlags::drawn_neighbours) {
+            keep_drawn_neighbours(frame_clusters_rendered_, frame_clusters_.size());
+            in.shared_edges = cluster_neighbour_edges_.data();
             in.edge_apexes = cluster_cross_edge_apexes_.data();
         }
         if (!frame_started_) buffer_.render_frame(in, parallel);

@@ -73,7 +73,21 @@ public:
     // copy among the cluster's vertices, after those of its own triangles and own apexes.
     std::vector<std::uint8_t> cluster_cross_shared_edges_;
     std::vector<std::uint32_t> cluster_cross_edge_apexes_;
-    void add_candidate_clusters(std::size_t k, const OccluderClusters& part);
+    // The cross-object flags' edges whose neighbour is in another candidate: cluster c's are
+    // [cluster_neighbour_first_[c], cluster_neighbour_first_[c + 1]) of cluster_neighbours_. A
+    // frame that draws some candidates (EdgeFlags::drawn_neighbours) keeps such an edge's flag in
+    // cluster_neighbour_edges_ (otherwise cluster_cross_shared_edges_) only when the neighbour
+    // is drawn too.
+    struct ClusterNeighbour {
+        std::uint32_t triangle;   // into the clustered triangles
+        std::uint32_t candidate;  // the neighbour's k
+        std::uint8_t edge_bit;
+    };
+    std::vector<ClusterNeighbour> cluster_neighbours_;
+    std::vector<std::uint32_t> cluster_neighbour_first_;
+    std::vector<std::uint8_t> cluster_neighbour_edges_;
+    void add_candidate_clusters(std::size_t k, const OccluderClusters& part, const std::vector<std::uint32_t>& vertex_candidate);
+    void keep_drawn_neighbours(std::size_t first_cluster, std::size_t end_cluster);
     ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
@@ -91,7 +105,13 @@ public:
     std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
     std::vector<Backface> frame_cluster_backfaces_;  // each one's backface mode (closed candidates': cw)
     std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
-    bool frame_clusters_cross_ = false;           // those not rendered yet all take the cross-object flags
+    // Which shared-edge flags occluders take (docs/scene-culling.md, "Shared edges").
+    // own_object: each object's own (right for any subset); across_objects: across the whole
+    // candidate set (every candidate that may meet the frustum is drawn); drawn_neighbours: across
+    // objects where the neighbour is drawn too, decided when the clusters are rendered (clusters
+    // only; triangles take their own object's).
+    enum class EdgeFlags : std::uint8_t { own_object, across_objects, drawn_neighbours };
+    EdgeFlags frame_cluster_flags_ = EdgeFlags::own_object;  // the flags the clusters not rendered yet all take
     std::size_t frame_cluster_triangles_waiting_ = 0;
     // Closed candidates' back faces left out and not rendered yet: they count towards
     // progressive's batches as if drawn, so that skipping them does not delay a batch.
@@ -101,14 +121,12 @@ public:
     std::vector<std::uint32_t> ranked_;           // rank_occluders' choice
     std::vector<std::pair<float, std::uint32_t>> rank_scratch_, node_heap_;
     std::vector<Visibility> last_visibility_;
-    std::vector<std::uint8_t> drawn_;  // per candidate k: drawn this frame
+    std::vector<std::uint8_t> drawn_;  // per candidate k: drawn this frame (1), as its LOD (2), or not (0)
     bool has_history_ = false;
 
     static constexpr std::uint32_t kNone = ~std::uint32_t(0);
     struct Frame;
     void select_occluders(const Frame& frame);
-    // Which shared-edge flags an occluder is drawn with (docs/scene-culling.md, "Shared edges").
-    enum class EdgeFlags : std::uint8_t { own_object, across_objects };
     // Appends an occluder's triangles (or clusters), its LOD's when it has one usable from this
     // camera, with those flags (an LOD always has its own).
     void append_occluder(std::uint32_t id, const Frame& frame, EdgeFlags edge_flags);
