@@ -583,16 +583,28 @@ TEST(SceneCulling, ClosedOccludersAreDrawnWithoutTheirBackFaces) {
 // A wall made of two objects that meet along the view's middle column of sample centres (a
 // hair beside them), and a stick behind that column alone. Drawing every candidate in the frustum (one-pass, no budget),
 // the edge the two objects share goes without its coverage margin, as triangles and as
-// clusters alike, and the wall hides the stick; with a budget, flags within each object only:
-// the margin opens a leak one sample wide along the seam, and the stick shows through it.
-TEST(SceneCulling, EdgesSharedAcrossObjectsCloseTheSeamAsTrianglesAndAsClusters) {
+// clusters alike, and the wall hides the stick. With a budget the triangles take the flags
+// within each object only: the margin opens a leak one sample wide along the seam, and the stick
+// shows through it; the clusters keep the flag, the neighbour being drawn, unless the budget
+// leaves it out.
+// The two halves and the stick, for a 65 x 33 display seen by test::camera_down_minus_z(90).
+struct SeamedWall {
+    std::uint32_t left, right, stick;
+};
+SeamedWall add_seamed_wall(Scene& scene) {
     // The seam 2^-12 sample right of the column's centres: inside the left half by less than the
     // margin (2^-10 sample). (A sample centre exactly on a shared edge is covered by neither side.)
     const float seam = 5.0f * (65.0f / 33.0f) * (2.0f / 65.0f) * 0x1.0p-12f;
+    SeamedWall w;
+    w.left = test::add_quad(scene, "left half", {-10, -10, -5}, {seam, -10, -5}, {seam, 10, -5}, {-10, 10, -5});
+    w.right = test::add_quad(scene, "right half", {seam, -10, -5}, {10, -10, -5}, {10, 10, -5}, {seam, 10, -5});
+    w.stick = test::add_box(scene, "stick behind the seam", {-1e-4f, -1, -10}, {1e-4f, 1, -9});
+    return w;
+}
+
+TEST(SceneCulling, EdgesSharedAcrossObjectsCloseTheSeamAsTrianglesAndAsClusters) {
     Scene scene;
-    const std::uint32_t left = test::add_quad(scene, "left half", {-10, -10, -5}, {seam, -10, -5}, {seam, 10, -5}, {-10, 10, -5});
-    const std::uint32_t right = test::add_quad(scene, "right half", {seam, -10, -5}, {10, -10, -5}, {10, 10, -5}, {seam, 10, -5});
-    const std::uint32_t stick = test::add_box(scene, "stick behind the seam", {-1e-4f, -1, -10}, {1e-4f, 1, -9});
+    const auto [left, right, stick] = add_seamed_wall(scene);
     scene.finalize();
     const Camera camera = test::camera_down_minus_z(90.0);
     for (const bool clusters : {false, true}) {
@@ -633,11 +645,8 @@ TEST(SceneCulling, EdgesSharedAcrossObjectsCloseTheSeamAsTrianglesAndAsClusters)
 // open and the stick visible. The frame after, both halves are drawn together and the seam is
 // closed.
 TEST(SceneCulling, TemporalClustersCloseASeamOnlyWithTheNeighbourDrawn) {
-    const float seam = 5.0f * (65.0f / 33.0f) * (2.0f / 65.0f) * 0x1.0p-12f;
     Scene scene;
-    const std::uint32_t left = test::add_quad(scene, "left half", {-10, -10, -5}, {seam, -10, -5}, {seam, 10, -5}, {-10, 10, -5});
-    const std::uint32_t right = test::add_quad(scene, "right half", {seam, -10, -5}, {10, -10, -5}, {10, 10, -5}, {seam, 10, -5});
-    const std::uint32_t stick = test::add_box(scene, "stick behind the seam", {-1e-4f, -1, -10}, {1e-4f, 1, -9});
+    const auto [left, right, stick] = add_seamed_wall(scene);
     const std::uint32_t screen = test::add_quad(scene, "screen", {0.5f, -10, -2}, {10, -10, -2}, {10, 10, -2}, {0.5f, 10, -2});
     scene.finalize();
     const Camera aligned = test::camera_down_minus_z(90.0);
