@@ -3,13 +3,17 @@
 // out-of-memory at every allocation. The C99 engine host (tests/c_host) drives it on the castle.
 #include <homcull/homcull.h>
 
+#include <homcull/occluder_selection.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/scene.hpp>
 
 #include <gtest/gtest.h>
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -51,6 +55,19 @@ homcull_context* make_context(EngineMemory* memory = nullptr, homcull_isa isa = 
     return context;
 }
 
+// A mesh of packed x, y, z positions and 16- or 32-bit indices, 3 per triangle.
+template <typename Index>
+homcull_mesh_desc indexed_mesh_desc(const std::vector<float>& positions, const std::vector<Index>& indices) {
+    homcull_mesh_desc d{};
+    d.positions = positions.data();
+    d.position_stride = 12;
+    d.vertex_count = positions.size() / 3;
+    d.indices = indices.data();
+    d.index_size = sizeof(Index);
+    d.triangle_count = indices.size() / 3;
+    return d;
+}
+
 // A small world with answers known by construction, seen from the origin looking down -z
 // (right-handed, y up): a wall of 2 x 2 quads at z = -10 over x in [-20, 5] and y in [-20, 20]
 // (CCW towards the camera), covering the view but for a strip on the right, and boxes.
@@ -83,16 +100,7 @@ struct Scene {
         boxes.push_back({{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}});
         expected.push_back(v);
     }
-    homcull_mesh_desc mesh_desc() const {
-        homcull_mesh_desc d{};
-        d.positions = positions.data();
-        d.position_stride = 12;
-        d.vertex_count = positions.size() / 3;
-        d.indices = indices.data();
-        d.index_size = 2;
-        d.triangle_count = indices.size() / 3;
-        return d;
-    }
+    homcull_mesh_desc mesh_desc() const { return indexed_mesh_desc(positions, indices); }
 };
 
 constexpr double kNear = 0.1, kFar = 100.0, kFovY = glm::radians(60.0), kAspect = 16.0 / 9.0;
@@ -688,6 +696,103 @@ TEST(CApi, OutOfMemoryAtEveryAllocation) {
         EXPECT_EQ(memory.live, 0u) << "failing allocation " << k;
     }
     EXPECT_EQ(failures_seen, total);  // every allocation failed once, and was reported
+}
+
+// A unit square in the z = 0 plane split into n x n cells of two triangles: 2 n^2 triangles per
+// unit of surface.
+struct GridMesh {
+    std::vector<float> positions;
+    std::vector<std::uint32_t> indices;
+    explicit GridMesh(int n, bool flat = false) {
+        for (int y = 0; y <= n; ++y)
+            for (int x = 0; x <= n; ++x) positions.insert(positions.end(), {float(x) / float(n), flat ? 0.0f : float(y) / float(n), 0.0f});
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const auto a = std::uint32_t((n + 1) * y + x), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
+                indices.insert(indices.end(), {a, b, d, a, d, c});
+            }
+    }
+    homcull_mesh* make(homcull_context* context) const {
+        const homcull_mesh_desc d = indexed_mesh_desc(positions, indices);
+        homcull_mesh* mesh = nullptr;
+        EXPECT_EQ(homcull_mesh_create(context, &d, &mesh), HOMCULL_OK) << homcull_last_error();
+        return mesh;
+    }
+};
+
+// Zhang's complexity filter over meshes and model matrices: candidates denser than factor times
+// the median (triangles per unit of world surface) and those without surface are dropped; a
+// matrix's scale counts; factor 0 keeps all; bad arguments and a failed allocation are errors
+// that leave every candidate kept.
+TEST(CApi, ComplexityFilterDropsDenseAndFlatCandidates) {
+    EngineMemory memory;
+    ErrorLog log;
+    homcull_context* context = make_context(&memory, HOMCULL_ISA_BEST, &log);
+    homcull_mesh* coarse = GridMesh(1).make(context);   // 2 triangles per unit
+    homcull_mesh* fine = GridMesh(40).make(context);    // 3,200
+    homcull_mesh* flat = GridMesh(2, true).make(context);  // no surface
+    const homcull_mesh* meshes[7] = {coarse, coarse, coarse, coarse, fine, fine, flat};
+    // Column-major: the identity, and a uniform scale by 40 for the second fine one (its
+    // surface 1,600 times larger: 2 triangles per unit again).
+    std::vector<float> matrices(16 * 7, 0.0f);
+    for (int k = 0; k < 7; ++k)
+        for (int i = 0; i < 4; ++i) matrices[std::size_t(16 * k + 5 * i)] = k == 5 && i < 3 ? 40.0f : 1.0f;
+    std::uint8_t keep[7];
+    ASSERT_EQ(homcull_filter_by_complexity(context, meshes, matrices.data(), HOMCULL_COLUMN_MAJOR, 7, 256.0, keep), HOMCULL_OK)
+        << homcull_last_error();
+    EXPECT_EQ(std::vector<std::uint8_t>(keep, keep + 7), (std::vector<std::uint8_t>{1, 1, 1, 1, 0, 1, 0}));
+    {  // the scene culler's filter over the same objects keeps the same ones
+        homcull::Scene scene;
+        for (const GridMesh& g : {GridMesh(1), GridMesh(40), GridMesh(2, true)}) {
+            homcull::Mesh m;
+            for (std::size_t i = 0; i < g.positions.size(); i += 3) m.positions.emplace_back(g.positions[i], g.positions[i + 1], g.positions[i + 2]);
+            m.indices = g.indices;
+            scene.meshes.push_back(m);
+        }
+        const std::uint32_t mesh_of[7] = {0, 0, 0, 0, 1, 1, 2};
+        for (int k = 0; k < 7; ++k) {
+            homcull::Object o;
+            o.mesh = mesh_of[k];
+            o.world = glm::make_mat4(matrices.data() + 16 * k);
+            scene.objects.push_back(o);
+        }
+        scene.finalize();
+        const std::vector<std::uint32_t> kept = homcull::filter_by_complexity(scene, {0, 1, 2, 3, 4, 5, 6}, 256.0);
+        EXPECT_EQ(kept, (std::vector<std::uint32_t>{0, 1, 2, 3, 5}));
+    }
+    // Without matrices both fine meshes are dense; with a factor above 1,600 they stay.
+    ASSERT_EQ(homcull_filter_by_complexity(context, meshes, nullptr, HOMCULL_ROW_MAJOR, 7, 256.0, keep), HOMCULL_OK);
+    EXPECT_EQ(std::vector<std::uint8_t>(keep, keep + 7), (std::vector<std::uint8_t>{1, 1, 1, 1, 0, 0, 0}));
+    ASSERT_EQ(homcull_filter_by_complexity(context, meshes, nullptr, HOMCULL_ROW_MAJOR, 7, 2000.0, keep), HOMCULL_OK);
+    EXPECT_EQ(std::vector<std::uint8_t>(keep, keep + 7), (std::vector<std::uint8_t>{1, 1, 1, 1, 1, 1, 0}));
+    ASSERT_EQ(homcull_filter_by_complexity(context, meshes, nullptr, HOMCULL_COLUMN_MAJOR, 7, 0.0, keep), HOMCULL_OK);
+    EXPECT_EQ(std::vector<std::uint8_t>(keep, keep + 7), std::vector<std::uint8_t>(7, 1));
+
+    const auto all_kept_after = [&](homcull_result expected, const homcull_mesh* const* m, const float* matrix, homcull_matrix_layout layout,
+                                    double factor) {
+        std::fill(keep, keep + 7, std::uint8_t(0));
+        EXPECT_EQ(homcull_filter_by_complexity(context, m, matrix, layout, 7, factor, keep), expected);
+        EXPECT_EQ(std::vector<std::uint8_t>(keep, keep + 7), std::vector<std::uint8_t>(7, 1));
+    };
+    all_kept_after(HOMCULL_ERROR_INVALID_ARGUMENT, meshes, nullptr, HOMCULL_COLUMN_MAJOR, std::nan(""));
+    all_kept_after(HOMCULL_ERROR_INVALID_ARGUMENT, meshes, nullptr, 7, 256.0);
+    all_kept_after(HOMCULL_ERROR_INVALID_ARGUMENT, nullptr, nullptr, HOMCULL_COLUMN_MAJOR, 256.0);
+    const homcull_mesh* with_null[7] = {coarse, coarse, nullptr, coarse, fine, fine, flat};
+    all_kept_after(HOMCULL_ERROR_INVALID_ARGUMENT, with_null, nullptr, HOMCULL_COLUMN_MAJOR, 256.0);
+    matrices[16 * 3 + 2] = INFINITY;
+    all_kept_after(HOMCULL_ERROR_INVALID_ARGUMENT, meshes, matrices.data(), HOMCULL_COLUMN_MAJOR, 256.0);
+    matrices[16 * 3 + 2] = 0.0f;
+    memory.fail_at = memory.calls + 1;  // the densities' allocation
+    all_kept_after(HOMCULL_ERROR_OUT_OF_MEMORY, meshes, matrices.data(), HOMCULL_COLUMN_MAJOR, 256.0);
+    memory.fail_at = 0;
+    EXPECT_EQ(homcull_filter_by_complexity(context, meshes, nullptr, HOMCULL_COLUMN_MAJOR, 0, 256.0, nullptr), HOMCULL_OK);
+    EXPECT_EQ(homcull_filter_by_complexity(context, meshes, nullptr, HOMCULL_COLUMN_MAJOR, 7, 256.0, nullptr), HOMCULL_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(log.messages.size(), 7u);  // one per error above
+    homcull_mesh_destroy(coarse);
+    homcull_mesh_destroy(fine);
+    homcull_mesh_destroy(flat);
+    homcull_context_destroy(context);
+    EXPECT_EQ(memory.live, 0u);
 }
 
 // An answer with the samples it counted (0 for a box).

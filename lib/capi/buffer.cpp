@@ -80,13 +80,6 @@ homcull_result check_no_task_list(const homcull_buffer& b, const char* fn) {
     return capi::report(b.account.context, HOMCULL_ERROR_INVALID_OPERATION, "%s: %s", fn, kTaskListOpen);
 }
 
-bool finite_matrix(const float* m) {
-    if (!m) return true;
-    for (int i = 0; i < 16; ++i)
-        if (!std::isfinite(m[i])) return false;
-    return true;
-}
-
 // A homcull_triangles as the library's input, or an error result.
 homcull_result triangle_input(const homcull_buffer& b, const homcull_triangles* t, const float* model, const char* fn, TriangleInput& in) {
     const homcull_context* context = b.account.context;
@@ -102,7 +95,7 @@ homcull_result triangle_input(const homcull_buffer& b, const homcull_triangles* 
                             t->triangle_count, 3 * t->triangle_count, t->vertex_count);
     if (t->triangle_count >= (std::size_t(1) << 32))
         return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: at most 2^32 - 1 triangles a call", fn);
-    if (!finite_matrix(model)) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: model_matrix has a number that is not finite", fn);
+    if (!capi::finite_matrix(model)) return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: model_matrix has a number that is not finite", fn);
     in = TriangleInput{};
     in.positions = t->positions;
     in.position_components = 3;
@@ -378,7 +371,7 @@ homcull_result homcull_buffer_draw_mesh(homcull_buffer* b, const homcull_mesh* m
     if (!model_matrices && instance_count > 1)
         return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: %zu instances need their model matrices", fn, instance_count);
     for (std::size_t i = 0; model_matrices && i < instance_count; ++i)
-        if (!finite_matrix(model_matrices + 16 * i))
+        if (!capi::finite_matrix(model_matrices + 16 * i))
             return capi::report(context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: model matrix %zu has a number that is not finite", fn, i);
     ++b->draw_calls;
     if (mesh->triangle_count == 0) return HOMCULL_OK;
@@ -417,7 +410,7 @@ homcull_result homcull_buffer_test_boxes(const homcull_buffer* b, const homcull_
     all_visible(visibility, count);
     if (homcull_result r = check_frame(b, fn); r != HOMCULL_OK) return r;
     if (count > 0 && !boxes) return capi::report(b->account.context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: boxes is null", fn);
-    if (!finite_matrix(model_matrix))
+    if (!capi::finite_matrix(model_matrix))
         return capi::report(b->account.context, HOMCULL_ERROR_INVALID_ARGUMENT, "%s: model_matrix has a number that is not finite", fn);
     return capi::guarded(b->account, fn, [&]() -> homcull_result {
         const glm::dmat4 model = read_model(*b, model_matrix);

@@ -19,6 +19,13 @@ glm::dmat4 read_matrix(const float* m, homcull_matrix_layout layout) {
     return read_matrix(d, layout);
 }
 
+bool finite_matrix(const float* m) {
+    if (!m) return true;
+    for (int i = 0; i < 16; ++i)
+        if (!std::isfinite(m[i])) return false;
+    return true;
+}
+
 std::array<float, 16> float_clip_from_model(const glm::dmat4& clip_from_world, const glm::dmat4& model) {
     const glm::dmat4 m = clip_from_world * model;
     std::array<float, 16> out;

@@ -36,6 +36,9 @@ homcull_result read_view(const homcull_context* context, const homcull_view& vie
 glm::dmat4 read_matrix(const double* m, homcull_matrix_layout layout);
 glm::dmat4 read_matrix(const float* m, homcull_matrix_layout layout);
 
+// Whether every number of a model matrix is finite (null: the identity, which is).
+bool finite_matrix(const float* m);
+
 // The library's float model-to-clip matrix: clip_from_world * model, composed in double and
 // rounded once.
 std::array<float, 16> float_clip_from_model(const glm::dmat4& clip_from_world, const glm::dmat4& model);

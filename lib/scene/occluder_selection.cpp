@@ -4,9 +4,9 @@
 #include <homcull/frustum.hpp>
 #include <homcull/world_triangles.hpp>
 
+#include "common/complexity_rule.hpp"
+
 #include <algorithm>
-#include <cmath>
-#include <limits>
 
 namespace homcull {
 
@@ -33,7 +33,7 @@ namespace {
 // the inverse of its mean triangle area. Its box's surface, the first measure, rated thin
 // detailed objects that hide much (FZK-Haus's windows, 500 to 2,200 times the median per unit of
 // box surface) as dense as railings, and dropping them cost culling from outside the house.
-double triangle_density(const Scene& scene, std::uint32_t id) {
+double object_triangle_density(const Scene& scene, std::uint32_t id) {
     const Object& object = scene.objects[id];
     const Mesh& mesh = scene.meshes[object.mesh];
     std::vector<float> world;  // each vertex once, as ground truth places it
@@ -44,9 +44,7 @@ double triangle_density(const Scene& scene, std::uint32_t id) {
         const glm::dvec3 a = vertex(mesh.indices[k]), b = vertex(mesh.indices[k + 1]), c = vertex(mesh.indices[k + 2]);
         area += 0.5 * glm::length(glm::cross(b - a, c - a));
     }
-    // No area (degenerate triangles only) or a non-finite one: it hides nothing, infinitely dense.
-    if (!(area > 0.0) || !std::isfinite(area)) return std::numeric_limits<double>::infinity();
-    return double(scene.triangle_count(object)) / area;
+    return detail::triangle_density(scene.triangle_count(object), area);
 }
 
 }  // namespace
@@ -54,13 +52,12 @@ double triangle_density(const Scene& scene, std::uint32_t id) {
 std::vector<std::uint32_t> filter_by_complexity(const Scene& scene, const std::vector<std::uint32_t>& candidates, double factor) {
     if (!(factor > 0.0) || candidates.empty()) return candidates;
     std::vector<double> densities;
-    for (std::uint32_t id : candidates) densities.push_back(triangle_density(scene, id));
+    for (std::uint32_t id : candidates) densities.push_back(object_triangle_density(scene, id));
     std::vector<double> sorted = densities;
-    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
-    const double limit = factor * sorted[sorted.size() / 2];
+    const double limit = detail::complexity_limit(sorted.data(), sorted.size(), factor);
     std::vector<std::uint32_t> kept;
     for (std::size_t k = 0; k < candidates.size(); ++k)
-        if (densities[k] <= limit && std::isfinite(densities[k])) kept.push_back(candidates[k]);
+        if (detail::within_complexity(densities[k], limit)) kept.push_back(candidates[k]);
     return kept;
 }
 

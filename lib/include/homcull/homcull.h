@@ -196,6 +196,23 @@ typedef struct homcull_view {
     uint32_t reserved;              /* 0 */
 } homcull_view;
 
+/* ---- Occluder selection ------------------------------------------------------------------------ */
+
+/* Zhang's complexity filter (docs/scene-culling.md, "Occluder selection"): an occluder should
+ * hide much for few triangles, and railings, spiral stairs or finely tessellated patches cover
+ * little for their cost. For `count` candidates, candidate k being meshes[k] under the model
+ * matrix model_matrices + 16 k (in `layout`; model_matrices NULL: every one the identity),
+ * keep[k] becomes 1 when its triangles per unit of its own world surface are at most `factor`
+ * times the median of the candidates', else 0; a candidate without surface (degenerate
+ * triangles only, or a coordinate that is not finite after the matrix) is not kept. factor <= 0
+ * keeps every candidate. The scene culler's default factor is 256. Meant for load time, or when
+ * the candidates change: it reads every triangle and allocates a double per candidate. A null
+ * mesh, a matrix with a number that is not finite, or a factor that is NaN is an error (keep
+ * then all 1). */
+HOMCULL_API homcull_result homcull_filter_by_complexity(homcull_context* context, const homcull_mesh* const* meshes,
+                                                        const float* model_matrices, homcull_matrix_layout layout, size_t count,
+                                                        double factor, uint8_t* keep);
+
 /* ---- Buffers --------------------------------------------------------------------------------- */
 
 enum {
