@@ -206,9 +206,9 @@ typedef struct homcull_view {
  * times the median of the candidates', else 0; a candidate without surface (degenerate
  * triangles only, or a coordinate that is not finite after the matrix) is not kept. factor <= 0
  * keeps every candidate. The scene culler's default factor is 256. Meant for load time, or when
- * the candidates change: it reads every triangle and allocates a double per candidate. A null
- * mesh, a matrix with a number that is not finite, or a factor that is NaN is an error (keep
- * then all 1). */
+ * the candidates change: it reads every triangle and allocates two doubles per candidate. A null
+ * mesh, a matrix with a number that is not finite, an unknown layout, a factor that is NaN and
+ * running out of memory are errors (keep then all 1). */
 HOMCULL_API homcull_result homcull_filter_by_complexity(homcull_context* context, const homcull_mesh* const* meshes,
                                                         const float* model_matrices, homcull_matrix_layout layout, size_t count,
                                                         double factor, uint8_t* keep);
