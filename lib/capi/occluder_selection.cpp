@@ -8,8 +8,7 @@
 #include "common/complexity_rule.hpp"
 #include "common/float_mode.hpp"
 
-#include <glm/geometric.hpp>
-#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include <cmath>
 
@@ -29,7 +28,7 @@ double world_area(const homcull_mesh& mesh, const glm::dmat4& model) {
         for (std::uint32_t t = cluster.first_triangle; t < cluster.first_triangle + cluster.triangle_count; ++t) {
             const glm::dvec3 a = vertex(c.indices[3 * std::size_t(t)]), b = vertex(c.indices[3 * std::size_t(t) + 1]),
                              d = vertex(c.indices[3 * std::size_t(t) + 2]);
-            area += 0.5 * glm::length(glm::cross(b - a, d - a));
+            area += detail::triangle_area(a, b, d);
         }
     }
     return area;

@@ -3,12 +3,18 @@
 // filter_by_complexity), shared by the scene culler's candidates and the C interface's
 // homcull_filter_by_complexity: a candidate is kept when its triangles per unit of its own
 // surface are at most `factor` times the median over the candidates.
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 
 namespace homcull::detail {
+
+// A triangle's area, the term of a candidate's surface.
+inline double triangle_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) { return 0.5 * glm::length(glm::cross(b - a, c - a)); }
 
 // Triangles per unit of surface (the inverse of the mean triangle area). No area (degenerate
 // triangles only) or a non-finite one: it hides nothing, infinitely dense.

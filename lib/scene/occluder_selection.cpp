@@ -42,7 +42,7 @@ double object_triangle_density(const Scene& scene, std::uint32_t id) {
     double area = 0.0;
     for (std::size_t k = 0; k + 2 < mesh.indices.size(); k += 3) {
         const glm::dvec3 a = vertex(mesh.indices[k]), b = vertex(mesh.indices[k + 1]), c = vertex(mesh.indices[k + 2]);
-        area += 0.5 * glm::length(glm::cross(b - a, c - a));
+        area += detail::triangle_area(a, b, c);
     }
     return detail::triangle_density(scene.triangle_count(object), area);
 }

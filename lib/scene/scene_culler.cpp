@@ -439,12 +439,8 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
         // triangles face out counter-clockwise in world space, so its front faces are
         // counter-clockwise in the GL clip space (y up) the culler projects to.
         const Backface backface = closed_[k] ? Backface::cw : config_.backface;
-        // A batch not rendered yet takes the cross-object flags only if all its clusters may;
-        // those of drawn neighbours suit either of the two.
-        if (frame_clusters_.size() == frame_clusters_rendered_) frame_cluster_flags_ = edge_flags;
-        else if (frame_cluster_flags_ != edge_flags)
-            frame_cluster_flags_ = frame_cluster_flags_ == EdgeFlags::own_object || edge_flags == EdgeFlags::own_object ? EdgeFlags::own_object
-                                                                                                                       : EdgeFlags::drawn_neighbours;
+        // A batch not rendered yet takes the flags all its clusters may take (EdgeFlags' order).
+        frame_cluster_flags_ = frame_clusters_.size() == frame_clusters_rendered_ ? edge_flags : std::min(frame_cluster_flags_, edge_flags);
         // A cluster whose box (OccluderCluster::bounds, of its own vertices, in anchored world)
         // misses the frustum (Frame::frustum) is left out. The buffer places
         // a cluster by the screen rectangle of its box's corners, which covers part of the screen

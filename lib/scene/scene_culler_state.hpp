@@ -105,12 +105,13 @@ public:
     std::vector<std::uint32_t> frame_clusters_;   // with clusters: the drawn candidates' clusters
     std::vector<Backface> frame_cluster_backfaces_;  // each one's backface mode (closed candidates': cw)
     std::size_t frame_clusters_rendered_ = 0;     // of those, already rendered
-    // Which shared-edge flags occluders take (docs/scene-culling.md, "Shared edges").
-    // own_object: each object's own (right for any subset); across_objects: across the whole
-    // candidate set (every candidate that may meet the frustum is drawn); drawn_neighbours: across
-    // objects where the neighbour is drawn too, decided when the clusters are rendered (clusters
-    // only; triangles take their own object's).
-    enum class EdgeFlags : std::uint8_t { own_object, across_objects, drawn_neighbours };
+    // Which shared-edge flags occluders take (docs/scene-culling.md, "Shared edges"), from the
+    // fewest flags kept to the most: own_object, each object's own (right for any subset);
+    // drawn_neighbours, across objects where the neighbour is drawn too, decided when the
+    // clusters are rendered (clusters only; triangles take their own object's); across_objects,
+    // across the whole candidate set (every candidate that may meet the frustum is drawn). A
+    // batch of clusters appended with several takes the first of them in this order.
+    enum class EdgeFlags : std::uint8_t { own_object, drawn_neighbours, across_objects };
     EdgeFlags frame_cluster_flags_ = EdgeFlags::own_object;  // the flags the clusters not rendered yet all take
     std::size_t frame_cluster_triangles_waiting_ = 0;
     // Closed candidates' back faces left out and not rendered yet: they count towards
