@@ -410,12 +410,13 @@ TEST(SceneCulling, TemporalDrawsAnOccluderThatComesIntoViewAtOnce) {
     const std::vector<std::uint32_t> candidates = {near_wall, far_wall};
     SceneCullerConfig config;
     config.display = {128, 128};
+    config.strategy = CullStrategy::one_pass;
     SceneCuller one_pass(scene, candidates, config);
     config.strategy = CullStrategy::temporal;
     SceneCuller temporal(scene, candidates, config);
-    // Frame a: the near wall hides the far wall and the box. Frame b: a step to the side
-    // uncovers part of the far wall, which alone hides the box.
-    const Camera a = test::camera_down_minus_z(60.0);
+    // Frame a: the near wall hides the far wall and the box. Frame b: a step to the side (6
+    // near distances, no camera cut) uncovers part of the far wall, which alone hides the box.
+    const Camera a = test::camera_down_minus_z(60.0, 0.5);
     Camera b = a;
     b.eye = {3.0, 0.0, 0.0};
     b.target = {3.0, 0.0, -1.0};
@@ -431,6 +432,77 @@ TEST(SceneCulling, TemporalDrawsAnOccluderThatComesIntoViewAtOnce) {
     EXPECT_EQ(answers[box].visibility, Visibility::occluded) << "the far wall, hidden last frame, was not drawn";
     EXPECT_EQ(temporal.work().occluder_objects, 2u);
     EXPECT_EQ(temporal.work().renders, 2u);  // the second pass
+    EXPECT_TRUE(temporal.work().used_history);
+}
+
+// temporal works as one_pass at a camera cut: an eye that moved more than TemporalCut's step in
+// near distances, or a view that turned more than its angle, since the last frame. Not at the
+// limits themselves, nor after a step or a turn within them. From `start` the near wall hides
+// the far one: a frame with history draws the near wall alone first (and the far wall in a
+// second pass if it came into view), a cut frame draws what one_pass draws, in one render.
+TEST(SceneCulling, TemporalWorksAsOnePassAtACameraCut) {
+    Scene scene;
+    const std::uint32_t near_wall = test::add_quad(scene, "near wall", {-1, -1, -5}, {1, -1, -5}, {1, 1, -5}, {-1, 1, -5});
+    const std::uint32_t far_wall = test::add_quad(scene, "far wall", {-1.8f, -1.8f, -10}, {1.8f, -1.8f, -10}, {1.8f, 1.8f, -10},
+                                                  {-1.8f, 1.8f, -10});
+    scene.finalize();
+    SceneCullerConfig config;
+    config.display = {128, 128};
+    ASSERT_EQ(config.strategy, CullStrategy::temporal);  // the default
+    config.temporal_cut = {16.0, 20.0};
+    SceneCuller culler(scene, {near_wall, far_wall}, config);
+    config.strategy = CullStrategy::one_pass;
+    SceneCuller one_pass(scene, {near_wall, far_wall}, config);
+    const Camera start = test::camera_down_minus_z(60.0, 0.25);
+    const auto moved = [&](double dx, double turn_degrees) {
+        Camera c = start;
+        c.eye.x += dx;
+        const double t = glm::radians(turn_degrees);
+        c.target = c.eye + glm::dvec3(std::sin(t), 0.0, -std::cos(t));
+        return c;
+    };
+    std::vector<OccludeeAnswer> answers, expected;
+    culler.cull(start, answers);
+    EXPECT_FALSE(culler.work().used_history);  // the first frame
+    ASSERT_EQ(answers[far_wall].visibility, Visibility::occluded);
+    struct Step {
+        double dx, turn_degrees;
+        bool cut;
+    };
+    // Each from `start`, culled twice before it (the way back from a cut is one too): 4.0 is
+    // exactly 16 near distances of 0.25.
+    for (const Step& s : {Step{1.0, 0.0, false}, Step{4.0, 0.0, false}, Step{4.01, 0.0, true}, Step{0.0, 19.0, false},
+                          Step{0.0, 21.0, true}, Step{-5.0, 0.0, true}, Step{0.0, -45.0, true}}) {
+        culler.cull(start, answers);
+        culler.cull(start, answers);
+        ASSERT_TRUE(culler.work().used_history);
+        const Camera camera = moved(s.dx, s.turn_degrees);
+        culler.cull(camera, answers);
+        EXPECT_EQ(culler.work().used_history, !s.cut) << "step " << s.dx << ", turn " << s.turn_degrees;
+        if (!s.cut) continue;
+        one_pass.cull(camera, expected);
+        EXPECT_EQ(culler.drawn_occluders(), one_pass.drawn_occluders()) << "step " << s.dx << ", turn " << s.turn_degrees;
+        EXPECT_EQ(culler.work().renders, one_pass.work().renders) << "step " << s.dx << ", turn " << s.turn_degrees;  // no second pass
+        for (std::size_t id = 0; id < answers.size(); ++id) EXPECT_EQ(answers[id].visibility, expected[id].visibility);
+    }
+    // reset_history() makes the next frame one-pass whatever the camera.
+    culler.cull(start, answers);
+    culler.reset_history();
+    culler.cull(start, answers);
+    EXPECT_FALSE(culler.work().used_history);
+
+    // Limits out of range are errors; infinity and 180 degrees turn the cuts off.
+    config.strategy = CullStrategy::temporal;
+    for (const TemporalCut bad : {TemporalCut{-1.0, 20.0}, TemporalCut{std::nan(""), 20.0}, TemporalCut{16.0, 181.0},
+                                  TemporalCut{16.0, -1.0}, TemporalCut{16.0, std::nan("")}}) {
+        config.temporal_cut = bad;
+        EXPECT_THROW(SceneCuller(scene, {near_wall, far_wall}, config), Error);
+    }
+    config.temporal_cut = {std::numeric_limits<double>::infinity(), 180.0};
+    SceneCuller never(scene, {near_wall, far_wall}, config);
+    never.cull(start, answers);
+    never.cull(moved(-1000.0, 180.0), answers);
+    EXPECT_TRUE(never.work().used_history);
 }
 
 // A box beside the view that reaches behind the eye has its corners behind it, so the buffer's

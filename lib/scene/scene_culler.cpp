@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -120,6 +121,10 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
         throw Error("baked occluder ranking needs a visibility grid");
     if (config.occludee_parts < 0 || config.occludee_parts > 64)
         throw Error("occludee parts must be 0 to 64 per object, got " + std::to_string(config.occludee_parts));
+    if (!(config.temporal_cut.step_in_near_planes >= 0.0))
+        throw Error("a temporal camera cut's step must be at least 0 near distances, got " + std::to_string(config.temporal_cut.step_in_near_planes));
+    if (!(config.temporal_cut.turn_degrees >= 0.0 && config.temporal_cut.turn_degrees <= 180.0))
+        throw Error("a temporal camera cut's turn must be 0 to 180 degrees, got " + std::to_string(config.temporal_cut.turn_degrees));
     temporal_pool_.reserve(occluders.size());
     ranked_.reserve(occluders.size());
     rank_scratch_.reserve(occluders.size());
@@ -213,8 +218,10 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_back_faces_waiting_ = 0;
     frame_started_ = false;
 
-    // one_pass (and temporal's first frame): the candidates in the frustum. temporal: those not
-    // found occluded last frame. progressive draws as it traverses.
+    // one_pass (and temporal's first frame, or its first after a cut): the candidates in the
+    // frustum. temporal: those not found occluded last frame. progressive draws as it traverses.
+    if (config_.strategy == CullStrategy::temporal && has_history_ && camera_cut(camera)) has_history_ = false;
+    work_.used_history = config_.strategy == CullStrategy::temporal && has_history_;
     if (config_.strategy != CullStrategy::progressive) {
         select_occluders(frame);
         render_pending(frame, parallel);
@@ -226,7 +233,18 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     if (config_.strategy == CullStrategy::temporal) {
         for (std::size_t id = 0; id < answers.size(); ++id) last_visibility_[id] = answers[id].visibility;
         has_history_ = true;
+        last_eye_ = camera.eye;
+        last_direction_ = glm::normalize(camera.target - camera.eye);
     }
+}
+
+bool detail::SceneCullerState::camera_cut(const Camera& camera) const {
+    const TemporalCut& cut = config_.temporal_cut;
+    const double step = glm::length(camera.eye - last_eye_);
+    const double cos_turn = glm::dot(glm::normalize(camera.target - camera.eye), last_direction_);
+    // A turn of exactly the limit is no cut; 180 degrees is never one (cos_turn >= -1 up to rounding).
+    const bool turned = cut.turn_degrees < 180.0 && cos_turn < std::cos(glm::radians(cut.turn_degrees));
+    return step > cut.step_in_near_planes * camera.near_plane || turned;
 }
 
 // one_pass and temporal: the frame's occluders into frame_indices_. temporal keeps the

@@ -122,6 +122,9 @@ public:
     std::vector<std::uint32_t> ranked_;           // rank_occluders' choice
     std::vector<std::pair<float, std::uint32_t>> rank_scratch_, node_heap_;
     std::vector<Visibility> last_visibility_;
+    glm::dvec3 last_eye_{0.0}, last_direction_{0.0};  // the camera of last_visibility_'s frame
+    // temporal: whether this camera jumped from last frame's (SceneCullerConfig::temporal_cut).
+    bool camera_cut(const Camera& camera) const;
     std::vector<std::uint8_t> drawn_;  // per candidate k: drawn this frame (1), as its LOD (2), or not (0)
     bool has_history_ = false;
 

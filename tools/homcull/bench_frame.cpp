@@ -76,14 +76,23 @@ void run_frame_bench(const FrameBenchOptions& o) {
     SceneCuller culler(scene, resources.occluders, config);
 
     // One untimed cull per view (the scratch grows to the largest frame), then the timed rounds,
-    // the views interleaved so that the machine's load spreads over all of them alike.
+    // the views interleaved so that the machine's load spreads over all of them alike. A walk's
+    // frames follow one another and the temporal strategy keeps its history along them (from
+    // the walk's start at every round); other views are unrelated, each culled without history,
+    // so that a view's figures do not depend on the view before it.
     const std::size_t views = path.frames.size();
+    const bool consecutive = o.walk > 0;
+    const auto cull_view = [&](std::size_t v, std::vector<OccludeeAnswer>& answers) {
+        if (!consecutive || v == 0) culler.reset_history();
+        culler.cull(path.frames[v], answers, parallel);
+    };
     std::vector<ViewFigures> figures(views);
     std::vector<StageTimes> stages(views);
     std::vector<OccludeeAnswer> answers;
-    for (const Camera& camera : path.frames) culler.cull(camera, answers, parallel);
+    for (std::size_t v = 0; v < views; ++v) cull_view(v, answers);
     for (int r = 0; r < o.rounds; ++r)
         for (std::size_t v = 0; v < views; ++v) {
+            if (!consecutive || v == 0) culler.reset_history();
             const long long start = now_ns();
             culler.cull(path.frames[v], answers, parallel);
             const double frame_ms = elapsed_ms(start);
@@ -101,7 +110,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     std::vector<double> frame_medians;
     for (std::size_t v = 0; v < views; ++v) {
         const Camera& camera = path.frames[v];
-        culler.cull(camera, answers, parallel);
+        cull_view(v, answers);
         const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
         ViewFigures& f = figures[v];
         tally_answers(scene, truth, answers, camera, f.tally);

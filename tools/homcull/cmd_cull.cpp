@@ -44,9 +44,12 @@ void run_cull(const CullCommandOptions& o) {
     const double setup_ms = elapsed_ms(start);
     std::vector<OccludeeAnswer> answers;
     const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
-    // The first call also allocates the render scratch; repeats show the per-frame cost.
+    // The first call also allocates the render scratch; repeats show the per-frame cost. Each
+    // repeat forgets the one before it: the temporal strategy would otherwise draw exactly the
+    // occluders it found visible in the same view, a frame no walk or cut has.
     SceneCullTimings best;
     for (int r = 0; r < o.repeat; ++r) {
+        culler.reset_history();
         culler.cull(camera, answers, parallel);
         const SceneCullTimings& t = culler.timings();
         best = r == 0 ? t : SceneCullTimings{std::min(best.select_ms, t.select_ms), std::min(best.render_ms, t.render_ms),

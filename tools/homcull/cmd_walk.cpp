@@ -116,13 +116,14 @@ void run_walk(const WalkCommandOptions& o) {
             frames.push_back(std::move(frame));
         } else {
             fmt::print("frame {:4}: objects {} / {} in frustum / {} kept{}; occluders {} tris; {:.3f} ms (render {:.3f}, maps {:.3f}, "
-                       "tests {:.3f}){}\n",
+                       "tests {:.3f}){}{}\n",
                        k, f.objects.total, f.objects.after_frustum, f.objects.after_occlusion,
                        f.has_truth ? fmt::format(" / {} visible", f.objects.exactly_visible) : "", f.work.occluder_triangles,
                        f.ms.select_ms + f.ms.render_ms + f.ms.maps_ms + f.ms.test_ms, f.ms.render_ms, f.ms.maps_ms, f.ms.test_ms,
                        f.has_truth ? fmt::format("; false culls {}, missed {} of {} hidden", f.truth.false_culls, f.truth.missed_culls(),
                                                  f.truth.hidden_in_frustum)
-                                   : "");
+                                   : "",
+                       config.strategy == CullStrategy::temporal && !f.work.used_history ? "; no history (first frame or camera cut)" : "");
         }
         if (!o.quiet) print_progress(k + 1, path.frames.size());
     }
@@ -140,6 +141,9 @@ void run_walk(const WalkCommandOptions& o) {
     }
     for (std::size_t i = 0; i < names.size(); ++i)
         summary[names[i].first] = {{"mean", sum[i] / double(measured.size())}, {"max", most[i]}};
+    std::size_t without_history = 0;  // temporal: the first frame and the camera cuts
+    for (const WalkFrame& f : measured) without_history += config.strategy == CullStrategy::temporal && !f.work.used_history;
+    if (config.strategy == CullStrategy::temporal) summary["frames_without_history"] = without_history;
     CullingTally tally;
     for (const WalkFrame& f : measured) tally += f.truth;
     const double efficiency = tally.efficiency();
@@ -192,6 +196,8 @@ void run_walk(const WalkCommandOptions& o) {
         (void)value;
         fmt::print("{:<28}{:>14.3f}{:>14.3f}\n", name, summary[name]["mean"].get<double>(), summary[name]["max"].get<double>());
     }
+    if (config.strategy == CullStrategy::temporal)
+        fmt::print("frames without history (the first, camera cuts): {} of {}\n", without_history, measured.size());
     if (rays) {
         fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %)\n", tally.false_culls,
                    tally.robust_false_culls, tally.culled_hidden, tally.hidden_in_frustum, 100.0 * efficiency);

@@ -76,8 +76,16 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
         ->capture_default_str()->check(CLI::NonNegativeNumber);
     app.add_option("--strategy", o.strategy,
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
-                   "to back) or temporal (last frame's visible candidates plus those new in the frustum)")
+                   "to back) or temporal (last frame's visible candidates plus those new in the frustum; one-pass on the "
+                   "first frame and at a camera cut)")
         ->capture_default_str()->check(CLI::IsMember({"one-pass", "progressive", "temporal"}));
+    app.add_option("--cut-step", o.cut_step,
+                   "temporal: a frame whose eye moved more than this many near-plane distances since the last one is a camera "
+                   "cut (works as one-pass)")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
+    app.add_option("--cut-turn", o.cut_turn,
+                   "temporal: a frame whose view direction turned more than this many degrees since the last one is a camera cut")
+        ->capture_default_str()->check(CLI::Range(0.0, 180.0));
     app.add_option("--rank", o.rank, "Per-frame ranking of the candidates in the frustum under --budget: none, distance, area, or "
                                      "baked (the --grid point nearest the eye)")
         ->capture_default_str()->check(CLI::IsMember({"none", "distance", "area", "baked"}));
@@ -121,6 +129,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o) {
     c.skip_closed_back_faces = o.closed_back_faces == "skip";
     c.strategy = o.strategy == "progressive" ? CullStrategy::progressive : o.strategy == "temporal" ? CullStrategy::temporal
                                                                                                  : CullStrategy::one_pass;
+    c.temporal_cut = {o.cut_step, o.cut_turn};
     c.occluder_budget.ranking = o.rank == "distance" ? OccluderRanking::distance : o.rank == "area" ? OccluderRanking::area
                               : o.rank == "baked"  ? OccluderRanking::baked
                                                    : OccluderRanking::none;

@@ -32,7 +32,7 @@ nlohmann::json work_json(const SceneCullWork& w) {
             {"occluder_lods", w.occluder_lods},       {"renders", w.renders},
             {"nodes_tested", w.nodes_tested},         {"objects_tested", w.objects_tested},
             {"occludee_parts_tested", w.occludee_parts_tested}, {"solid_parts_tested", w.solid_parts_tested},
-            {"back_faces_skipped", w.back_faces_skipped}};
+            {"back_faces_skipped", w.back_faces_skipped}, {"used_history", w.used_history}};
 }
 
 }  // namespace homcull::cli
