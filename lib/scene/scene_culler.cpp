@@ -152,6 +152,7 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     find_closed_candidates();
     gather_lods();
     build_clusters();
+    find_triangle_neighbours();
     drawn_.assign(occluders.size(), 0);
     frame_occluders_.reserve(occluders.size());
     frame_indices_.reserve(occluders_.indices.size());
@@ -210,6 +211,7 @@ void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAn
     frame_shared_.clear();
     frame_apexes_.clear();
     frame_rendered_ = 0;  // the buffer is cleared by the frame's first render (render_frame), or by build_maps
+    frame_neighbours_.clear();
     frame_clusters_.clear();
     frame_cluster_backfaces_.clear();
     frame_clusters_rendered_ = 0;
@@ -257,7 +259,8 @@ bool detail::SceneCullerState::camera_cut(const Camera& camera) const {
 // outside a frustum plane, and so does the edge it shares, at least half a sample from every
 // sample centre, far beyond the margin's 2^-10 sample (near plane: the part of a triangle
 // before it is clipped away, and the edge with it). With a budget or temporal's choice,
-// neighbours may be missing: each object's own flags then.
+// neighbours may be missing: the flags across objects then, each kept only where the neighbour
+// is drawn too (EdgeFlags::drawn_neighbours), or, with an LOD drawn, each object's own.
 void detail::SceneCullerState::select_occluders(const Frame& frame) {
     const auto start = Clock::now();
     const std::vector<std::uint32_t>* pool = &occluder_ids_;
@@ -270,7 +273,8 @@ void detail::SceneCullerState::select_occluders(const Frame& frame) {
     rank_occluders(*scene_, *pool, *frame.camera, config_.display.aspect(), config_.occluder_budget, ranked_, rank_scratch_,
                    config_.lods);
     // Cross-object flags also need every neighbour drawn as itself, not as an LOD; where some
-    // candidates are left out, the clusters keep the flags of the edges whose neighbour is drawn.
+    // candidates are left out, the clusters and triangles keep the flags of the edges whose
+    // neighbour is drawn.
     bool any_lod = false;
     for (std::size_t i = 0; i < ranked_.size() && !any_lod; ++i) any_lod = draws_lod(ranked_[i], *frame.camera);
     const bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0 && !any_lod;
@@ -319,11 +323,7 @@ void detail::SceneCullerState::build_clusters() {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
     cluster_neighbour_first_.assign(1, 0);
-    // Which candidate each vertex of occluders_ belongs to (each object's vertices are its own).
-    std::vector<std::uint32_t> vertex_candidate(occluders_.positions.size() / 3, kNone);
-    for (std::size_t k = 0; k < occluder_ids_.size(); ++k)
-        for (std::size_t i = 3 * std::size_t(first_triangle_[k]); i < 3 * std::size_t(first_triangle_[k + 1]); ++i)
-            vertex_candidate[occluders_.indices[i]] = std::uint32_t(k);
+    const std::vector<std::uint32_t> vertex_candidate = vertex_candidates();
     std::vector<std::uint32_t> local, local_apexes;  // the candidate's indices and apexes, relative to its first vertex
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
@@ -351,6 +351,34 @@ void detail::SceneCullerState::build_clusters() {
 // cluster vertex; an apex in another object becomes a vertex of the cluster (found among its
 // vertices by position, or a copy appended), so that either set of flags names apexes among
 // the cluster's own vertices, as the render requires.
+std::vector<std::uint32_t> detail::SceneCullerState::vertex_candidates() const {
+    std::vector<std::uint32_t> vertex_candidate(occluders_.positions.size() / 3, kNone);
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k)
+        for (std::size_t i = 3 * std::size_t(first_triangle_[k]); i < 3 * std::size_t(first_triangle_[k + 1]); ++i)
+            vertex_candidate[occluders_.indices[i]] = std::uint32_t(k);
+    return vertex_candidate;
+}
+
+// Occluders drawn as triangles: each candidate's edges whose cross-object flag names an apex in
+// another candidate (for EdgeFlags::drawn_neighbours, as add_candidate_clusters lists them for
+// clusters). The LODs' vertices, after the candidates', belong to none and are never such apexes.
+void detail::SceneCullerState::find_triangle_neighbours() {
+    triangle_neighbour_first_.assign(1, 0);
+    if (config_.occluder_clusters) return;
+    const std::vector<std::uint32_t> vertex_candidate = vertex_candidates();
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+        for (std::uint32_t t = first_triangle_[k]; t < first_triangle_[k + 1]; ++t)
+            for (std::size_t e = 0; e < 3; ++e) {
+                if (!((occluders_.shared_edges[t] >> e) & 1u)) continue;
+                const std::uint32_t apex = occluders_.edge_apexes[3 * std::size_t(t) + e];
+                if (apex < vertex_candidate.size() && vertex_candidate[apex] != kNone && vertex_candidate[apex] != k)
+                    triangle_neighbours_.push_back({t, vertex_candidate[apex], std::uint8_t(1u << e)});
+            }
+        triangle_neighbour_first_.push_back(std::uint32_t(triangle_neighbours_.size()));
+    }
+    frame_neighbours_.reserve(triangle_neighbours_.size());
+}
+
 void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const OccluderClusters& part, const std::vector<std::uint32_t>& vertex_candidate) {
     const std::size_t first = first_triangle_[k];
     const auto triangle_base = std::uint32_t(clusters_.shared_edges.size());
@@ -442,7 +470,9 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
     const Camera& camera = *frame.camera;
     const std::uint32_t k = candidate_of_[id];
     const bool lod = draws_lod(id, camera);
-    const bool own = edge_flags != EdgeFlags::across_objects;  // drawn_neighbours: decided for clusters alone
+    // drawn_neighbours starts from the cross-object flags, cleared where the neighbour is not
+    // drawn when the clusters or triangles are rendered.
+    const bool own = edge_flags == EdgeFlags::own_object;
     const std::vector<std::uint32_t>& indices = lod ? lod_indices_ : occluders_.indices;
     const std::vector<std::uint8_t>& flags = lod ? lod_shared_edges_ : own ? own_shared_edges_ : occluders_.shared_edges;
     const std::vector<std::uint32_t>& apexes = lod ? lod_edge_apexes_ : own ? own_edge_apexes_ : occluders_.edge_apexes;
@@ -476,6 +506,16 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
         frame_cluster_triangles_waiting_ += last - first;
         return;
     }
+    // drawn_neighbours: this candidate's edges shared with others, in triangle order, each noted
+    // at its place in frame_shared_ as its triangle is appended.
+    const bool note_neighbours = !lod && edge_flags == EdgeFlags::drawn_neighbours;
+    std::uint32_t n = note_neighbours ? triangle_neighbour_first_[k] : 0;
+    const std::uint32_t n_end = note_neighbours ? triangle_neighbour_first_[k + 1] : 0;
+    const auto note_neighbours_of = [&](std::uint32_t t) {
+        for (; n < n_end && triangle_neighbours_[n].triangle <= t; ++n)
+            if (triangle_neighbours_[n].triangle == t)
+                frame_neighbours_.push_back({std::uint32_t(frame_shared_.size()), triangle_neighbours_[n].candidate, triangle_neighbours_[n].edge_bit});
+    };
     if (!lod && closed_[k]) {
         // The triangles facing the eye (find_closed_candidates); a triangle seen edge-on, or one
         // whose sign rounds the wrong way, may go either way: leaving it out only loses occlusion.
@@ -488,11 +528,16 @@ void detail::SceneCullerState::append_occluder(std::uint32_t id, const Frame& fr
                 ++frame_back_faces_waiting_;
                 continue;
             }
+            note_neighbours_of(t);
             frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::ptrdiff_t(t), indices.begin() + 3 * std::ptrdiff_t(t + 1));
             frame_shared_.push_back(flags[t]);
             frame_apexes_.insert(frame_apexes_.end(), apexes.begin() + 3 * std::ptrdiff_t(t), apexes.begin() + 3 * std::ptrdiff_t(t + 1));
         }
         return;
+    }
+    for (; n < n_end; ++n) {
+        const NeighbourEdge& edge = triangle_neighbours_[n];
+        frame_neighbours_.push_back({std::uint32_t(frame_shared_.size() + (edge.triangle - first)), edge.candidate, edge.edge_bit});
     }
     frame_indices_.insert(frame_indices_.end(), indices.begin() + 3 * std::size_t(first), indices.begin() + 3 * std::size_t(last));
     frame_shared_.insert(frame_shared_.end(), flags.begin() + first, flags.begin() + last);
@@ -551,11 +596,20 @@ void detail::SceneCullerState::keep_drawn_neighbours(std::size_t first_cluster, 
     for (std::size_t i = first_cluster; i < end_cluster; ++i) {
         const std::uint32_t c = frame_clusters_[i];
         for (std::uint32_t n = cluster_neighbour_first_[c]; n < cluster_neighbour_first_[c + 1]; ++n) {
-            const ClusterNeighbour& edge = cluster_neighbours_[n];
+            const NeighbourEdge& edge = cluster_neighbours_[n];
             std::uint8_t& flags = cluster_neighbour_edges_[edge.triangle];
             flags = edge.candidate != kNone && drawn_[edge.candidate] == 1 ? std::uint8_t(flags | edge.edge_bit) : std::uint8_t(flags & ~edge.edge_bit);
         }
     }
+}
+
+// The flags of the pending triangles noted in frame_neighbours_ (drawn_neighbours): an edge
+// shared with another candidate loses its flag unless that candidate is drawn as itself this
+// frame (so far), as keep_drawn_neighbours does for clusters.
+void detail::SceneCullerState::clear_undrawn_neighbours() {
+    for (const NeighbourEdge& edge : frame_neighbours_)
+        if (drawn_[edge.candidate] != 1) frame_shared_[edge.triangle] = std::uint8_t(frame_shared_[edge.triangle] & ~edge.edge_bit);
+    frame_neighbours_.clear();
 }
 
 // The clusters of frame_clusters_ and the triangles of frame_indices_ not rendered yet; the
@@ -586,6 +640,7 @@ void detail::SceneCullerState::render_pending(const Frame& frame, const Parallel
         ++work_.renders;
     }
     if (count > 0) {
+        clear_undrawn_neighbours();
         TriangleInput in = occluders_.input(frame.clip, config_.backface);
         in.indices = frame_indices_.data() + 3 * frame_rendered_;
         in.triangle_count = count;

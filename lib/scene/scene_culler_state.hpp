@@ -73,21 +73,35 @@ public:
     // copy among the cluster's vertices, after those of its own triangles and own apexes.
     std::vector<std::uint8_t> cluster_cross_shared_edges_;
     std::vector<std::uint32_t> cluster_cross_edge_apexes_;
-    // The cross-object flags' edges whose neighbour is in another candidate: cluster c's are
-    // [cluster_neighbour_first_[c], cluster_neighbour_first_[c + 1]) of cluster_neighbours_. A
-    // frame that draws some candidates (EdgeFlags::drawn_neighbours) keeps such an edge's flag in
-    // cluster_neighbour_edges_ (otherwise cluster_cross_shared_edges_) only when the neighbour
-    // is drawn too.
-    struct ClusterNeighbour {
-        std::uint32_t triangle;   // into the clustered triangles
+    // An edge of the cross-object flags whose neighbour is in another candidate.
+    struct NeighbourEdge {
+        std::uint32_t triangle;   // see each list
         std::uint32_t candidate;  // the neighbour's k
         std::uint8_t edge_bit;
     };
-    std::vector<ClusterNeighbour> cluster_neighbours_;
+    // Clusters: cluster c's such edges are [cluster_neighbour_first_[c],
+    // cluster_neighbour_first_[c + 1]) of cluster_neighbours_ (triangle: into the clustered
+    // triangles). A frame that draws some candidates (EdgeFlags::drawn_neighbours) keeps such an
+    // edge's flag in cluster_neighbour_edges_ (otherwise cluster_cross_shared_edges_) only when
+    // the neighbour is drawn too.
+    std::vector<NeighbourEdge> cluster_neighbours_;
     std::vector<std::uint32_t> cluster_neighbour_first_;
     std::vector<std::uint8_t> cluster_neighbour_edges_;
+    // Triangles (no clusters): candidate k's such edges are [triangle_neighbour_first_[k],
+    // triangle_neighbour_first_[k + 1]) of triangle_neighbours_ (triangle: into occluders_), in
+    // triangle order. A frame's triangles drawn with EdgeFlags::drawn_neighbours take the
+    // cross-object flags, and frame_neighbours_ lists their such edges (triangle: into
+    // frame_shared_) until they are rendered, when each flag whose neighbour is not drawn is
+    // cleared.
+    std::vector<NeighbourEdge> triangle_neighbours_;
+    std::vector<std::uint32_t> triangle_neighbour_first_;
+    std::vector<NeighbourEdge> frame_neighbours_;
+    // Which candidate each vertex of occluders_ belongs to (each object's vertices are its own).
+    std::vector<std::uint32_t> vertex_candidates() const;
+    void find_triangle_neighbours();
     void add_candidate_clusters(std::size_t k, const OccluderClusters& part, const std::vector<std::uint32_t>& vertex_candidate);
     void keep_drawn_neighbours(std::size_t first_cluster, std::size_t end_cluster);
+    void clear_undrawn_neighbours();
     ObjectHierarchy hierarchy_;
     OcclusionBuffer buffer_;
     OcclusionMaps maps_;
@@ -108,7 +122,7 @@ public:
     // Which shared-edge flags occluders take (docs/scene-culling.md, "Shared edges"), from the
     // fewest flags kept to the most: own_object, each object's own (right for any subset);
     // drawn_neighbours, across objects where the neighbour is drawn too, decided when the
-    // clusters are rendered (clusters only; triangles take their own object's); across_objects,
+    // clusters or triangles are rendered; across_objects,
     // across the whole candidate set (every candidate that may meet the frustum is drawn). A
     // batch of clusters appended with several takes the first of them in this order.
     enum class EdgeFlags : std::uint8_t { own_object, drawn_neighbours, across_objects };
