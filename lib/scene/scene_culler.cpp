@@ -346,11 +346,6 @@ void detail::SceneCullerState::build_clusters() {
     frame_cluster_backfaces_.reserve(clusters_.clusters.size());
 }
 
-// Candidate k's clusters (built with its own flags) appended to clusters_, each with the
-// cross-object flags of its triangles beside them. An apex the own flags already name keeps its
-// cluster vertex; an apex in another object becomes a vertex of the cluster (found among its
-// vertices by position, or a copy appended), so that either set of flags names apexes among
-// the cluster's own vertices, as the render requires.
 std::vector<std::uint32_t> detail::SceneCullerState::vertex_candidates() const {
     std::vector<std::uint32_t> vertex_candidate(occluders_.positions.size() / 3, kNone);
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k)
@@ -379,6 +374,11 @@ void detail::SceneCullerState::find_triangle_neighbours() {
     frame_neighbours_.reserve(triangle_neighbours_.size());
 }
 
+// Candidate k's clusters (built with its own flags) appended to clusters_, each with the
+// cross-object flags of its triangles beside them. An apex the own flags already name keeps its
+// cluster vertex; an apex in another object becomes a vertex of the cluster (found among its
+// vertices by position, or a copy appended), so that either set of flags names apexes among
+// the cluster's own vertices, as the render requires.
 void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const OccluderClusters& part, const std::vector<std::uint32_t>& vertex_candidate) {
     const std::size_t first = first_triangle_[k];
     const auto triangle_base = std::uint32_t(clusters_.shared_edges.size());

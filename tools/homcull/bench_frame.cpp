@@ -82,8 +82,11 @@ void run_frame_bench(const FrameBenchOptions& o) {
     // so that a view's figures do not depend on the view before it.
     const std::size_t views = path.frames.size();
     const bool consecutive = o.walk > 0;
-    const auto cull_view = [&](std::size_t v, std::vector<OccludeeAnswer>& answers) {
+    const auto forget_before = [&](std::size_t v) {
         if (!consecutive || v == 0) culler.reset_history();
+    };
+    const auto cull_view = [&](std::size_t v, std::vector<OccludeeAnswer>& answers) {
+        forget_before(v);
         culler.cull(path.frames[v], answers, parallel);
     };
     std::vector<ViewFigures> figures(views);
@@ -92,7 +95,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     for (std::size_t v = 0; v < views; ++v) cull_view(v, answers);
     for (int r = 0; r < o.rounds; ++r)
         for (std::size_t v = 0; v < views; ++v) {
-            if (!consecutive || v == 0) culler.reset_history();
+            forget_before(v);
             const long long start = now_ns();
             culler.cull(path.frames[v], answers, parallel);
             const double frame_ms = elapsed_ms(start);
