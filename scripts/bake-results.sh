@@ -47,8 +47,8 @@ for budget in ${BUDGETS:-2000 4000 10000}; do
       [ "$rank" = baked ] && grid=(--grid "$out/castle.grid.json")
       json=$out/walk.$budget.$rank.$lod.$seed.json
       echo "bake-results: budget $budget, $rank, LOD $lod, path $seed" >&2
-      "$homcull" walk --scene "$file" --path "$out/path.$seed.json" --resolution "$resolution" --rank "$rank" "${grid[@]}" \
-        --budget "$budget" --lod "$lod" --quiet --json >"$json"
+      "$homcull" walk --scene "$file" --path "$out/path.$seed.json" --resolution "$resolution" --strategy one-pass \
+        --rank "$rank" "${grid[@]}" --budget "$budget" --lod "$lod" --quiet --json >"$json"
       read -r h m f < <(jq -r '[([.frames[].hidden_in_frustum]|add), ([.frames[].missed_culls]|add), .summary.total_false_culls] | @tsv' "$json")
       hidden=$((hidden + h)); culled=$((culled + h - m)); false_culls=$((false_culls + f))
     done
