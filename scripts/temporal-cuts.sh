@@ -3,7 +3,7 @@
 # gains over one-pass as the camera moves further between frames. Each scene's generated walk
 # (`homcull path --frames FRAMES --seed 1`) is taken every K-th frame, K = 1 .. 32, so that the
 # eye steps K times as far and the view turns K times as much a frame, and culled three ways:
-# one-pass, temporal without camera cuts (--cut-step 1e30 --cut-turn 180), and temporal with
+# one-pass, temporal without camera cuts (--cut-step inf --cut-turn 180), and temporal with
 # the default cuts, the three in turn, ROUNDS times (3). Markdown on stdout: the median over the
 # rounds of each walk's mean whole frame in ms, and the frames the defaults cut.
 #   taskset -c 1 bash scripts/temporal-cuts.sh [FRAMES] [RESOLUTION]   (defaults: 960, 1280x720)
@@ -60,7 +60,7 @@ for scene in ${SCENES:-intel_castle crytek_sponza openarena_oa_thor openarena_pu
       path=$out/$scene.every$k.json
       echo "temporal-cuts: $scene, round $((r + 1)) of $rounds, K = $k" >&2
       read -r ms _ < <(walk "$path" --strategy one-pass) && ms_of[$k,one]+="$ms "
-      read -r ms _ < <(walk "$path" --strategy temporal --cut-step 1e30 --cut-turn 180) && ms_of[$k,uncut]+="$ms "
+      read -r ms _ < <(walk "$path" --strategy temporal --cut-step inf --cut-turn 180) && ms_of[$k,uncut]+="$ms "
       read -r ms cut < <(walk "$path" --strategy temporal) && ms_of[$k,cut]+="$ms " && cut_of[$k]=$cut
     done
   done

@@ -241,6 +241,20 @@ TEST(Cli, WalkReportsEveryFrameAndASummary) {
     r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --strategy twice");
     EXPECT_NE(r.exit_code, 0);
     EXPECT_MENTIONS(r.err, "--strategy");
+    // Camera cuts: limits out of range are errors that name them; inf turns the step's off, and
+    // the summary counts the frames without history (the first at least).
+    for (const char* bad : {"--cut-step -1", "--cut-step nan"}) {
+        r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --resolution 96x54 --truth off --quiet " + bad);
+        EXPECT_NE(r.exit_code, 0) << bad;
+        EXPECT_MENTIONS(r.err, "step") << bad;
+    }
+    r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --resolution 96x54 --truth off --quiet --cut-turn 181");
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_MENTIONS(r.err, "--cut-turn");
+    r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --resolution 96x54 --truth off --quiet --json "
+                "--cut-step inf --cut-turn 180");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["summary"]["frames_without_history"], 1);
     r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --resolution 96x54 --truth off --quiet");
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(r.err, "");

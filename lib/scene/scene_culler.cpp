@@ -356,7 +356,7 @@ std::vector<std::uint32_t> detail::SceneCullerState::vertex_candidates() const {
 
 // Occluders drawn as triangles: each candidate's edges whose cross-object flag names an apex in
 // another candidate (for EdgeFlags::drawn_neighbours, as add_candidate_clusters lists them for
-// clusters). The LODs' vertices, after the candidates', belong to none and are never such apexes.
+// clusters, an apex in no candidate listed with kNone, never drawn).
 void detail::SceneCullerState::find_triangle_neighbours() {
     triangle_neighbour_first_.assign(1, 0);
     if (config_.occluder_clusters) return;
@@ -366,7 +366,7 @@ void detail::SceneCullerState::find_triangle_neighbours() {
             for (std::size_t e = 0; e < 3; ++e) {
                 if (!((occluders_.shared_edges[t] >> e) & 1u)) continue;
                 const std::uint32_t apex = occluders_.edge_apexes[3 * std::size_t(t) + e];
-                if (apex < vertex_candidate.size() && vertex_candidate[apex] != kNone && vertex_candidate[apex] != k)
+                if (apex < vertex_candidate.size() && vertex_candidate[apex] != k)  // kNone: in no candidate, never drawn
                     triangle_neighbours_.push_back({t, vertex_candidate[apex], std::uint8_t(1u << e)});
             }
         triangle_neighbour_first_.push_back(std::uint32_t(triangle_neighbours_.size()));
@@ -608,7 +608,8 @@ void detail::SceneCullerState::keep_drawn_neighbours(std::size_t first_cluster, 
 // frame (so far), as keep_drawn_neighbours does for clusters.
 void detail::SceneCullerState::clear_undrawn_neighbours() {
     for (const NeighbourEdge& edge : frame_neighbours_)
-        if (drawn_[edge.candidate] != 1) frame_shared_[edge.triangle] = std::uint8_t(frame_shared_[edge.triangle] & ~edge.edge_bit);
+        if (edge.candidate == kNone || drawn_[edge.candidate] != 1)
+            frame_shared_[edge.triangle] = std::uint8_t(frame_shared_[edge.triangle] & ~edge.edge_bit);
     frame_neighbours_.clear();
 }
 

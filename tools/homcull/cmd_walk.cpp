@@ -81,6 +81,7 @@ void run_walk(const WalkCommandOptions& o) {
     const CameraPath path = read_camera_path(o.path);
     if (path.frames.empty()) throw Error("camera path " + o.path + " has no frames");
     SceneCuller culler(scene, resources.occluders, config);
+    const bool temporal = config.strategy == CullStrategy::temporal;  // its frames without history are counted
     std::unique_ptr<RayScene> rays;
     if (o.truth == "on") rays = std::make_unique<RayScene>(scene);
     TruthOptions truth_options;
@@ -123,7 +124,7 @@ void run_walk(const WalkCommandOptions& o) {
                        f.has_truth ? fmt::format("; false culls {}, missed {} of {} hidden", f.truth.false_culls, f.truth.missed_culls(),
                                                  f.truth.hidden_in_frustum)
                                    : "",
-                       config.strategy == CullStrategy::temporal && !f.work.used_history ? "; no history (first frame or camera cut)" : "");
+                       temporal && !f.work.used_history ? "; no history (first frame or camera cut)" : "");
         }
         if (!o.quiet) print_progress(k + 1, path.frames.size());
     }
@@ -142,8 +143,8 @@ void run_walk(const WalkCommandOptions& o) {
     for (std::size_t i = 0; i < names.size(); ++i)
         summary[names[i].first] = {{"mean", sum[i] / double(measured.size())}, {"max", most[i]}};
     std::size_t without_history = 0;  // temporal: the first frame and the camera cuts
-    for (const WalkFrame& f : measured) without_history += config.strategy == CullStrategy::temporal && !f.work.used_history;
-    if (config.strategy == CullStrategy::temporal) summary["frames_without_history"] = without_history;
+    for (const WalkFrame& f : measured) without_history += temporal && !f.work.used_history;
+    if (temporal) summary["frames_without_history"] = without_history;
     CullingTally tally;
     for (const WalkFrame& f : measured) tally += f.truth;
     const double efficiency = tally.efficiency();
@@ -196,7 +197,7 @@ void run_walk(const WalkCommandOptions& o) {
         (void)value;
         fmt::print("{:<28}{:>14.3f}{:>14.3f}\n", name, summary[name]["mean"].get<double>(), summary[name]["max"].get<double>());
     }
-    if (config.strategy == CullStrategy::temporal)
+    if (temporal)
         fmt::print("frames without history (the first, camera cuts): {} of {}\n", without_history, measured.size());
     if (rays) {
         fmt::print("false culls {} ({} seen by robust samples); culled {} of {} hidden objects ({:.1f} %)\n", tally.false_culls,

@@ -79,10 +79,11 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "to back) or temporal (last frame's visible candidates plus those new in the frustum; one-pass on the "
                    "first frame and at a camera cut)")
         ->capture_default_str()->check(CLI::IsMember({"one-pass", "progressive", "temporal"}));
+    // Checked by SceneCuller (at least 0, infinity allowed), whose error names the value.
     app.add_option("--cut-step", o.cut_step,
                    "temporal: a frame whose eye moved more than this many near-plane distances since the last one is a camera "
-                   "cut (works as one-pass)")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+                   "cut (works as one-pass); inf: never")
+        ->capture_default_str();
     app.add_option("--cut-turn", o.cut_turn,
                    "temporal: a frame whose view direction turned more than this many degrees since the last one is a camera cut")
         ->capture_default_str()->check(CLI::Range(0.0, 180.0));
