@@ -129,43 +129,50 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
         }
 }
 
-// SceneCuller frames allocate nothing after the first, on one thread and with a job system,
-// and a new near plane is no exception: the buffer and the maps take it in place (they were
-// rebuilt, about 15 MB at 720p). The answers with the new near plane are a fresh culler's.
-TEST(FrameAllocations, SceneCullerFramesNoneAfterTheFirstNearPlaneChangesIncluded) {
+// SceneCuller frames allocate nothing, from the first on (the culler reserves its worst frame
+// when it is made), on one thread and with a job system, drawing clusters or triangles, and a
+// new near plane is no exception: the buffer and the maps take it in place (they were rebuilt,
+// about 15 MB at 720p). Only the caller's answers vector may grow, on its first frame. The
+// answers with the new near plane are a fresh culler's.
+TEST(FrameAllocations, SceneCullerFramesNoneFromTheFirstNearPlaneChangesIncluded) {
     const test::CityStreet street;
     const std::vector<std::uint32_t> candidates = occluder_candidates(street.city, OccluderFilter::role);
-    SceneCullerConfig config;
-    config.display = {320, 180};
     Camera other = street.camera, farther = street.camera;
     other.eye += glm::dvec3(4.0, 0.5, 10.0);
     farther.near_plane = 0.35;
     const ParallelFor serial{}, job_system{&test::run_backwards, nullptr, 2};
-    for (const ParallelFor* parallel : {&serial, &job_system}) {
-        const std::string what = parallel->run ? "job system" : "serial";
-        SceneCuller culler(street.city, candidates, config);
-        std::vector<OccludeeAnswer> answers;
-        culler.cull(street.camera, answers, *parallel);  // the first frame may allocate
-        culler.cull(farther, answers, *parallel);       // and the first with each near plane
-        EXPECT_EQ(allocations_of([&] {
-                      culler.cull(other, answers, *parallel);
-                      culler.cull(farther, answers, *parallel);
-                      culler.cull(street.camera, answers, *parallel);
-                  }),
-                  0u)
-            << what;
-        culler.cull(farther, answers, *parallel);
-        SceneCuller fresh(street.city, candidates, config);
-        std::vector<OccludeeAnswer> fresh_answers;
-        fresh.cull(farther, fresh_answers, *parallel);
-        ASSERT_EQ(answers.size(), fresh_answers.size()) << what;
-        std::size_t occluded = 0;
-        for (std::size_t id = 0; id < answers.size(); ++id) {
-            EXPECT_EQ(answers[id].visibility, fresh_answers[id].visibility) << what << ", object " << id;
-            occluded += answers[id].visibility == Visibility::occluded;
-        }
-        EXPECT_GT(occluded, 10u) << what;  // the frames culled something
-    }
+    for (const CullStrategy strategy : {CullStrategy::temporal, CullStrategy::one_pass, CullStrategy::progressive})
+        for (const bool clusters : {true, false})
+            for (const ParallelFor* parallel : {&serial, &job_system}) {
+                const std::string what = std::string(parallel->run ? "job system" : "serial") + (clusters ? ", clusters" : ", triangles") +
+                                         ", strategy " + std::to_string(int(strategy));
+                SceneCullerConfig config;
+                config.display = {320, 180};
+                config.occluder_clusters = clusters;
+                config.strategy = strategy;
+                SceneCuller culler(street.city, candidates, config);
+                std::vector<OccludeeAnswer> answers(street.city.objects.size());
+                EXPECT_EQ(allocations_of([&] {
+                              culler.cull(street.camera, answers, *parallel);
+                              culler.cull(farther, answers, *parallel);
+                              culler.cull(other, answers, *parallel);
+                              culler.cull(farther, answers, *parallel);
+                              culler.cull(street.camera, answers, *parallel);
+                          }),
+                          0u)
+                    << what;
+                culler.cull(farther, answers, *parallel);
+                SceneCuller fresh(street.city, candidates, config);
+                std::vector<OccludeeAnswer> fresh_answers;
+                fresh.cull(farther, fresh_answers, *parallel);
+                ASSERT_EQ(answers.size(), fresh_answers.size()) << what;
+                std::size_t occluded = 0;
+                for (std::size_t id = 0; id < answers.size(); ++id) {
+                    EXPECT_EQ(answers[id].visibility, fresh_answers[id].visibility) << what << ", object " << id;
+                    occluded += answers[id].visibility == Visibility::occluded;
+                }
+                EXPECT_GT(occluded, 10u) << what;  // the frames culled something
+            }
 }
 
 // After OcclusionBuffer::reserve, not even the first frame allocates: every resolution within

@@ -300,6 +300,7 @@ std::size_t detail::BufferState::close_tasks() {
     const ClusterPass pass{*this};
     std::size_t room = 0;
     for (const PlacedCluster& p : placed_clusters_) room += recorded_draws_[p.draw].clusters->clusters[p.cluster].triangle_count;
+    room = std::min(room, kSetUpRoomTriangles);
     if (band_vertex_clip_.size() < bands * 4 * pass.plane()) band_vertex_clip_.resize(bands * 4 * pass.plane());
     if (band_vertex_outcode_.size() < bands * pass.plane()) band_vertex_outcode_.resize(bands * pass.plane());
     if (setup_triangles_.size() < room) setup_triangles_.resize(room);
@@ -312,13 +313,17 @@ std::size_t detail::BufferState::close_tasks() {
         return band_seconds_[a] > band_seconds_[b] || (band_seconds_[a] == band_seconds_[b] && a < b);
     });
 
+    // Each cluster's room in order while they fit (kSetUpRoomTriangles); the others are set up
+    // by every band that draws them.
     std::size_t first = 0;
     for (std::size_t k = 0; k < placed_clusters_.size(); ++k) {
         const PlacedCluster& p = placed_clusters_[k];
         ClusterSetup& s = cluster_setups_[k];
-        s.first = first, s.room = recorded_draws_[p.draw].clusters->clusters[p.cluster].triangle_count, s.count = 0;
+        const std::size_t triangles = recorded_draws_[p.draw].clusters->clusters[p.cluster].triangle_count;
+        const bool fits = first + triangles <= room;
+        s.first = first, s.room = fits ? triangles : 0, s.count = 0;
         s.stats = RasterStats{};
-        s.state.store(ClusterSetup::kNotSetUp, std::memory_order_relaxed);
+        s.state.store(fits ? ClusterSetup::kNotSetUp : ClusterSetup::kEach, std::memory_order_relaxed);
         first += s.room;
     }
     if (task_list_clears_) stats_ = RasterStats{};

@@ -273,7 +273,7 @@ void detail::BufferState::reserve(const BufferReserve& r) {
         at_least(band_vertex_outcode_, z.bands * plane);
     }
     at_least(cluster_setups_, r.max_task_list_clusters);
-    at_least(setup_triangles_, r.max_task_list_triangles);
+    at_least(setup_triangles_, std::min(r.max_task_list_triangles, kSetUpRoomTriangles));
 }
 
 void detail::BufferState::check_projection(bool orthographic, const char* caller) const {

@@ -1,5 +1,6 @@
 // SceneCuller: set-up, and a frame's occluder selection and rendering. The tests are in
 // scene_traversal.cpp.
+#include <homcull/detail/memory.hpp>
 #include <homcull/error.hpp>
 #include <homcull/scene_culler.hpp>
 
@@ -125,9 +126,9 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
         throw Error("a temporal camera cut's step must be at least 0 near distances, got " + std::to_string(config.temporal_cut.step_in_near_planes));
     if (!(config.temporal_cut.turn_degrees >= 0.0 && config.temporal_cut.turn_degrees <= 180.0))
         throw Error("a temporal camera cut's turn must be 0 to 180 degrees, got " + std::to_string(config.temporal_cut.turn_degrees));
-    temporal_pool_.reserve(occluders.size());
-    ranked_.reserve(occluders.size());
-    rank_scratch_.reserve(occluders.size());
+    detail::reserve_written(temporal_pool_, occluders.size());
+    detail::reserve_written(ranked_, occluders.size());
+    detail::reserve_written(rank_scratch_, occluders.size());
     // Where each candidate's triangles are, and their shared edges within the object alone.
     candidate_of_.assign(scene.objects.size(), kNone);
     first_triangle_.push_back(0);
@@ -153,15 +154,17 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     gather_lods();
     build_clusters();
     find_triangle_neighbours();
+    reserve_buffer();
     drawn_.assign(occluders.size(), 0);
-    frame_occluders_.reserve(occluders.size());
-    frame_indices_.reserve(occluders_.indices.size());
-    frame_shared_.reserve(occluders_.triangle_count());
-    frame_apexes_.reserve(3 * occluders_.triangle_count());
+    detail::reserve_written(frame_occluders_, occluders.size());
+    detail::reserve_written(frame_indices_, occluders_.indices.size());
+    detail::reserve_written(frame_shared_, occluders_.triangle_count());
+    detail::reserve_written(frame_apexes_, 3 * occluders_.triangle_count());
     last_visibility_.assign(scene.objects.size(), Visibility::visible);
     task_tallies_.resize(64);
-    subtrees_.reserve(hierarchy_.nodes.size());
-    next_subtrees_.reserve(hierarchy_.nodes.size());
+    detail::reserve_written(subtrees_, hierarchy_.nodes.size());
+    detail::reserve_written(next_subtrees_, hierarchy_.nodes.size());
+    detail::reserve_written(node_heap_, hierarchy_.nodes.size());  // front-to-back traversal (one thread or progressive)
     // Rounded up to whole cache lines and one line more, so that two tasks' stacks, pushed and
     // popped at every node, share no line (the vector's start need not be a line's).
     constexpr std::size_t kLineWords = 64 / sizeof(std::uint32_t);
@@ -314,6 +317,27 @@ void detail::SceneCullerState::gather_lods() {
     }
 }
 
+// The buffer's room for the largest frame this culler can draw, made now so that no cull()
+// allocates (homcull/scene_culler.hpp): every candidate's clusters in one render, on one thread
+// or as a task list with a job system; or, drawn as triangles (without clusters, and the LODs),
+// all of them, with a job system too. Grown during a frame instead, the set-up triangles of a
+// first two-thread frame drawing crytek_sponza's candidates cost 57-73 ms of page faults.
+void detail::SceneCullerState::reserve_buffer() {
+    BufferReserve r;
+    if (config_.occluder_clusters) {
+        r.max_clusters = r.max_task_list_clusters = clusters_.clusters.size();
+        for (const OccluderCluster& c : clusters_.clusters) r.max_cluster_vertices = std::max<std::size_t>(r.max_cluster_vertices, c.vertex_count);
+        r.max_task_list_draws = 1;  // each render is a list of one draw
+        r.max_task_list_triangles = clusters_.shared_edges.size();
+    }
+    if (!config_.occluder_clusters || config_.lods) {
+        r.max_triangles = occluders_.triangle_count() + lod_indices_.size() / 3;
+        r.max_vertices = occluders_.positions.size() / 3;
+        r.max_threads = 2;  // any job system: the waves' room does not depend on its threads (world positions: no row parts)
+    }
+    buffer_.reserve(r);
+}
+
 // config_.occluder_clusters: each candidate's triangles split into clusters of their own (so
 // that a frame draws the clusters of the candidates it picks), one after the other in clusters_,
 // with the flags within each object (own_shared_edges_), right whichever candidates a frame
@@ -342,8 +366,8 @@ void detail::SceneCullerState::build_clusters() {
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
     cluster_neighbour_edges_ = cluster_cross_shared_edges_;
-    frame_clusters_.reserve(clusters_.clusters.size());
-    frame_cluster_backfaces_.reserve(clusters_.clusters.size());
+    detail::reserve_written(frame_clusters_, clusters_.clusters.size());
+    detail::reserve_written(frame_cluster_backfaces_, clusters_.clusters.size());
 }
 
 std::vector<std::uint32_t> detail::SceneCullerState::vertex_candidates() const {
@@ -371,7 +395,7 @@ void detail::SceneCullerState::find_triangle_neighbours() {
             }
         triangle_neighbour_first_.push_back(std::uint32_t(triangle_neighbours_.size()));
     }
-    frame_neighbours_.reserve(triangle_neighbours_.size());
+    detail::reserve_written(frame_neighbours_, triangle_neighbours_.size());
 }
 
 // Candidate k's clusters (built with its own flags) appended to clusters_, each with the

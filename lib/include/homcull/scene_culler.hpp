@@ -3,8 +3,9 @@
 // occluders, render them into an occlusion buffer, build the maps, and test the objects
 // through a hierarchy of boxes, front to back, skipping what lies under a hidden node.
 // One SceneCuller is reused frame after frame: the buffer, the maps, the hierarchy and the
-// candidate occluders' triangles are set up once, and a frame allocates nothing once its
-// scratch has grown (the first frames), whatever the camera's near plane.
+// candidate occluders' triangles are set up once, with room (written, so faulted in) for the
+// largest frame it can draw, on one thread or through a job system; no frame allocates, the
+// first included, whatever the camera's near plane (the caller's answers vector aside).
 #include <homcull/object_hierarchy.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occluder_lod.hpp>
