@@ -487,6 +487,50 @@ TEST(ClusteredRender, TaskListsGiveTheBitsOfOneRenderPerDraw) {
     }
 }
 
+// A task list keeps at most 65,536 set-up triangles for its bands (render_bands.hpp,
+// kSetUpRoomTriangles): the clusters past them, nearest first, are set up by every band that
+// draws them. 450 small walls of 162 triangles each (72,900 in view), staggered in depth so that
+// far ones show between near ones: the task list, on threads and shuffled, gives the bits,
+// statistics and pyramid of one render on one thread.
+TEST(ClusteredRender, TaskListsPastTheSetUpPoolGiveTheBitsOfOneRender) {
+    OccluderClusters clusters;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> across(-1.0f, 1.0f);
+    for (int k = 0; k < 450; ++k) {
+        const float z = -4.0f - 0.25f * float(k % 80), x = across(rng) * 0.8f * -z, y = across(rng) * 0.5f * -z;
+        const float w = 0.04f * -z, h = 0.3f * -z;  // narrow: the ones behind show beside it
+        std::vector<glm::vec3> vertices;
+        std::vector<std::uint16_t> indices;
+        for (int j = 0; j < 10; ++j)
+            for (int i = 0; i < 10; ++i) vertices.push_back({x + w * float(i) / 9.0f, y + h * float(j) / 9.0f, z + 0.01f * float(i)});
+        for (int j = 0; j < 9; ++j)
+            for (int i = 0; i < 9; ++i) {
+                const auto v = [&](int a, int b) { return std::uint16_t(10 * b + a); };
+                indices.insert(indices.end(), {v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j), v(i + 1, j + 1), v(i, j + 1)});
+            }
+        append_cluster(clusters, vertices, indices, std::vector<std::uint8_t>(indices.size() / 3, 0));
+    }
+    ASSERT_GT(clusters.shared_edges.size(), std::size_t(1) << 16);
+    const Camera camera = test::camera_down_minus_z(90.0, 0.5);
+    const ClusteredInput draw{&clusters, clip_from_world(camera, 16.0 / 9.0), Backface::none};
+    const BufferConfig config = test::buffer_config(640, 360, 1, 0.5f, true);
+    OcclusionBuffer reference(config);
+    reference.render_frame(draw);
+    EXPECT_EQ(reference.stats().clusters_outside, 0u);
+    EXPECT_GT(reference.stats().cluster_bands_hidden, 50u);
+    EXPECT_GT(reference.stats().cluster_bands_drawn, 450u);
+    std::mt19937_64 order_rng(3);
+    const ParallelFor shuffled{test::run_shuffled, &order_rng}, threads = test::thread_jobs(2);
+    for (const ParallelFor* jobs : {&shuffled, &threads}) {
+        OcclusionBuffer buffer(config);
+        buffer.render_frame(draw, *jobs);
+        const std::string what = jobs == &shuffled ? "shuffled" : "threads";
+        EXPECT_TRUE(reference.stats() == buffer.stats()) << what;
+        EXPECT_TRUE(test::same_subtiles(reference, buffer)) << what;
+        EXPECT_TRUE(test::same_pyramid(reference, buffer)) << what;
+    }
+}
+
 // Calls out of order are errors that change nothing; a task list whose tasks did not all run
 // is an error, and the buffer then holds what ran (with its pyramid): conservative, and no row
 // of the frame before when the list clears.
