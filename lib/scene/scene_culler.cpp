@@ -331,7 +331,8 @@ void detail::SceneCullerState::reserve_buffer() {
         r.max_task_list_triangles = clusters_.shared_edges.size();
     }
     if (!config_.occluder_clusters || config_.lods) {
-        r.max_triangles = occluders_.triangle_count() + lod_indices_.size() / 3;
+        // With clusters, only the LODs go triangle by triangle.
+        r.max_triangles = (config_.occluder_clusters ? 0 : occluders_.triangle_count()) + lod_indices_.size() / 3;
         r.max_vertices = occluders_.positions.size() / 3;
         r.max_threads = 2;  // any job system: the waves' room does not depend on its threads (world positions: no row parts)
     }
