@@ -42,12 +42,10 @@ inline void prefetch_triangle(const RasterTriangle& tri) {
 // How far past a cluster being set up by another band a band looks for one to set up meanwhile
 // (clustered_render.cpp, run_band).
 constexpr std::size_t kSetUpAheadClusters = 16;
-// The most set-up triangles a task list keeps for its bands (12 MB of RasterTriangle): the
-// clusters nearest first until they fill it, the rest set up by each band that draws them
-// (ClusterSetup::kEach, the same bits). Nearest first, the later clusters are mostly hidden and
-// skipped before any set-up. Unbounded, the room for a first frame drawing every candidate of
-// crytek_sponza (132,271 triangles, 25 MB) was allocated and faulted in during the frame: 57-73
-// ms of a two-thread render that takes 1.2 ms with the room in place.
+// The most set-up triangles a task list keeps for its bands (12 MB of RasterTriangle), so that
+// a reserve for the largest draw stays bounded: the clusters nearest first until they fill it,
+// the rest set up by each band that draws them (ClusterSetup::kEach, the same bits). Nearest
+// first, the later clusters are mostly hidden and skipped before any set-up.
 constexpr std::size_t kSetUpRoomTriangles = std::size_t(1) << 16;
 // render_binned's chunks: triangles set up per task, and each chunk's room for its set-up
 // triangles (clipping at the near plane or the guard band may give a triangle more than one; a

@@ -154,12 +154,9 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     gather_lods();
     build_clusters();
     find_triangle_neighbours();
-    reserve_buffer();
+    reserve_frame_room();
     drawn_.assign(occluders.size(), 0);
     detail::reserve_written(frame_occluders_, occluders.size());
-    detail::reserve_written(frame_indices_, occluders_.indices.size());
-    detail::reserve_written(frame_shared_, occluders_.triangle_count());
-    detail::reserve_written(frame_apexes_, 3 * occluders_.triangle_count());
     last_visibility_.assign(scene.objects.size(), Visibility::visible);
     task_tallies_.resize(64);
     detail::reserve_written(subtrees_, hierarchy_.nodes.size());
@@ -317,26 +314,31 @@ void detail::SceneCullerState::gather_lods() {
     }
 }
 
-// The buffer's room for the largest frame this culler can draw, made now so that no cull()
-// allocates (homcull/scene_culler.hpp): every candidate's clusters in one render, on one thread
-// or as a task list with a job system; or, drawn as triangles (without clusters, and the LODs),
-// all of them, with a job system too. Grown during a frame instead, the set-up triangles of a
-// first two-thread frame drawing crytek_sponza's candidates cost 57-73 ms of page faults.
-void detail::SceneCullerState::reserve_buffer() {
+// The room for the largest frame this culler can draw, made now (its pages written) so that no
+// cull() allocates (homcull/scene_culler.hpp): the buffer's for every candidate's clusters in
+// one render, on one thread or as a task list with a job system, and for the triangles that go
+// triangle by triangle (every candidate's without clusters, else the LODs'), with a job system
+// too; and the frame's lists of those triangles. Grown during a frame, that room would bring its
+// page faults into the frame: tens of milliseconds for a two-thread first frame drawing every
+// candidate of a large scene.
+void detail::SceneCullerState::reserve_frame_room() {
+    const std::size_t triangles = (config_.occluder_clusters ? 0 : occluders_.triangle_count()) + lod_indices_.size() / 3;
     BufferReserve r;
     if (config_.occluder_clusters) {
         r.max_clusters = r.max_task_list_clusters = clusters_.clusters.size();
-        for (const OccluderCluster& c : clusters_.clusters) r.max_cluster_vertices = std::max<std::size_t>(r.max_cluster_vertices, c.vertex_count);
+        r.max_cluster_vertices = clusters_.max_cluster_vertices;
         r.max_task_list_draws = 1;  // each render is a list of one draw
         r.max_task_list_triangles = clusters_.shared_edges.size();
     }
-    if (!config_.occluder_clusters || config_.lods) {
-        // With clusters, only the LODs go triangle by triangle.
-        r.max_triangles = (config_.occluder_clusters ? 0 : occluders_.triangle_count()) + lod_indices_.size() / 3;
+    if (triangles > 0) {
+        r.max_triangles = triangles;
         r.max_vertices = occluders_.positions.size() / 3;
         r.max_threads = 2;  // any job system: the waves' room does not depend on its threads (world positions: no row parts)
     }
     buffer_.reserve(r);
+    detail::reserve_written(frame_indices_, 3 * triangles);
+    detail::reserve_written(frame_shared_, triangles);
+    detail::reserve_written(frame_apexes_, 3 * triangles);
 }
 
 // config_.occluder_clusters: each candidate's triangles split into clusters of their own (so

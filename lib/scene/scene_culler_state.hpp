@@ -151,7 +151,7 @@ public:
     bool draws_lod(std::uint32_t id, const Camera& camera) const;
     void gather_lods();
     void build_clusters();
-    void reserve_buffer();
+    void reserve_frame_room();
     // Triangles appended and not rendered yet (progressive draws every batch of them).
     std::size_t triangles_waiting() const {
         return frame_shared_.size() - frame_rendered_ + frame_cluster_triangles_waiting_ + frame_back_faces_waiting_;
