@@ -624,7 +624,7 @@ TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kColumns = 70, kStride = 96;
     std::vector<float> d0(kStride), d1(kStride);
     std::vector<std::uint32_t> layer(kStride);
-    int checked = 0, unhidden_seen = 0;
+    int checked = 0, unhidden_seen = 0, runs_without_unhidden = 0;
     for (const std::string& isa : available_isas()) {
         if (isa == "scalar") continue;
         const detail::OccludeeRowKernel kernel = detail::buffer_kernels(detail::isa_choice(isa)).occludee_row;
@@ -661,8 +661,11 @@ TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
             // Rows ty of a view whose row stride is 0: every row is these arrays.
             const detail::SubtileView view{d0.data(), d1.data(), layer.data(), 0, nullptr, 0, nullptr, nullptr, 0};
             std::uint32_t masks[kColumns + 16], unhidden[kColumns + 16], want_masks[kColumns], want_unhidden[kColumns];
-            kernel(view, ty, first, last, tx_begin, count, depth, masks, unhidden);
-            detail::occludee_row_reference(view, ty, first, last, tx_begin, count, depth, want_masks, want_unhidden);
+            const detail::OccludeeRowSummary summary = kernel(view, ty, first, last, tx_begin, count, depth, masks, unhidden);
+            const detail::OccludeeRowSummary want = detail::occludee_row_reference(view, ty, first, last, tx_begin, count, depth, want_masks, want_unhidden);
+            ASSERT_EQ(summary.samples, want.samples) << isa << " trial " << trial;
+            ASSERT_EQ(summary.any_unhidden, want.any_unhidden) << isa << " trial " << trial;
+            runs_without_unhidden += !want.any_unhidden;
             for (int k = 0; k < count; ++k) {
                 ASSERT_EQ(masks[k], want_masks[k]) << isa << " trial " << trial << " subtile " << k;
                 ASSERT_EQ(unhidden[k], want_unhidden[k]) << isa << " trial " << trial << " subtile " << k;
@@ -673,6 +676,7 @@ TEST(OccludeeTriangles, TheRowKernelAnswersAsItsReference) {
     }
     EXPECT_GT(checked, 1000);
     EXPECT_GT(unhidden_seen, checked / 10);  // both answers compared
+    EXPECT_GT(runs_without_unhidden, 0);      // and both summaries
 }
 
 // The per-sample depth's test of a subtile (BufferKernels::sample_depth_unhidden) gives its

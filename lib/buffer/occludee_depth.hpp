@@ -58,17 +58,32 @@ inline std::uint32_t occludee_unhidden(const SubtileView& view, int tx, int ty, 
     return c.mask ? subtile_unhidden_samples(view, tx, ty, c.mask, depth.over(tx, ty, c)) : 0u;
 }
 
+// What the row kernel tells of a run beside its masks: the covered samples of all its subtiles
+// and whether any subtile has samples the layers leave unhidden. A run without any is counted
+// at once, without a look at each subtile (on a walk, most runs of the occludee triangles:
+// they are hidden).
+struct OccludeeRowSummary {
+    std::uint32_t samples = 0;
+    bool any_unhidden = false;
+};
+
 // What the kernel computes, subtile by subtile (Highway's one-lane target runs this).
-inline void occludee_row_reference(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,
-                                   int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden) {
+inline OccludeeRowSummary occludee_row_reference(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4],
+                                                 int tx_begin, int count, const OccludeeDepth& depth, std::uint32_t* masks,
+                                                 std::uint32_t* unhidden) {
+    OccludeeRowSummary summary;
     for (int k = 0; k < count; ++k) {
         const SubtileCoverage c = subtile_coverage(first, last, tx_begin + k);
         masks[k] = c.mask;
         unhidden[k] = occludee_unhidden(view, tx_begin + k, ty, c, depth);
+        summary.samples += bit_count(c.mask);
+        summary.any_unhidden = summary.any_unhidden || unhidden[k] != 0;
     }
+    return summary;
 }
-using OccludeeRowKernel = void (*)(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,
-                                   int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden);
+using OccludeeRowKernel = OccludeeRowSummary (*)(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4],
+                                                 int tx_begin, int count, const OccludeeDepth& depth, std::uint32_t* masks,
+                                                 std::uint32_t* unhidden);
 // (A SIMD kernel: BufferKernels::occludee_row.)
 
 // Of the samples `unhidden` of subtile (tx, ty), those the per-sample depth (view.sample_depth,

@@ -61,10 +61,10 @@ HWY_INLINE hn::Vec<DF> OccludeeBound(DF df, const OccludeeDepth& depth, hn::Vec<
 }
 #endif
 
-void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin, int count,
-                 const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden) {
+OccludeeRowSummary OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], const std::int32_t last[4], int tx_begin,
+                               int count, const OccludeeDepth& depth, std::uint32_t* masks, std::uint32_t* unhidden) {
 #if HWY_TARGET == HWY_SCALAR
-    occludee_row_reference(view, ty, first, last, tx_begin, count, depth, masks, unhidden);
+    return occludee_row_reference(view, ty, first, last, tx_begin, count, depth, masks, unhidden);
 #else
     constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
     static_assert(kW == 8 && kH == 4, "a subtile's mask is 4 bytes of 8 columns");
@@ -81,6 +81,9 @@ void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], c
     const VI lane = hn::Iota(di, 0), zero = hn::Zero(di), seven = hn::Set(di, kW - 1);
     const hn::Vec<decltype(du)> byte = hn::Set(du, 0xFFu);
     const std::size_t row = std::size_t(ty) * view.stride;
+    // The summary: the masks' bits summed lane by lane (at most 64 x 32 a lane), any unhidden.
+    auto samples = hn::Zero(du);
+    auto any_shown = hn::Zero(du);
     for (int base = 0; base < count; base += lanes) {
         const auto live = hn::FirstN(di, std::size_t(count - base));
         const VI x0 = hn::ShiftLeft<3>(hn::Add(lane, hn::Set(di, tx_begin + base)));  // tx * 8
@@ -114,7 +117,13 @@ void OccludeeRow(const SubtileView& view, int ty, const std::int32_t first[4], c
         shown = hn::IfThenZeroElse(hn::RebindMask(du, hn::Lt(d_near, d0)), shown);
         hn::StoreU(mask, du, masks + base);
         hn::StoreU(shown, du, unhidden + base);
+        samples = hn::Add(samples, hn::PopulationCount(mask));
+        any_shown = hn::Or(any_shown, shown);
     }
+    OccludeeRowSummary summary;
+    summary.samples = hn::GetLane(hn::SumOfLanes(du, samples));
+    summary.any_unhidden = !hn::AllTrue(du, hn::Eq(any_shown, hn::Zero(du)));
+    return summary;
 #endif
 }
 

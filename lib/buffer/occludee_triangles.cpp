@@ -309,11 +309,16 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
             }
             continue;
         }
-        // A subtile per SIMD lane, runs of kRunSubtiles (the same masks and answers); then the
-        // counts in order, the rest of a run taken again once it needs the raised-vertex bound.
+        // A subtile per SIMD lane, runs of kRunSubtiles (the same masks and answers); a run the
+        // layers hide throughout adds its samples at once; in the others, the counts in order,
+        // the rest of the run taken again once it needs the raised-vertex bound.
         for (int run_begin = tx_begin; run_begin <= tx_end; run_begin += kRunSubtiles) {
             const int run_end = std::min(run_begin + kRunSubtiles, tx_end + 1);
-            row_kernel(view, ty, first, last, run_begin, run_end - run_begin, depth, masks, unhidden);
+            const detail::OccludeeRowSummary run = row_kernel(view, ty, first, last, run_begin, run_end - run_begin, depth, masks, unhidden);
+            if (!run.any_unhidden) {
+                counts.samples += run.samples;
+                continue;
+            }
             for (int tx = run_begin; tx < run_end; ++tx) {
                 const int k = tx - run_begin;
                 if (masks[k] == 0) continue;
