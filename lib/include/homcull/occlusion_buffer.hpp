@@ -275,9 +275,9 @@ public:
     // farther than any of its own (its nearest vertex, raised by the transform's rounding
     // bound), against the layers as test_rect's rectangles are: where the layers hide that, the
     // triangle shows nothing and its samples are not counted (the same answer, for a fraction
-    // of the work: most triangles of a hidden occludee end there), so with no tolerance the
-    // counts are partial for occluded occludees too. No allocation; thread-safe like the other
-    // tests.
+    // of the work: most triangles of a hidden occludee end there), and so are its subtile rows
+    // whose subtiles' far bounds all lie nearer than that depth; so with no tolerance the counts
+    // are partial for occluded occludees too. No allocation; thread-safe like the other tests.
     struct TriangleTest {
         Visibility visibility = Visibility::view_culled;
         std::uint64_t samples = 0;          // samples the triangles counted may cover (see above)
