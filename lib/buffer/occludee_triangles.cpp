@@ -250,8 +250,7 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
         depth.plane.has_plane = false;  // zero area after projection: its padded bounding box, at its nearest vertex
     }
 
-    const bool rows_behind_far_bound = tolerated == 0;
-    const float nearest_bound = bounding_rectangle(b).d_near;
+    const bool no_tolerance = tolerated == 0;
     bool raised_ready = false;
     const detail::OccludeeRowKernel row_kernel = kernels.occludee_row;
     const detail::SampleDepthUnhiddenKernel sample_depth_unhidden = kernels.sample_depth_unhidden;
@@ -279,14 +278,19 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
         else detail::subtile_row_intervals(has_area ? &edges : nullptr, ty, i0, i1, j0, j1, row_first, row_last);
         int tx_begin, tx_end;
         if (!detail::reached_subtile_columns(first, last, i0, i1, tx_begin, tx_end)) continue;
-        // With no tolerance, a subtile row whose reached subtiles are all farther than the
-        // layers' far bound there (d0 beyond the bounding rectangle's depth, which no bound
-        // below exceeds) shows nothing: passed over before its masks are made, its samples not
-        // counted, as for a triangle its bounding rectangle hides.
-        if (rows_behind_far_bound) {
+        // With no tolerance, a subtile row whose reached subtiles all lie farther than the
+        // layers' far bound there (d0) shows nothing: passed over before its masks are made, its
+        // samples not counted, as for a triangle its bounding rectangle hides. The triangle's
+        // bound over the row is its plane's at the corner of the row's subtiles where the plane
+        // is nearest (OccludeeDepth::over takes each subtile's at the same corner of its covered
+        // samples, and float rounding keeps the order), or its nearest vertex's without a plane.
+        if (no_tolerance) {
+            const int column = depth.plane.has_plane && depth.plane.far_is_left ? tx_end * kW + kW - 1 : tx_begin * kW;
+            const int row = depth.plane.has_plane && depth.plane.far_is_top ? ty * kH + kH - 1 : ty * kH;
+            const float row_bound = depth.plane_bound(column, row);
             const float* d0 = view.d0 + std::size_t(ty) * view.stride;
             bool behind = true;
-            for (int tx = tx_begin; tx <= tx_end && behind; ++tx) behind = d0[tx] > nearest_bound;
+            for (int tx = tx_begin; tx <= tx_end && behind; ++tx) behind = d0[tx] > row_bound;
             if (behind) continue;
         }
         // A subtile's samples into the counts: those the per-sample depth leaves unhidden too.
