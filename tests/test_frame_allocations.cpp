@@ -28,10 +28,13 @@ namespace {
 // Only the counting thread's allocations count (a full run of the binary may have other
 // threads, a job system's say, allocating at the same time).
 thread_local bool counting = false;
-std::atomic<std::size_t> allocations{0};
+std::atomic<std::size_t> allocations{0}, allocated_bytes{0};
 
 void* counted_allocation(std::size_t size, std::size_t alignment) {
-    if (counting) allocations.fetch_add(1, std::memory_order_relaxed);
+    if (counting) {
+        allocations.fetch_add(1, std::memory_order_relaxed);
+        allocated_bytes.fetch_add(size, std::memory_order_relaxed);
+    }
     if (size == 0) size = 1;
     void* p = alignment <= alignof(std::max_align_t) ? std::malloc(size) : std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
     if (!p) throw std::bad_alloc();
@@ -82,6 +85,16 @@ std::size_t allocations_of(Frame&& frame) {
     frame();
     counting = false;
     return allocations.load();
+}
+
+// The bytes the calling thread allocates in `work` (freed or not).
+template <typename Work>
+std::size_t bytes_allocated_by(Work&& work) {
+    allocated_bytes.store(0);
+    counting = true;
+    work();
+    counting = false;
+    return allocated_bytes.load();
 }
 
 TEST(FrameAllocations, NoneAfterTheFirstFrame) {
@@ -173,6 +186,47 @@ TEST(FrameAllocations, SceneCullerFramesNoneFromTheFirstNearPlaneChangesIncluded
                 }
                 EXPECT_GT(occluded, 10u) << what;  // the frames culled something
             }
+}
+
+// A culler told that no job system will come (SceneCullerConfig::job_system false) reserves
+// less when it is made (not the room of the draws a job system runs: with clusters, the task
+// list's set-up pool), still allocates nothing in a frame on its own thread, and, given a job
+// system anyway, answers as a culler that reserved for one.
+TEST(FrameAllocations, SceneCullerWithoutAJobSystemReservesLessAndAnswersTheSame) {
+    const test::CityStreet street;
+    const std::vector<std::uint32_t> candidates = occluder_candidates(street.city, OccluderFilter::role);
+    Camera other = street.camera;
+    other.eye += glm::dvec3(4.0, 0.5, 10.0);
+    const ParallelFor serial{}, job_system{&test::run_backwards, nullptr, 2};
+    for (const bool clusters : {true, false}) {
+        const std::string what = clusters ? "clusters" : "triangles";
+        SceneCullerConfig reserving;
+        reserving.display = {320, 180};
+        reserving.occluder_clusters = clusters;
+        SceneCullerConfig light = reserving;
+        light.job_system = false;
+        const std::size_t reserving_bytes = bytes_allocated_by([&] { const SceneCuller c(street.city, candidates, reserving); });
+        const std::size_t light_bytes = bytes_allocated_by([&] { const SceneCuller c(street.city, candidates, light); });
+        EXPECT_LT(light_bytes, reserving_bytes) << what;
+        SceneCuller with_room(street.city, candidates, reserving), without_room(street.city, candidates, light);
+        std::vector<OccludeeAnswer> answers(street.city.objects.size()), light_answers(street.city.objects.size());
+        EXPECT_EQ(allocations_of([&] {
+                      without_room.cull(street.camera, light_answers, serial);
+                      without_room.cull(other, light_answers, serial);
+                  }),
+                  0u)
+            << what;
+        std::size_t occluded = 0;
+        for (const Camera& camera : {street.camera, other, street.camera}) {
+            with_room.cull(camera, answers, job_system);
+            without_room.cull(camera, light_answers, job_system);
+            for (std::size_t id = 0; id < answers.size(); ++id) {
+                EXPECT_EQ(answers[id].visibility, light_answers[id].visibility) << what << ", object " << id;
+                occluded += answers[id].visibility == Visibility::occluded;
+            }
+        }
+        EXPECT_GT(occluded, 10u) << what;  // the frames culled something
+    }
 }
 
 // After OcclusionBuffer::reserve, not even the first frame allocates: every resolution within

@@ -318,22 +318,27 @@ void detail::SceneCullerState::gather_lods() {
 // cull() allocates (homcull/scene_culler.hpp): the buffer's for every candidate's clusters in
 // one render, on one thread or as a task list with a job system, and for the triangles that go
 // triangle by triangle (every candidate's without clusters, else the LODs'), with a job system
-// too; and the frame's lists of those triangles. Grown during a frame, that room would bring its
+// too (either only when config_.job_system says one may come); and the frame's lists of those
+// triangles. Grown during a frame, that room would bring its
 // page faults into the frame: tens of milliseconds for a two-thread first frame drawing every
 // candidate of a large scene.
 void detail::SceneCullerState::reserve_frame_room() {
     const std::size_t triangles = (config_.occluder_clusters ? 0 : occluders_.triangle_count()) + lod_indices_.size() / 3;
     BufferReserve r;
     if (config_.occluder_clusters) {
-        r.max_clusters = r.max_task_list_clusters = clusters_.clusters.size();
+        r.max_clusters = clusters_.clusters.size();
         r.max_cluster_vertices = clusters_.max_cluster_vertices;
-        r.max_task_list_draws = 1;  // each render is a list of one draw
-        r.max_task_list_triangles = clusters_.shared_edges.size();
+        if (config_.job_system) {
+            r.max_task_list_clusters = clusters_.clusters.size();
+            r.max_task_list_draws = 1;  // each render is a list of one draw
+            r.max_task_list_triangles = clusters_.shared_edges.size();
+        }
     }
     if (triangles > 0) {
         r.max_triangles = triangles;
         r.max_vertices = occluders_.positions.size() / 3;
-        r.max_threads = 2;  // any job system: the waves' room does not depend on its threads (world positions: no row parts)
+        // Any job system: the waves' room does not depend on its threads (world positions: no row parts).
+        r.max_threads = config_.job_system ? 2 : 0;
     }
     buffer_.reserve(r);
     detail::reserve_written(frame_indices_, 3 * triangles);

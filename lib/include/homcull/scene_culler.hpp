@@ -126,6 +126,13 @@ struct SceneCullerConfig {
     // tenths of a second on the shared scenes, which frames culled faster win back over a few
     // hundred frames.
     bool occluder_clusters = true;
+    // Whether cull() may be given a job system (ParallelFor::run). The culler then reserves,
+    // when it is made, the room the draws a job system runs take (with clusters, the task
+    // list's set-up pool: up to 65,536 triangles' worth, about 12 MB), so that no frame
+    // allocates, the first included. A caller that culls on its own thread only can leave it
+    // out: a cull given a job system anyway answers the same, but grows that room in its first
+    // frames.
+    bool job_system = true;
 };
 
 // The shape `automatic` stands for with this configuration.
