@@ -60,8 +60,8 @@ inline std::uint32_t occludee_unhidden(const SubtileView& view, int tx, int ty, 
 
 // What the row kernel tells of a run beside its masks: the covered samples of all its subtiles
 // and whether any subtile has samples the layers leave unhidden. A run without any is counted
-// at once, without a look at each subtile (on a walk, most runs of the occludee triangles:
-// they are hidden).
+// at once, without a look at each subtile: most runs, as most of the triangles tested row by
+// row are hidden (about two thirds of them on oa_thor's walk).
 struct OccludeeRowSummary {
     std::uint32_t samples = 0;
     bool any_unhidden = false;

@@ -319,9 +319,8 @@ void detail::SceneCullerState::gather_lods() {
 // one render, on one thread or as a task list with a job system, and for the triangles that go
 // triangle by triangle (every candidate's without clusters, else the LODs'), with a job system
 // too (either only when config_.job_system says one may come); and the frame's lists of those
-// triangles. Grown during a frame, that room would bring its
-// page faults into the frame: tens of milliseconds for a two-thread first frame drawing every
-// candidate of a large scene.
+// triangles. Grown during a frame, that room would bring its page faults into the frame: tens of
+// milliseconds for a two-thread first frame drawing every candidate of a large scene.
 void detail::SceneCullerState::reserve_frame_room() {
     const std::size_t triangles = (config_.occluder_clusters ? 0 : occluders_.triangle_count()) + lod_indices_.size() / 3;
     BufferReserve r;
