@@ -77,24 +77,22 @@ void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::f
 namespace homcull {
 namespace {
 
-// The allocations `frame` makes.
-template <typename Frame>
-std::size_t allocations_of(Frame&& frame) {
-    allocations.store(0);
-    counting = true;
-    frame();
-    counting = false;
-    return allocations.load();
-}
-
-// The bytes the calling thread allocates in `work` (freed or not).
+// The allocations the calling thread makes in `work`, and their bytes (freed or not).
+struct Allocated {
+    std::size_t count = 0, bytes = 0;
+};
 template <typename Work>
-std::size_t bytes_allocated_by(Work&& work) {
+Allocated allocated_in(Work&& work) {
+    allocations.store(0);
     allocated_bytes.store(0);
     counting = true;
     work();
     counting = false;
-    return allocated_bytes.load();
+    return {allocations.load(), allocated_bytes.load()};
+}
+template <typename Frame>
+std::size_t allocations_of(Frame&& frame) {
+    return allocated_in(frame).count;
 }
 
 TEST(FrameAllocations, NoneAfterTheFirstFrame) {
@@ -205,8 +203,8 @@ TEST(FrameAllocations, SceneCullerWithoutAJobSystemReservesLessAndAnswersTheSame
         reserving.occluder_clusters = clusters;
         SceneCullerConfig light = reserving;
         light.job_system = false;
-        const std::size_t reserving_bytes = bytes_allocated_by([&] { const SceneCuller c(street.city, candidates, reserving); });
-        const std::size_t light_bytes = bytes_allocated_by([&] { const SceneCuller c(street.city, candidates, light); });
+        const std::size_t reserving_bytes = allocated_in([&] { const SceneCuller c(street.city, candidates, reserving); }).bytes;
+        const std::size_t light_bytes = allocated_in([&] { const SceneCuller c(street.city, candidates, light); }).bytes;
         EXPECT_LT(light_bytes, reserving_bytes) << what;
         SceneCuller with_room(street.city, candidates, reserving), without_room(street.city, candidates, light);
         std::vector<OccludeeAnswer> answers(street.city.objects.size()), light_answers(street.city.objects.size());
