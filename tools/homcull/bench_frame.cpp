@@ -10,7 +10,6 @@
 #include <homcull/error.hpp>
 #include <homcull/io/camera_path.hpp>
 #include <homcull/scene_culler.hpp>
-#include <homcull/tbb_parallel_for.hpp>
 #include <homcull/truth/culling_accuracy.hpp>
 #include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/ray_scene.hpp>
@@ -66,7 +65,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     if (o.scaling) check_scaling_threads(o.threads);
     select_isa(o.isa);
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
-    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+    const ParallelFor parallel = command_job_system(o.threads);
     SceneCullerConfig config = scene_culler_config(o.cull);
     const Scene scene = load_chosen_scene(SceneChoice{o.scene, 0});
     const RayScene rays(scene);

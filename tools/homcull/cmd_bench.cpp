@@ -14,7 +14,6 @@
 #include <homcull/io/workload_s1.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
-#include <homcull/tbb_parallel_for.hpp>
 #include <homcull/world_triangles.hpp>
 
 #include <fmt/core.h>
@@ -186,7 +185,7 @@ void run_bench(const BenchOptions& o) {
     select_isa(o.isa);  // checks the name; "best" names the best one in the JSON
     // One thread: the library's serial path. More: TBB limited to that many threads.
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
-    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+    const ParallelFor parallel = command_job_system(o.threads);
     const Resolution res = parse_resolution(o.resolution.empty() ? "1920x1080" : o.resolution);
     BufferConfig config;
     config.width = res.width;

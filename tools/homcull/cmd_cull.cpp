@@ -6,7 +6,6 @@
 #include "options.hpp"
 
 #include <homcull/io/scene_io.hpp>
-#include <homcull/tbb_parallel_for.hpp>
 #include <homcull/truth/culling_accuracy.hpp>
 #include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/ray_scene.hpp>
@@ -44,9 +43,8 @@ void run_cull(const CullCommandOptions& o) {
     SceneCuller culler(scene, occluders, config);
     const double setup_ms = elapsed_ms(start);
     std::vector<OccludeeAnswer> answers;
-    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
-    // The first call also allocates the render scratch; repeats show the per-frame cost. Each
-    // repeat forgets the one before it: the temporal strategy would otherwise draw exactly the
+    const ParallelFor parallel = command_job_system(o.threads);
+    // Each repeat forgets the one before it: the temporal strategy would otherwise draw exactly the
     // occluders it found visible in the same view, a frame no walk or cut has.
     SceneCullTimings best;
     for (int r = 0; r < o.repeat; ++r) {

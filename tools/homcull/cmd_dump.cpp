@@ -8,7 +8,6 @@
 
 #include <homcull/error.hpp>
 #include <homcull/io/scene_io.hpp>
-#include <homcull/tbb_parallel_for.hpp>
 
 #include <fmt/core.h>
 
@@ -33,7 +32,7 @@ void run_dump(const DumpCommandOptions& o) {
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     SceneCuller culler(scene, resources.occluders, config);
     std::vector<OccludeeAnswer> answers;
-    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
+    const ParallelFor parallel = command_job_system(o.threads);
     culler.cull(camera, answers, parallel);
     fmt::print("scene      {} ({} objects); depth {}\n", scene.source, scene.objects.size(), o.cull.depth);
     const RayScene rays(scene);

@@ -11,7 +11,6 @@
 #include <homcull/error.hpp>
 #include <homcull/io/camera_path.hpp>
 #include <homcull/io/scene_io.hpp>
-#include <homcull/tbb_parallel_for.hpp>
 #include <homcull/truth/walkthrough.hpp>
 
 #include <fmt/core.h>
@@ -87,10 +86,7 @@ void run_walk(const WalkCommandOptions& o) {
     if (o.truth == "on") rays = std::make_unique<RayScene>(scene);
     TruthOptions truth_options;
     truth_options.resolution = config.display;
-    const ParallelFor parallel = o.threads > 1 ? tbb_parallel_for() : ParallelFor{};
-    // TBB starts its worker threads at its first parallel loop: started here, so that frame 0
-    // does not count their start (an engine's job system has its threads already).
-    if (parallel.run) parallel.run(parallel.user, 64, [](void*, std::size_t) {}, nullptr);
+    const ParallelFor parallel = command_job_system(o.threads);
 
     nlohmann::json frames = nlohmann::json::array();
     std::vector<WalkFrame> measured;

@@ -4,6 +4,7 @@
 #include <homcull/io/camera_path.hpp>
 #include <homcull/io/scene_io.hpp>
 #include <homcull/soup_subdivision.hpp>
+#include <homcull/tbb_parallel_for.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -119,6 +120,13 @@ double elapsed_ms(long long start_ns) { return double(now_ns() - start_ns) * 1e-
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+ParallelFor command_job_system(int threads) {
+    if (threads <= 1) return {};
+    const ParallelFor parallel = tbb_parallel_for();
+    parallel.run(parallel.user, 64, [](void*, std::size_t) {}, nullptr);
+    return parallel;
 }
 
 }  // namespace homcull::cli

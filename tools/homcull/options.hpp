@@ -2,6 +2,7 @@
 // Options several subcommands share: the scene, the camera, the display resolution.
 #include <homcull/camera.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
 #include <homcull/scene.hpp>
 
 #include <CLI/CLI.hpp>
@@ -53,5 +54,10 @@ double elapsed_ms(long long start_ns);
 long long now_ns();
 // The median of timings (the mean of the middle two for an even count; 0 for none).
 double median(std::vector<double> v);
+
+// The job system of a command's --threads: TBB's for more than one thread, its worker threads
+// started now, so that a command's first cull or render does not count their start (an engine's
+// job system has its threads already); for one, the calling thread.
+ParallelFor command_job_system(int threads);
 
 }  // namespace homcull::cli
