@@ -148,9 +148,12 @@ nlohmann::json measure_thread_scaling(const Scene& scene, const std::vector<std:
                                       const CameraPath& views, int rounds, int threads, const ParallelFor& parallel) {
     check_scaling_threads(threads);
     if (!parallel.run) throw Error("bench --scaling: no job system to run the threads");
-    SceneCuller one(scene, occluders, config), many(scene, occluders, config);
+    // The one-thread culler and the copies run on one thread each, as cull --threads 1 does.
+    SceneCullerConfig serial = config, threaded = config;
+    serial.job_system = false, threaded.job_system = true;
+    SceneCuller one(scene, occluders, serial), many(scene, occluders, threaded);
     std::vector<std::unique_ptr<SceneCuller>> copies;
-    for (int k = 0; k < threads; ++k) copies.push_back(std::make_unique<SceneCuller>(scene, occluders, config));
+    for (int k = 0; k < threads; ++k) copies.push_back(std::make_unique<SceneCuller>(scene, occluders, serial));
 
     const std::size_t count = views.frames.size();
     std::vector<std::vector<double>> t_one(count), t_many(count), t_copies(count);
