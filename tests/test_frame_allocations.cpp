@@ -7,6 +7,7 @@
 #include <homcull/generate.hpp>
 #include <homcull/homcull.h>
 #include <homcull/occluder_clusters.hpp>
+#include <homcull/occluder_lod.hpp>
 #include <homcull/occluder_selection.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/scene_culler.hpp>
@@ -225,6 +226,52 @@ TEST(FrameAllocations, SceneCullerWithoutAJobSystemReservesLessAndAnswersTheSame
         }
         EXPECT_GT(occluded, 10u) << what;  // the frames culled something
     }
+}
+
+// Occluders drawn with their LODs (SceneCullerConfig::lods) allocate nothing in a frame either,
+// every strategy, clusters or triangles, on one thread and with a job system. Each LOD here is
+// its mesh itself (the path is the same; what makes a real LOD is homcull::truth's build).
+TEST(FrameAllocations, SceneCullerFramesWithLodsNone) {
+    const test::CityStreet street;
+    const std::vector<std::uint32_t> candidates = occluder_candidates(street.city, OccluderFilter::role);
+    OccluderLods lods;
+    lods.lod_of_mesh.assign(street.city.meshes.size(), -1);
+    lods.status_of_mesh.assign(street.city.meshes.size(), LodStatus::not_requested);
+    lods.built_for_object.assign(street.city.objects.size(), 0);
+    for (const std::uint32_t id : candidates) {
+        const std::uint32_t mesh = street.city.objects[id].mesh;
+        lods.built_for_object[id] = 1;
+        if (lods.lod_of_mesh[mesh] >= 0) continue;
+        lods.lod_of_mesh[mesh] = std::int32_t(lods.lods.size());
+        lods.status_of_mesh[mesh] = LodStatus::built;
+        lods.lods.push_back(OccluderLod{street.city.meshes[mesh], mesh, 0, 1, 0.0f});
+    }
+    Camera other = street.camera;
+    other.eye += glm::dvec3(4.0, 0.5, 10.0);
+    const ParallelFor serial{}, job_system{&test::run_backwards, nullptr, 2};
+    for (const CullStrategy strategy : {CullStrategy::temporal, CullStrategy::one_pass, CullStrategy::progressive})
+        for (const bool clusters : {true, false})
+            for (const ParallelFor* parallel : {&serial, &job_system}) {
+                const std::string what = std::string(parallel->run ? "job system" : "serial") + (clusters ? ", clusters" : ", triangles") +
+                                         ", strategy " + std::to_string(int(strategy));
+                SceneCullerConfig config;
+                config.display = {320, 180};
+                config.occluder_clusters = clusters;
+                config.strategy = strategy;
+                config.lods = &lods;
+                SceneCuller culler(street.city, candidates, config);
+                std::vector<OccludeeAnswer> answers(street.city.objects.size());
+                std::size_t drawn_with_lod = 0;
+                EXPECT_EQ(allocations_of([&] {
+                              for (const Camera& camera : {street.camera, other, street.camera}) {
+                                  culler.cull(camera, answers, *parallel);
+                                  drawn_with_lod += culler.work().occluder_lods;
+                              }
+                          }),
+                          0u)
+                    << what;
+                EXPECT_GT(drawn_with_lod, 0u) << what;  // the frames drew LODs
+            }
 }
 
 // After OcclusionBuffer::reserve, not even the first frame allocates: every resolution within
