@@ -141,6 +141,24 @@ TEST(FrameAllocations, NoneAfterTheFirstFrame) {
         }
 }
 
+// check(config, job system, what) for a 320x180 culler of every strategy, drawing clusters or
+// triangles, on one thread and through a job system.
+template <typename Check>
+void for_each_frame_setup(Check&& check) {
+    const ParallelFor serial{}, job_system{&test::run_backwards, nullptr, 2};
+    for (const CullStrategy strategy : {CullStrategy::temporal, CullStrategy::one_pass, CullStrategy::progressive})
+        for (const bool clusters : {true, false})
+            for (const ParallelFor* parallel : {&serial, &job_system}) {
+                SceneCullerConfig config;
+                config.display = {320, 180};
+                config.occluder_clusters = clusters;
+                config.strategy = strategy;
+                check(config, *parallel,
+                      std::string(parallel->run ? "job system" : "serial") + (clusters ? ", clusters" : ", triangles") + ", strategy " +
+                          std::to_string(int(strategy)));
+            }
+}
+
 // SceneCuller frames allocate nothing, from the first on (the culler reserves its worst frame
 // when it is made), on one thread and with a job system, drawing clusters or triangles, and a
 // new near plane is no exception: the buffer and the maps take it in place (they were rebuilt,
@@ -152,39 +170,30 @@ TEST(FrameAllocations, SceneCullerFramesNoneFromTheFirstNearPlaneChangesIncluded
     Camera other = street.camera, farther = street.camera;
     other.eye += glm::dvec3(4.0, 0.5, 10.0);
     farther.near_plane = 0.35;
-    const ParallelFor serial{}, job_system{&test::run_backwards, nullptr, 2};
-    for (const CullStrategy strategy : {CullStrategy::temporal, CullStrategy::one_pass, CullStrategy::progressive})
-        for (const bool clusters : {true, false})
-            for (const ParallelFor* parallel : {&serial, &job_system}) {
-                const std::string what = std::string(parallel->run ? "job system" : "serial") + (clusters ? ", clusters" : ", triangles") +
-                                         ", strategy " + std::to_string(int(strategy));
-                SceneCullerConfig config;
-                config.display = {320, 180};
-                config.occluder_clusters = clusters;
-                config.strategy = strategy;
-                SceneCuller culler(street.city, candidates, config);
-                std::vector<OccludeeAnswer> answers(street.city.objects.size());
-                EXPECT_EQ(allocations_of([&] {
-                              culler.cull(street.camera, answers, *parallel);
-                              culler.cull(farther, answers, *parallel);
-                              culler.cull(other, answers, *parallel);
-                              culler.cull(farther, answers, *parallel);
-                              culler.cull(street.camera, answers, *parallel);
-                          }),
-                          0u)
-                    << what;
-                culler.cull(farther, answers, *parallel);
-                SceneCuller fresh(street.city, candidates, config);
-                std::vector<OccludeeAnswer> fresh_answers;
-                fresh.cull(farther, fresh_answers, *parallel);
-                ASSERT_EQ(answers.size(), fresh_answers.size()) << what;
-                std::size_t occluded = 0;
-                for (std::size_t id = 0; id < answers.size(); ++id) {
-                    EXPECT_EQ(answers[id].visibility, fresh_answers[id].visibility) << what << ", object " << id;
-                    occluded += answers[id].visibility == Visibility::occluded;
-                }
-                EXPECT_GT(occluded, 10u) << what;  // the frames culled something
-            }
+    for_each_frame_setup([&](const SceneCullerConfig& config, const ParallelFor& parallel, const std::string& what) {
+        SceneCuller culler(street.city, candidates, config);
+        std::vector<OccludeeAnswer> answers(street.city.objects.size());
+        EXPECT_EQ(allocations_of([&] {
+                      culler.cull(street.camera, answers, parallel);
+                      culler.cull(farther, answers, parallel);
+                      culler.cull(other, answers, parallel);
+                      culler.cull(farther, answers, parallel);
+                      culler.cull(street.camera, answers, parallel);
+                  }),
+                  0u)
+            << what;
+        culler.cull(farther, answers, parallel);
+        SceneCuller fresh(street.city, candidates, config);
+        std::vector<OccludeeAnswer> fresh_answers;
+        fresh.cull(farther, fresh_answers, parallel);
+        ASSERT_EQ(answers.size(), fresh_answers.size()) << what;
+        std::size_t occluded = 0;
+        for (std::size_t id = 0; id < answers.size(); ++id) {
+            EXPECT_EQ(answers[id].visibility, fresh_answers[id].visibility) << what << ", object " << id;
+            occluded += answers[id].visibility == Visibility::occluded;
+        }
+        EXPECT_GT(occluded, 10u) << what;  // the frames culled something
+    });
 }
 
 // A culler told that no job system will come (SceneCullerConfig::job_system false) reserves
@@ -248,30 +257,21 @@ TEST(FrameAllocations, SceneCullerFramesWithLodsNone) {
     }
     Camera other = street.camera;
     other.eye += glm::dvec3(4.0, 0.5, 10.0);
-    const ParallelFor serial{}, job_system{&test::run_backwards, nullptr, 2};
-    for (const CullStrategy strategy : {CullStrategy::temporal, CullStrategy::one_pass, CullStrategy::progressive})
-        for (const bool clusters : {true, false})
-            for (const ParallelFor* parallel : {&serial, &job_system}) {
-                const std::string what = std::string(parallel->run ? "job system" : "serial") + (clusters ? ", clusters" : ", triangles") +
-                                         ", strategy " + std::to_string(int(strategy));
-                SceneCullerConfig config;
-                config.display = {320, 180};
-                config.occluder_clusters = clusters;
-                config.strategy = strategy;
-                config.lods = &lods;
-                SceneCuller culler(street.city, candidates, config);
-                std::vector<OccludeeAnswer> answers(street.city.objects.size());
-                std::size_t drawn_with_lod = 0;
-                EXPECT_EQ(allocations_of([&] {
-                              for (const Camera& camera : {street.camera, other, street.camera}) {
-                                  culler.cull(camera, answers, *parallel);
-                                  drawn_with_lod += culler.work().occluder_lods;
-                              }
-                          }),
-                          0u)
-                    << what;
-                EXPECT_GT(drawn_with_lod, 0u) << what;  // the frames drew LODs
-            }
+    for_each_frame_setup([&](SceneCullerConfig config, const ParallelFor& parallel, const std::string& what) {
+        config.lods = &lods;
+        SceneCuller culler(street.city, candidates, config);
+        std::vector<OccludeeAnswer> answers(street.city.objects.size());
+        std::size_t drawn_with_lod = 0;
+        EXPECT_EQ(allocations_of([&] {
+                      for (const Camera& camera : {street.camera, other, street.camera}) {
+                          culler.cull(camera, answers, parallel);
+                          drawn_with_lod += culler.work().occluder_lods;
+                      }
+                  }),
+                  0u)
+            << what;
+        EXPECT_GT(drawn_with_lod, 0u) << what;  // the frames drew LODs
+    });
 }
 
 // After OcclusionBuffer::reserve, not even the first frame allocates: every resolution within
