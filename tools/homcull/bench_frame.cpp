@@ -66,8 +66,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     select_isa(o.isa);
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
     const ParallelFor parallel = command_job_system(o.threads);
-    SceneCullerConfig config = scene_culler_config(o.cull);
-    config.job_system = o.threads > 1;  // on the calling thread alone: no room reserved for a job system
+    SceneCullerConfig config = scene_culler_config(o.cull, o.threads);
     const Scene scene = load_chosen_scene(SceneChoice{o.scene, 0});
     const RayScene rays(scene);
     const CameraPath path = frame_bench_views(o, rays, scene);

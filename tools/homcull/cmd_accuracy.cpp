@@ -30,7 +30,7 @@ namespace {
 
 template <class Options>
 void run_scene_accuracy(const Options& o) {
-    SceneCullerConfig config = scene_culler_config(o.cull);
+    SceneCullerConfig config = scene_culler_config(o.cull, 1);  // its views are culled on this thread
     const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const RayScene rays(scene);

@@ -31,8 +31,7 @@ struct CullCommandOptions {
 void run_cull(const CullCommandOptions& o) {
     select_isa(o.isa);
     const Camera camera = resolve_camera(o.camera);
-    SceneCullerConfig config = scene_culler_config(o.cull);
-    config.job_system = o.threads > 1;  // on the calling thread alone: no room reserved for a job system
+    SceneCullerConfig config = scene_culler_config(o.cull, o.threads);
     if (!o.dump.empty()) prepare_dump_folder(o.dump);
     long long start = now_ns();
     const Scene scene = load_chosen_scene(o.scene);

@@ -26,8 +26,7 @@ struct DumpCommandOptions {
 
 void run_dump(const DumpCommandOptions& o) {
     const Camera camera = resolve_camera(o.camera);
-    SceneCullerConfig config = scene_culler_config(o.cull);
-    config.job_system = o.threads > 1;  // on the calling thread alone: no room reserved for a job system
+    SceneCullerConfig config = scene_culler_config(o.cull, o.threads);
     prepare_dump_folder(o.out);  // fail on the folder before spending time on the scene
     const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);

@@ -73,8 +73,7 @@ void print_progress(std::size_t done, std::size_t total) {
 
 void run_walk(const WalkCommandOptions& o) {
     select_isa(o.isa);
-    SceneCullerConfig config = scene_culler_config(o.cull);
-    config.job_system = o.threads > 1;  // on the calling thread alone: no room reserved for a job system
+    SceneCullerConfig config = scene_culler_config(o.cull, o.threads);
     if (!o.dump.empty()) prepare_dump_folder(o.dump);
     const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);

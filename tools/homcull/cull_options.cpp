@@ -104,8 +104,9 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
 }
 
-SceneCullerConfig scene_culler_config(const CullOptions& o) {
+SceneCullerConfig scene_culler_config(const CullOptions& o, int threads) {
     SceneCullerConfig c;
+    c.job_system = threads > 1;
     c.display = parse_resolution(o.resolution);
     if (!o.buffer.empty()) c.buffer = parse_resolution(o.buffer, "--buffer");
     c.samples = o.samples;

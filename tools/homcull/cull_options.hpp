@@ -35,7 +35,9 @@ struct CullOptions {
 // and fill CullOptions::resolution and samples themselves).
 void add_cull_options(CLI::App& app, CullOptions& options, bool with_display = true);
 // Throws homcull::Error on inconsistent options (a hole size in conservative mode, ...).
-SceneCullerConfig scene_culler_config(const CullOptions& options);
+// `threads`: the command's --threads; with one, the culler reserves no room for a job system's
+// draws (SceneCullerConfig::job_system), as an engine culling on its own thread would say.
+SceneCullerConfig scene_culler_config(const CullOptions& options, int threads);
 // role: objects with role=occluder (all when none has a role); all; auto: role when the scene
 // marks occluders, otherwise objects whose box diagonal is at least 2 % of the scene's
 // (Zhang's static size filter).
