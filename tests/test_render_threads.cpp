@@ -449,7 +449,7 @@ TEST(Isa, EveryInstructionSetGivesTheReferenceBits) {
     std::vector<OcclusionBuffer> reference;
     render_all(reference);
     EXPECT_GT(reference.back().stats().rasterized, 10000u);
-    EXPECT_GT(reference.back().stats().subtiles_updated, 20000u);
+    EXPECT_GT(reference.back().stats().subtiles_updated, 15000u);  // the street merges triangles into many subtiles
     const std::vector<std::string> isas = available_isas();
     EXPECT_GE(isas.size(), 2u) << "no SIMD instruction set available";
     for (const std::string& isa : isas) {

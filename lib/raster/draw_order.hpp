@@ -1,9 +1,9 @@
 #pragma once
 // The order one render call draws its triangles in (TriangleInput::order). The buffer keeps
 // what it is given first best: a triangle behind a subtile's reference layer is skipped, and
-// the quick mask (Hasselgren et al., Masked Software Occlusion Culling, HPG 2016, §3.2) merges
-// a farther triangle into a nearer working layer but drops a nearer layer's samples for a
-// triangle far in front of it. Drawing the nearest triangles first, as Greene, Kass and Miller
+// two layers hold only two depths, so a subtile that has taken a farther triangle first keeps
+// either its samples at the farther depth or fewer samples at the nearer one
+// (layer_merge.hpp). Drawing the nearest triangles first, as Greene, Kass and Miller
 // draw front to back for their hierarchical Z-buffer (SIGGRAPH 1993), leaves more triangles
 // hidden before their rows are computed and more samples at a near depth.
 //

@@ -14,6 +14,7 @@
 // prepare_float_row_edges in rasterize.hpp.
 //
 #include "raster/rasterize.hpp"
+#include "raster/layer_merge.hpp"
 #include "raster/sample_depth_tiles.hpp"
 
 #include <algorithm>
@@ -308,25 +309,13 @@ std::uint64_t update_subtile_row_reference(const SubtilePlanes& planes, int ty, 
         planes.covered[i] |= m;
 
         const float d_tri = conservative_depth(tri, tx * kW + far_column, ty * kH + far_row);
-        float d0 = planes.d0[i], d1 = planes.d1[i];
-        std::uint32_t mask = planes.mask[i];
-        if (!(d_tri > d0)) continue;  // behind what is already known (or no bound): nothing to add
+        const SubtileLayers layers{planes.d0[i], planes.d1[i], planes.mask[i]};
+        if (!(d_tri > layers.d0)) continue;  // behind what is already known (or no bound): nothing to add
         ++updated;
-
-        // Quick mask: drop the working layer when the triangle is farther in front of it than
-        // it is in front of the reference layer (d_tri - d1 > d1 - d0), then merge, and
-        // promote a full layer to the reference.
-        if (mask != 0 && 2.0f * d1 - (d_tri + d0) < 0.0f) mask = 0;
-        d1 = mask == 0 ? d_tri : std::min(d1, d_tri);
-        mask |= m;
-        if (mask == valid_sample_mask(tx, ty, sample_width, sample_height)) {
-            d0 = d1;
-            mask = 0;
-            d1 = 0.0f;
-        }
-        planes.d0[i] = d0;
-        planes.d1[i] = d1;
-        planes.mask[i] = mask;
+        const SubtileLayers merged = merge_triangle_into_layers(layers, m, d_tri, valid_sample_mask(tx, ty, sample_width, sample_height));
+        planes.d0[i] = merged.d0;
+        planes.d1[i] = merged.d1;
+        planes.mask[i] = merged.mask;
     }
     return updated;
 }

@@ -150,14 +150,15 @@ inline float nearest_conservative_depth(const PreparedTriangle& tri, int i0, int
 // d0 > 0 and d0 >= nearest (nearest_conservative_depth of the triangle over those samples).
 // Then rasterizing the triangle there changes nothing, bit for bit: a subtile takes a triangle
 // only when its conservative depth is > d0, and `covered` already holds every sample of a
-// subtile with d0 > 0 (d0 is only set by promoting a full working layer, and every mask merged
-// into the layer was first added to `covered`). Nor does it change the per-sample depth
-// (planes.sample_depth): every sample's depth is at or in front of its subtile's d0, since each
-// sample of a promoted layer is covered by one of its triangles, whose conservative_depth at
-// the sample is at least its value at the corner of its covered samples that the layer took
-// (the roundings are monotone), and that is at least d0; so nearest, which bounds the
-// triangle's depth at every sample of the box, is at or behind what each sample holds. The
-// SIMD kernels make the same test with vectors of subtiles (pure comparisons: the same answer).
+// subtile with d0 > 0 (d0 leaves 0 only when every sample is in the working layer or under the
+// triangle merged, and each was added to `covered` as it was: layer_merge.hpp). Nor does it
+// change the per-sample depth (planes.sample_depth): every sample's depth is at or in front of
+// its subtile's d0, since d0 is the least of the bounds the merge keeps, and each is the
+// conservative_depth of a triangle covering the sample at the corner of its covered samples
+// that the subtile took (the roundings are monotone, so at most its value at the sample); so
+// nearest, which bounds the triangle's depth at every sample of the box, is at or behind what
+// each sample holds. The SIMD kernels make the same test with vectors of subtiles (pure
+// comparisons: the same answer).
 bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest);
 
 // nearest_conservative_depth of a triangle over its samples in subtile rows [ty0, ty1] (its

@@ -226,20 +226,26 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
         // pattern a predictor learns, and the mispredictions cost more than computing the update
         // and writing back the unchanged values (S1 14.55 -> 13.87 ms, castle 1.43 -> 1.40 ms).
         updated += hn::CountTrue(df, update);
-        // Quick mask, lane by lane as the reference.
-        const auto mask_nonzero = hn::RebindMask(df, hn::Ne(mask, hn::Zero(du)));
-        const auto discard = hn::And(mask_nonzero, hn::Lt(hn::Sub(hn::Mul(hn::Set(df, 2.0f), d1), hn::Add(d_tri, d0)), hn::Zero(df)));
-        const VU kept = hn::IfThenZeroElse(hn::RebindMask(du, discard), mask);
-        const auto kept_empty = hn::RebindMask(df, hn::Eq(kept, hn::Zero(du)));
-        VF d1_new = hn::IfThenElse(kept_empty, d_tri, hn::Min(d1, d_tri));
-        VU mask_new = hn::Or(kept, m);
+        // merge_triangle_into_layers (layer_merge.hpp), lane by lane: the same float operations.
         const VI columns = hn::Min(hn::Sub(hn::Set(di, sample_width), column0), eight);
         const VU row_bits = hn::Shr(byte, hn::BitCast(du, hn::Max(hn::Sub(eight, columns), zero_i)));
-        const VU full = hn::Mul(row_bits, replicate_v);
-        const auto promote = hn::RebindMask(df, hn::Eq(mask_new, full));
-        const VF d0_new = hn::IfThenElse(promote, d1_new, d0);
-        mask_new = hn::IfThenZeroElse(hn::RebindMask(du, promote), mask_new);
-        d1_new = hn::IfThenZeroElse(promote, d1_new);
+        const VU valid = hn::Mul(row_bits, replicate_v);
+        const VU covered_bits = hn::Or(mask, m), neither = hn::AndNot(covered_bits, valid);
+        const VU zero_u = hn::Zero(du);
+        const VF zero_f = hn::Zero(df);
+        const auto any = [&](VU bits) { return hn::RebindMask(df, hn::Ne(bits, zero_u)); };
+        const VF d_near = hn::Max(d1, d_tri);
+        const VF d_covered = hn::Min(hn::IfThenElse(any(hn::AndNot(m, mask)), d1, d_near), hn::IfThenElse(any(hn::AndNot(mask, m)), d_tri, d_near));
+        const VF d0_new = hn::IfThenElse(any(neither), d0, d_covered);
+        const VU near = hn::IfThenElse(hn::RebindMask(du, hn::Ge(d1, d_tri)), mask, m);
+        const VF near_lift = hn::Sub(d_near, d0_new);
+        const VF covered_lift = hn::Mul(hn::Set(df, 2.0f), hn::Sub(d_covered, d0_new));
+        const auto partial = hn::Eq(d0_new, zero_f);  // some sample without an occluder: every covered one
+        const auto take_near = hn::AndNot(partial, hn::And(hn::Gt(near_lift, zero_f), hn::Ge(near_lift, covered_lift)));
+        const auto take_covered = hn::Or(partial, hn::AndNot(take_near, hn::Gt(covered_lift, zero_f)));
+        const VF d1_new = hn::IfThenElse(take_near, d_near, hn::IfThenElseZero(take_covered, d_covered));
+        const VU mask_new = hn::IfThenElse(hn::RebindMask(du, take_near), near,
+                                           hn::IfThenElseZero(hn::RebindMask(du, take_covered), covered_bits));
 
         store(hn::IfThenElse(update, d0_new, d0), df, planes.d0, i);
         store(hn::IfThenElse(update, d1_new, d1), df, planes.d1, i);

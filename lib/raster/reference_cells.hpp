@@ -8,8 +8,8 @@
 // triangles.
 //
 // Why a cell read long after it was computed is still safe: a subtile's d0 never decreases
-// while a render draws (it changes only when a full working layer is promoted, and the
-// working layer's depth always lies above d0), so a cell's minimum, taken at any earlier
+// while a render draws (the merge takes the least of bounds none of which is below the old d0:
+// layer_merge.hpp), so a cell's minimum, taken at any earlier
 // point of the render, bounds every d0 of the cell from below. The render zeroes the cells
 // when it clears the buffer first, else computes them from d0, and refreshes those of the rows
 // it drew into every 4,096 triangles (each part of the rows its own copy of the cells). The cells
