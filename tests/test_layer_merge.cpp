@@ -17,6 +17,13 @@ float layer_bound(const SubtileLayers& l, int s) {
     return (l.mask >> s) & 1u ? std::max(l.d0, l.d1) : l.d0;
 }
 
+// Expects the layers (d0, d1, mask).
+void expect_layers(const SubtileLayers& got, float d0, float d1, std::uint32_t mask) {
+    EXPECT_EQ(got.d0, d0);
+    EXPECT_EQ(got.d1, d1);
+    EXPECT_EQ(got.mask, mask);
+}
+
 // Merges as the row update does: only a triangle in front of d0 enters.
 SubtileLayers draw(const SubtileLayers& l, std::uint32_t m, float d_tri, std::uint32_t valid) {
     return d_tri > l.d0 ? merge_triangle_into_layers(l, m, d_tri, valid) : l;
@@ -72,10 +79,7 @@ TEST(LayerMerge, AFartherTriangleDoesNotPullTheNearerLayerBack) {
     // d0 = 0.6 and the upper half back at 0.6. The merge raises d0 as far and keeps the upper
     // half at 0.8 above it.
     const SubtileLayers layers{0.5f, 0.8f, 0x0000FFFFu};
-    const SubtileLayers merged = merge_triangle_into_layers(layers, 0xFFFF0000u, 0.6f, 0xFFFFFFFFu);
-    EXPECT_EQ(merged.d0, 0.6f);
-    EXPECT_EQ(merged.mask, 0x0000FFFFu);
-    EXPECT_EQ(merged.d1, 0.8f);
+    expect_layers(merge_triangle_into_layers(layers, 0xFFFF0000u, 0.6f, 0xFFFFFFFFu), 0.6f, 0.8f, 0x0000FFFFu);
 }
 
 TEST(LayerMerge, AFartherTriangleLeavesANearLayerThatLiesMuchFartherAboveD0) {
@@ -84,15 +88,9 @@ TEST(LayerMerge, AFartherTriangleLeavesANearLayerThatLiesMuchFartherAboveD0) {
     // Here the layer stays at 0.9 (0.7 above d0, more than twice 0.1), and the triangle's
     // samples keep d0.
     const SubtileLayers layers{0.2f, 0.9f, 0x0F0F0F0Fu};
-    const SubtileLayers far = merge_triangle_into_layers(layers, 0x000000F0u, 0.3f, 0xFFFFFFFFu);
-    EXPECT_EQ(far.d0, 0.2f);
-    EXPECT_EQ(far.mask, 0x0F0F0F0Fu);
-    EXPECT_EQ(far.d1, 0.9f);
+    expect_layers(merge_triangle_into_layers(layers, 0x000000F0u, 0.3f, 0xFFFFFFFFu), 0.2f, 0.9f, 0x0F0F0F0Fu);
     // At 0.6 (0.4 above d0, 0.8 twice over: more than the layer's 0.7), both at 0.6.
-    const SubtileLayers near = merge_triangle_into_layers(layers, 0x000000F0u, 0.6f, 0xFFFFFFFFu);
-    EXPECT_EQ(near.d0, 0.2f);
-    EXPECT_EQ(near.mask, 0x0F0F0FFFu);
-    EXPECT_EQ(near.d1, 0.6f);
+    expect_layers(merge_triangle_into_layers(layers, 0x000000F0u, 0.6f, 0xFFFFFFFFu), 0.2f, 0.6f, 0x0F0F0FFFu);
 }
 
 TEST(LayerMerge, APartlyCoveredSubtileKeepsEveryCoveredSampleSoThatD0RisesWhenFull) {
@@ -103,16 +101,11 @@ TEST(LayerMerge, APartlyCoveredSubtileKeepsEveryCoveredSampleSoThatD0RisesWhenFu
     // The layer keeps every covered sample at 0.3 instead.
     const SubtileLayers layers{0.0f, 0.3f, 0x0F0F0F0Fu};
     const SubtileLayers merged = merge_triangle_into_layers(layers, 0xF0F00000u, 0.95f, 0xFFFFFFFFu);
-    EXPECT_EQ(merged.d0, 0.0f);
-    EXPECT_EQ(merged.mask, 0xFFFF0F0Fu);
-    EXPECT_EQ(merged.d1, 0.3f);
+    expect_layers(merged, 0.0f, 0.3f, 0xFFFF0F0Fu);
     // The last samples covered at 0.5: d0 rises to 0.3, and the new triangle's samples stay
-    // above it. (The quick mask drops the layer at 0.3 for the triangle at 0.5 and keeps d0 at
-    // 0: the layer is no longer full.)
-    const SubtileLayers full = merge_triangle_into_layers(merged, 0x0000F0F0u, 0.5f, 0xFFFFFFFFu);
-    EXPECT_EQ(full.d0, 0.3f);
-    EXPECT_EQ(full.mask, 0x0000F0F0u);
-    EXPECT_EQ(full.d1, 0.5f);
+    // above it. (After the quick mask's first step, which let the left half down, its layer is
+    // not full now, and d0 stays 0.)
+    expect_layers(merge_triangle_into_layers(merged, 0x0000F0F0u, 0.5f, 0xFFFFFFFFu), 0.3f, 0.5f, 0x0000F0F0u);
 }
 
 }  // namespace
