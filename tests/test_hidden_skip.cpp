@@ -154,9 +154,10 @@ void expect_same_with_and_without_skip(const TriangleInput& in, int width, int h
                 EXPECT_TRUE(depth_a == depth_b) << where;
                 EXPECT_EQ(depth_a.empty(), !sample_depth);
                 // Why the skip leaves the per-sample depth alone: every sample's depth is at or in
-                // front of its subtile's d0 (each sample of a promoted layer is covered by one of
-                // its triangles, whose depth at the sample is at least its depth at the corner
-                // the layer took, by the same monotone roundings as nearest_conservative_depth).
+                // front of its subtile's d0 (d0 is the least of the merge's bounds, each the depth
+                // of a triangle covering the sample at the corner the subtile took, which is at
+                // most its depth at the sample, by the same monotone roundings as
+                // nearest_conservative_depth: layer_merge.hpp).
                 std::size_t below_d0 = 0;
                 const int sw = skipping.sample_width();
                 for (std::size_t k = 0; k < depth_a.size(); ++k) {
