@@ -18,7 +18,8 @@
 //   that d0 rises once the last ones are covered (the quick mask may drop the layer there).
 // Counted on the 120-frame walks of the shared scenes (`homcull walk --isa scalar`, the units of
 // per-sample depth that the occludee tests fill), against the quick mask: 54 % fewer fills on
-// pul1duel's walk, 45 % on oa_thor's, 17 % on fzk_haus's, 18 % on the castle's, as many on sponza's.
+// pul1duel's walk, 45 % on oa_thor's, 17 % on fzk_haus's, 18 % on the castle's, as many on
+// sponza's (docs/occlusion-buffer.md has the times).
 //
 // Every sample's new bound is one that a class of samples had (below), so it stays at or behind
 // its occluders; d0 never decreases (no class bound is below the old d0), which the
@@ -48,7 +49,8 @@ inline SubtileLayers merge_triangle_into_layers(const SubtileLayers& layers, std
     // and counts only when neither single class has samples. (d1 is 0 when the mask is empty,
     // so the triangle is then the nearer.)
     const float d_near = std::max(layers.d1, d_tri);
-    const float d_covered = std::min((layers.mask & ~m) != 0 ? layers.d1 : d_near, (m & ~layers.mask) != 0 ? d_tri : d_near);
+    const float d_covered =
+        std::min((layers.mask & ~m) != 0 ? layers.d1 : d_near, (m & ~layers.mask) != 0 ? d_tri : d_near);
     const float d0 = neither != 0 ? layers.d0 : d_covered;
     // While some sample has no occluder yet (the new d0 is 0), the layer keeps every covered
     // sample, at the depth they all share: a sample let down to d0 there would hold d0 at 0 once

@@ -235,7 +235,8 @@ HWY_INLINE std::uint64_t UpdateSubtileRows(const SubtilePlanes& planes, int ty, 
         const VF zero_f = hn::Zero(df);
         const auto any = [&](VU bits) { return hn::RebindMask(df, hn::Ne(bits, zero_u)); };
         const VF d_near = hn::Max(d1, d_tri);
-        const VF d_covered = hn::Min(hn::IfThenElse(any(hn::AndNot(m, mask)), d1, d_near), hn::IfThenElse(any(hn::AndNot(mask, m)), d_tri, d_near));
+        const VF d_covered = hn::Min(hn::IfThenElse(any(hn::AndNot(m, mask)), d1, d_near),
+                                     hn::IfThenElse(any(hn::AndNot(mask, m)), d_tri, d_near));
         const VF d0_new = hn::IfThenElse(any(neither), d0, d_covered);
         const VU near = hn::IfThenElse(hn::RebindMask(du, hn::Ge(d1, d_tri)), mask, m);
         const VF near_lift = hn::Sub(d_near, d0_new);

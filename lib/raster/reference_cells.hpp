@@ -9,10 +9,10 @@
 //
 // Why a cell read long after it was computed is still safe: a subtile's d0 never decreases
 // while a render draws (the merge takes the least of bounds none of which is below the old d0:
-// layer_merge.hpp), so a cell's minimum, taken at any earlier
-// point of the render, bounds every d0 of the cell from below. The render zeroes the cells
-// when it clears the buffer first, else computes them from d0, and refreshes those of the rows
-// it drew into every 4,096 triangles (each part of the rows its own copy of the cells). The cells
+// layer_merge.hpp), so a cell's minimum, taken at any earlier point of the render, bounds
+// every d0 of the cell from below. The render zeroes the cells when it clears the buffer
+// first, else computes them from d0, and refreshes those of the rows it drew into every 4,096
+// triangles (each part of the rows its own copy of the cells). The cells
 // are the render's scratch: nothing reads them outside a render, and they change no bit (see
 // CellNote).
 //
