@@ -29,8 +29,10 @@ mkdir -p "$OUT"
 configs=(
   "boxes, clusters|--occludees box --clusters 124"
   "boxes, clusters, 32 parts|--occludees box --clusters 124 --occludee-parts 32"
+  "boxes, clusters, back faces culled|--occludees box --clusters 124 --back-faces cull"
   "boxes|--occludees box --clusters 0"
   "triangles, clusters (default)|"
+  "triangles, clusters, back faces culled|--back-faces cull"
   "triangles|--clusters 0"
 )
 for c in "${configs[@]}"; do

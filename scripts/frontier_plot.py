@@ -46,6 +46,8 @@ def load_homcull(out):
         parts = c.get('occludee_parts', 16)
         if parts != 16:  # the default; others are named
             label += ', ' + (f'{parts} parts' if parts > 1 else 'no parts')
+        if c.get('back_faces', 'draw') == 'cull':
+            label += ', back faces culled'
         points.setdefault(label, {})[kind] = doc
     return points
 

@@ -652,6 +652,34 @@ TEST(SceneCulling, ClosedOccludersAreDrawnWithoutTheirBackFaces) {
     }
 }
 
+// With backface cw (the CLI's --back-faces cull), no occluder triangle facing away from the eye
+// is drawn, closed or not: a quad seen from behind hides nothing, one seen from the front still
+// does, as triangles and as clusters.
+TEST(SceneCulling, BackfaceCullingLeavesOutEveryOccluderTriangleFacingAway) {
+    Scene scene;
+    const std::uint32_t front = test::add_quad(scene, "seen from the front", {-6, -2, -10}, {-0.2f, -2, -10}, {-0.2f, 2, -10}, {-6, 2, -10});
+    const std::uint32_t back = test::add_quad(scene, "seen from behind", {0.2f, -2, -10}, {0.2f, 2, -10}, {6, 2, -10}, {6, -2, -10});
+    const std::uint32_t behind_front = test::add_box(scene, "behind the front quad", {-2.5f, -1, -20}, {-1.5f, 1, -18});
+    const std::uint32_t behind_back = test::add_box(scene, "behind the back quad", {1.5f, -1, -20}, {2.5f, 1, -18});
+    scene.finalize();
+    const Camera camera = test::camera_down_minus_z(90.0);
+    for (const bool clusters : {false, true}) {
+        for (const Backface backface : {Backface::none, Backface::cw}) {
+            SceneCullerConfig config;
+            config.display = {160, 120};
+            config.occluder_clusters = clusters;
+            config.backface = backface;
+            SceneCuller culler(scene, {front, back}, config);
+            std::vector<OccludeeAnswer> answers;
+            culler.cull(camera, answers);
+            const char* what = clusters ? "clusters" : "triangles";
+            EXPECT_EQ(answers[behind_front].visibility, Visibility::occluded) << what;
+            EXPECT_EQ(answers[behind_back].visibility, backface == Backface::cw ? Visibility::visible : Visibility::occluded) << what;
+            EXPECT_EQ(culler.buffer().stats().backface_culled, backface == Backface::cw ? 2u : 0u) << what;
+        }
+    }
+}
+
 // A wall made of two objects that meet along the view's middle column of sample centres (a
 // hair beside them), and a stick behind that column alone. Drawing every candidate in the frustum (one-pass, no budget),
 // the edge the two objects share goes without its coverage margin, as triangles and as

@@ -152,7 +152,8 @@ void run_frame_bench(const FrameBenchOptions& o) {
             {"rounds", o.rounds},
             {"config", {{"mode", o.cull.mode}, {"depth", o.cull.depth}, {"occludees", o.cull.occludees}, {"clusters", o.cull.clusters},
                         {"strategy", o.cull.strategy}, {"occluders", o.cull.occluders}, {"lod", o.cull.lod},
-                        {"closed_back_faces", o.cull.closed_back_faces}, {"pyramid", o.cull.pyramid}, {"occludee_parts", o.cull.occludee_parts},
+                        {"closed_back_faces", o.cull.closed_back_faces}, {"back_faces", o.cull.back_faces},
+                        {"pyramid", o.cull.pyramid}, {"occludee_parts", o.cull.occludee_parts},
                         {"complexity", o.cull.complexity}}},
             {"per_view", per_view},
             {"summary", summary}};

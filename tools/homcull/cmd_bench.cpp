@@ -36,7 +36,7 @@ struct BenchOptions {
     bool complexity_given = false;
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
-    std::string occludees = "auto", closed_back_faces = "skip", pyramid = "lazy";
+    std::string occludees = "auto", closed_back_faces = "skip", back_faces = "draw", pyramid = "lazy";
     int occludee_parts = 16;
 };
 
@@ -59,6 +59,7 @@ void run_frame_workload(const BenchOptions& o) {
     f.cull.occludees = o.occludees;
     if (o.clusters_given) f.cull.clusters = o.clusters > 0 ? "on" : "off";
     f.cull.closed_back_faces = o.closed_back_faces;
+    f.cull.back_faces = o.back_faces;
     f.cull.pyramid = o.pyramid;
     f.cull.occludee_parts = o.occludee_parts;
     f.cull.complexity = o.complexity;
@@ -283,6 +284,9 @@ void register_bench(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--closed-back-faces", o->closed_back_faces, "frame: skip or draw the back faces of closed occluder meshes (cull --closed-back-faces)")
         ->capture_default_str()->check(CLI::IsMember({"skip", "draw"}));
+    cmd->add_option("--back-faces", o->back_faces,
+                    "frame: draw or cull every occluder triangle facing away from the eye (cull --back-faces)")
+        ->capture_default_str()->check(CLI::IsMember({"draw", "cull"}));
     cmd->add_option("--occludee-parts", o->occludee_parts, "frame: parts per object with a box each (cull --occludee-parts)")
         ->capture_default_str()->check(CLI::Range(0, 64));
     cmd->add_option("--pyramid", o->pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")

@@ -24,7 +24,8 @@ struct CullOptions {
     double hole = 0.0, distribution = 1.0, transparency = 0.0;
     int finest_level = 0, coarsest_level = -1;
     int occludee_parts = 16;
-    std::string deb = "64x64", occludees = "auto", sample_depth = "on", clusters = "on", closed_back_faces = "skip", pyramid = "lazy";
+    std::string deb = "64x64", occludees = "auto", sample_depth = "on", clusters = "on", closed_back_faces = "skip", back_faces = "draw",
+                pyramid = "lazy";
     std::string strategy = "temporal", rank = "none", hierarchy = "on", grid, lod = "off";
     std::size_t budget = 0, batch = 1024;
     double cut_step = TemporalCut{}.step_in_near_planes, cut_turn = TemporalCut{}.turn_degrees;
