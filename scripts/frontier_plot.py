@@ -3,8 +3,10 @@
 
 usage: frontier_plot.py OUT [PEERS_SUMMARY_MD]
 
-OUT holds `homcull bench --workload frame --json` outputs named <config>_castle.json (the views
-of data/views/castle.json) and <config>_random.json (random viewpoints). PEERS_SUMMARY_MD is a
+OUT holds `homcull bench --workload frame --json` outputs named <config>_castle.passN.json (the
+views of data/views/castle.json) and <config>_random.passN.json (random viewpoints), one per pass
+(frontier.sh alternates the configurations' order from pass to pass); a view's frame time is
+its median over the passes (names without .passN, from older runs, are one pass). PEERS_SUMMARY_MD is a
 ../shared/peers/measure.sh summary.md: its per-view whole-frame tables give the peers' points
 (Intel MOC, rawrunprotected), scored by the peers' summarize.py over every hidden object.
 Writes OUT/frontier.png (a panel per castle view, one for the random views) and OUT/frontier.md
@@ -15,6 +17,7 @@ import glob
 import json
 import os
 import re
+import statistics
 import sys
 
 import matplotlib
@@ -33,14 +36,46 @@ def pareto(points):
     return front
 
 
+def merge_passes(docs):
+    """One bench output from the passes' outputs of one configuration: each view's frame time
+    is its median over the passes (its stages', too), the summary's times recomputed from them.
+    Every pass answers the same (the culler is deterministic): a pass that does not is an error."""
+    merged = json.loads(json.dumps(docs[0]))
+    for v, view in enumerate(merged['per_view']):
+        for d in docs[1:]:
+            other = d['per_view'][v]
+            if (other['culled_hidden'], other['false_culls']) != (view['culled_hidden'], view['false_culls']):
+                sys.exit('frontier_plot.py: the passes of %s answer view %d differently' % (merged['config'], v))
+        view['frame_ms'] = statistics.median(d['per_view'][v]['frame_ms'] for d in docs)
+        view['frame_min_ms'] = min(d['per_view'][v]['frame_min_ms'] for d in docs)
+        for stage in view['stages_ms']:
+            view['stages_ms'][stage] = statistics.median(d['per_view'][v]['stages_ms'][stage] for d in docs)
+    times = [v['frame_ms'] for v in merged['per_view']]
+    merged['summary']['frame_ms'] = {'mean': statistics.mean(times), 'median': statistics.median(times), 'max': max(times)}
+    merged['summary']['stages_ms_mean'] = {
+        stage: statistics.mean(v['stages_ms'][stage] for v in merged['per_view']) for stage in merged['per_view'][0]['stages_ms']}
+    for v, view in enumerate(merged['per_view']):
+        view['frame_ms_passes'] = [d['per_view'][v]['frame_ms'] for d in docs]
+    merged['summary']['frame_ms_passes'] = [statistics.mean(v['frame_ms'] for v in d['per_view']) for d in docs]
+    merged['passes'] = len(docs)
+    merged['rounds'] = sum(d['rounds'] for d in docs)
+    return merged
+
+
 def load_homcull(out):
-    """{config: {'castle': json, 'random': json}} from OUT's bench outputs."""
-    points = {}
-    for path in sorted(glob.glob(os.path.join(out, '*_castle.json')) + glob.glob(os.path.join(out, '*_random.json'))):
-        base = os.path.basename(path)[:-len('.json')]
-        config, kind = base.rsplit('_', 1)
+    """{config: {'castle': json, 'random': json}} from OUT's bench outputs, passes merged."""
+    runs = {}
+    name = re.compile(r'^(.*)_(castle|random)(\.pass\d+)?\.json$')
+    for path in sorted(glob.glob(os.path.join(out, '*.json'))):
+        m = name.match(os.path.basename(path))
+        if not m:
+            continue
         with open(path) as f:
             doc = json.load(f)
+        runs.setdefault((m.group(1), m.group(2)), []).append(doc)
+    points = {}
+    for (_, kind), docs in sorted(runs.items()):
+        doc = merge_passes(docs)
         c = doc['config']
         label = ('boxes' if c['occludees'] == 'box' else 'triangles') + (', clusters' if c['clusters'] == 'on' else '')
         parts = c.get('occludee_parts', 16)
@@ -73,7 +108,7 @@ def main():
     out = sys.argv[1]
     homcull = load_homcull(out)
     if not homcull:
-        sys.exit('frontier_plot.py: no *_castle.json or *_random.json in ' + out)
+        sys.exit('frontier_plot.py: no <config>_castle[.passN].json or <config>_random[.passN].json in ' + out)
     peers = load_peers(sys.argv[2]) if len(sys.argv) == 3 else {}
     views = max(len(d['castle']['per_view']) for d in homcull.values() if 'castle' in d)
     has_random = any('random' in d for d in homcull.values())
@@ -119,8 +154,11 @@ def main():
     fig.savefig(os.path.join(out, 'frontier.png'), dpi=110)
 
     with open(os.path.join(out, 'frontier.md'), 'w') as f:
-        f.write('| culler | view | frame ms | efficiency, hidden outright | efficiency, all hidden | false culls |\n')
-        f.write('|---|---|---|---|---|---|\n')
+        some = next(iter(next(iter(homcull.values())).values()))
+        f.write('homcull: each view\'s whole frame is its median over %d pass(es) of %d rounds in all, the configurations\' order '
+                'alternating from pass to pass.\n\n' % (some.get('passes', 1), some['rounds']))
+        f.write('| culler | view | frame ms | passes\' range | efficiency, hidden outright | efficiency, all hidden | false culls |\n')
+        f.write('|---|---|---|---|---|---|---|\n')
         for label, docs in sorted(homcull.items()):
             for kind in ('castle', 'random'):
                 if kind not in docs:
@@ -128,13 +166,14 @@ def main():
                 doc = docs[kind]
                 rows = [('C%d' % v['view'], v) for v in doc['per_view']] if kind == 'castle' else []
                 s = doc['summary']
-                rows.append(('%s, mean of %d' % (kind, s['views']), dict(s, frame_ms=s['frame_ms']['mean'])))
+                rows.append(('%s, mean of %d' % (kind, s['views']), dict(s, frame_ms=s['frame_ms']['mean'], frame_ms_passes=s['frame_ms_passes'])))
                 for name, v in rows:
-                    f.write('| homcull %s | %s | %.3f | %.1f %% | %.1f %% | %d |\n' % (
-                        label, name, v['frame_ms'], 100 * v['efficiency'], 100 * v['efficiency_plain'], v['false_culls']))
+                    f.write('| homcull %s | %s | %.3f | %.3f-%.3f | %.1f %% | %.1f %% | %d |\n' % (
+                        label, name, v['frame_ms'], min(v['frame_ms_passes']), max(v['frame_ms_passes']), 100 * v['efficiency'],
+                        100 * v['efficiency_plain'], v['false_culls']))
         for label, per_view in sorted(peers.items()):
             for v, (ms, eff) in enumerate(per_view):
-                f.write('| %s | C%d | %.3f | | %.1f %% | |\n' % (label, v, ms, eff))
+                f.write('| %s | C%d | %.3f | | | %.1f %% | |\n' % (label, v, ms, eff))
     print('frontier_plot.py: wrote %s and %s' % (os.path.join(out, 'frontier.png'), os.path.join(out, 'frontier.md')))
 
 

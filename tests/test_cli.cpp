@@ -86,6 +86,11 @@ TEST(Cli, CullJsonHasEveryObjectStagesAndTruth) {
     for (const char* stage : {"render", "maps", "tests"}) EXPECT_TRUE(j["timings_ms"].contains(stage)) << stage;
     EXPECT_TRUE(j["stats"].contains("triangles_in"));
     EXPECT_TRUE(j["overlap_exits"].contains("predictive_rejection"));
+    // The configuration that made it, every option as given.
+    ASSERT_TRUE(j.contains("config"));
+    EXPECT_EQ(j["config"]["depth"], "hzb");
+    EXPECT_EQ(j["config"]["back_faces"], "draw");
+    EXPECT_EQ(j["config"]["occludee_parts"], 16);
 }
 
 // homcull sort: moving toothpicks in front of one camera, every frame checked against Embree.
@@ -252,9 +257,15 @@ TEST(Cli, WalkReportsEveryFrameAndASummary) {
     EXPECT_NE(r.exit_code, 0);
     EXPECT_MENTIONS(r.err, "--cut-turn");
     r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --resolution 96x54 --truth off --quiet --json "
-                "--cut-step inf --cut-turn 180");
+                "--cut-step inf --cut-turn 180 --back-faces cull --sample-depth off");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(nlohmann::json::parse(r.out)["summary"]["frames_without_history"], 1);
+    const nlohmann::json walked = nlohmann::json::parse(r.out);
+    EXPECT_EQ(walked["summary"]["frames_without_history"], 1);
+    // The configuration that made the walk, every option as given.
+    ASSERT_TRUE(walked.contains("config"));
+    EXPECT_EQ(walked["config"]["back_faces"], "cull");
+    EXPECT_EQ(walked["config"]["sample_depth"], "off");
+    EXPECT_EQ(walked["config"]["cut_turn"], 180.0);
     r = run_cli("walk --scene gen:city:blocks=3 --path " + dir + "/walk.json --resolution 96x54 --truth off --quiet");
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(r.err, "");

@@ -150,11 +150,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
             {"isa", culler.buffer().config().isa},
             {"threads", o.threads},
             {"rounds", o.rounds},
-            {"config", {{"mode", o.cull.mode}, {"depth", o.cull.depth}, {"occludees", o.cull.occludees}, {"clusters", o.cull.clusters},
-                        {"strategy", o.cull.strategy}, {"occluders", o.cull.occluders}, {"lod", o.cull.lod},
-                        {"closed_back_faces", o.cull.closed_back_faces}, {"back_faces", o.cull.back_faces},
-                        {"pyramid", o.cull.pyramid}, {"occludee_parts", o.cull.occludee_parts},
-                        {"complexity", o.cull.complexity}}},
+            {"config", cull_config_json(o.cull)},
             {"per_view", per_view},
             {"summary", summary}};
         if (o.scaling) out["scaling"] = scaling;

@@ -106,6 +106,7 @@ void run_cull(const CullCommandOptions& o) {
                             {"maps", ms.maps_ms}, {"tests", ms.test_ms}}},
             {"work", work_json(culler.work())},
             {"strategy", o.cull.strategy},
+            {"config", cull_config_json(o.cull)},
             {"stats", stats_json(culler.buffer().stats())},
             {"overlap_exits", exits}};
         if (o.truth) {

@@ -181,6 +181,7 @@ void run_walk(const WalkCommandOptions& o) {
                                     {"depth", o.cull.depth},
                                     {"isa", selected_isa()},
                                     {"occluder_candidates", {{"objects", culler.occluder_objects()}, {"triangles", culler.occluder_triangles()}}},
+                                    {"config", cull_config_json(o.cull)},
                                     {"frames", std::move(frames)},
                                     {"summary", std::move(summary)}};
         fmt::print("{}\n", out.dump(1));

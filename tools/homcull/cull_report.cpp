@@ -35,4 +35,33 @@ nlohmann::json work_json(const SceneCullWork& w) {
             {"back_faces_skipped", w.back_faces_skipped}, {"used_history", w.used_history}};
 }
 
+nlohmann::json cull_config_json(const CullOptions& o) {
+    return {{"mode", o.mode},
+            {"hole", o.hole},
+            {"distribution", o.distribution},
+            {"transparency", o.transparency},
+            {"depth", o.depth},
+            {"deb", o.deb},
+            {"pyramid", o.pyramid},
+            {"finest_level", o.finest_level},
+            {"coarsest_level", o.coarsest_level},
+            {"occludees", o.occludees},
+            {"occludee_parts", o.occludee_parts},
+            {"sample_depth", o.sample_depth},
+            {"clusters", o.clusters},
+            {"closed_back_faces", o.closed_back_faces},
+            {"back_faces", o.back_faces},
+            {"occluders", o.occluders},
+            {"complexity", o.complexity},
+            {"strategy", o.strategy},
+            {"cut_step", o.cut_step},
+            {"cut_turn", o.cut_turn},
+            {"rank", o.rank},
+            {"grid", o.grid},
+            {"lod", o.lod},
+            {"budget", o.budget},
+            {"batch", o.batch},
+            {"hierarchy", o.hierarchy}};
+}
+
 }  // namespace homcull::cli

@@ -1,6 +1,6 @@
 #pragma once
-// The JSON pieces `cull` and `walk` both print: per-object results in DESIGN.md's format,
-// stage timings, the culler's work.
+// The JSON pieces `cull`, `walk` and `bench --workload frame` print: per-object results in
+// DESIGN.md's format, stage timings, the culler's work, the configuration.
 #include <homcull/scene_culler.hpp>
 #include <homcull/truth/ground_truth.hpp>
 
@@ -13,5 +13,9 @@ nlohmann::json object_result_json(const Scene& scene, std::size_t id, const Occl
 // {"select","render","maps","tests"} in milliseconds.
 nlohmann::json timings_json(const SceneCullTimings& ms);
 nlohmann::json work_json(const SceneCullWork& work);
+struct CullOptions;
+// Every culling option as given (cull_options.hpp), so that a JSON output says which
+// configuration made it: {"mode", "depth", "occludees", "clusters", "back_faces", ...}.
+nlohmann::json cull_config_json(const CullOptions& options);
 
 }  // namespace homcull::cli
