@@ -3,6 +3,7 @@
 // out-of-memory at every allocation. The C99 engine host (tests/c_host) drives it on the castle.
 #include <homcull/homcull.h>
 
+#include <homcull/frustum.hpp>
 #include <homcull/occluder_selection.hpp>
 #include <homcull/occlusion_buffer.hpp>
 #include <homcull/scene.hpp>
@@ -505,6 +506,78 @@ TEST(CApi, BoxesCrossingTheNearPlaneBesideTheViewAreViewCulled) {
                 EXPECT_EQ(answers[k], expected[k]) << homcull_isa_name(isa) << ", box " << k;
             }
         }
+    }
+}
+
+// Boxes beside the view volume's edges of a turned camera (yawed and pitched, so that the
+// volume's edges lie across the world's axes), with nothing drawn: exactly the boxes that
+// homcull::intersects() finds apart from the camera's frustum are hidden (view-culled, or
+// occluded where their screen rectangle holds no sample), the others not view-culled, given as
+// world boxes and as model boxes under a translation, perspective and orthographic; among them
+// boxes outside no single side, which the screen rectangle and the plane tests kept.
+TEST(CApi, BoxesBesideACornerOfTheViewAreViewCulled) {
+    const Scene scene;
+    homcull::Camera camera;
+    camera.eye = {0, 0, 0};
+    camera.target = {1.0, 0.35, -0.8};
+    camera.fov_y_degrees = glm::degrees(kFovY);
+    camera.near_plane = kNear;
+    camera.far_plane = kFar;
+    const glm::dmat4 view_from_world = homcull::view_matrix(camera);
+    for (const bool orthographic : {false, true}) {
+        homcull::Camera c = camera;
+        if (orthographic) c.ortho_height = 2.0 * kOrthoHalfHeight;
+        const glm::dmat4 projection = orthographic ? glm::orthoRH_NO(-kOrthoHalfWidth, kOrthoHalfWidth, -kOrthoHalfHeight, kOrthoHalfHeight, kNear, kFar)
+                                                   : glm::perspectiveRH_NO(kFovY, kAspect, kNear, kFar);
+        homcull_view view{};
+        view.front_face = HOMCULL_FRONT_CCW, view.cull = HOMCULL_CULL_BACK;
+        view.layout = HOMCULL_COLUMN_MAJOR, view.depth_range = HOMCULL_DEPTH_MINUS_ONE_TO_ONE;
+        const glm::dmat4 clip_from_world = projection * view_from_world;
+        for (int k = 0; k < 16; ++k) view.world_to_clip[k] = glm::value_ptr(clip_from_world)[k];
+        const homcull::Frustum frustum = homcull::make_frustum(c, kAspect);
+        // Boxes around the volume's four side edges (within a few units of them, on either
+        // side), their corners on a grid of quarter units.
+        std::vector<homcull_box> world, model;
+        const glm::vec3 shift(-3.0f, 5.0f, 7.0f);  // model = world - shift, exact in float here
+        std::uint64_t seed = 12345;
+        const auto uniform = [&](double lo, double hi) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            return lo + (hi - lo) * double(seed >> 11) * 0x1.0p-53;
+        };
+        const auto quarter = [](double v) { return float(std::round(4.0 * v) / 4.0); };
+        for (int k = 0; k < 4000; ++k) {
+            const int edge = k % 4;
+            const glm::dvec3 along = frustum.corners[std::size_t(edge)] +
+                                     uniform(0.05, 0.6) * (frustum.corners[std::size_t(edge) + 4] - frustum.corners[std::size_t(edge)]);
+            const glm::vec3 lo(quarter(along.x + uniform(-6, 3)), quarter(along.y + uniform(-6, 3)), quarter(along.z + uniform(-6, 3)));
+            const glm::vec3 size(quarter(uniform(0.25, 3)), quarter(uniform(0.25, 3)), quarter(uniform(0.25, 3)));
+            world.push_back({{lo.x, lo.y, lo.z}, {lo.x + size.x, lo.y + size.y, lo.z + size.z}});
+            model.push_back({{lo.x - shift.x, lo.y - shift.y, lo.z - shift.z}, {lo.x + size.x - shift.x, lo.y + size.y - shift.y, lo.z + size.z - shift.z}});
+        }
+        const glm::mat4 model_matrix = glm::translate(glm::mat4(1.0f), shift);
+        Culler culler(scene, make_context());
+        ASSERT_EQ(homcull_buffer_begin_frame(culler.buffer, &view), HOMCULL_OK) << homcull_last_error();
+        std::vector<homcull_visibility> world_answers(world.size(), 99), model_answers(model.size(), 99);
+        ASSERT_EQ(homcull_buffer_test_boxes(culler.buffer, world.data(), world.size(), nullptr, world_answers.data()), HOMCULL_OK);
+        ASSERT_EQ(homcull_buffer_test_boxes(culler.buffer, model.data(), model.size(), glm::value_ptr(model_matrix), model_answers.data()),
+                  HOMCULL_OK);
+        std::size_t apart = 0, beside_a_corner = 0;
+        for (std::size_t k = 0; k < world.size(); ++k) {
+            const homcull::Aabb box{{world[k].min[0], world[k].min[1], world[k].min[2]}, {world[k].max[0], world[k].max[1], world[k].max[2]}};
+            const bool meets = homcull::intersects(frustum, box);
+            // Nothing is drawn: a box in view is visible (or occluded when its screen rectangle
+            // holds no sample centre, as some beside the view are: hidden either way).
+            if (meets) {
+                EXPECT_NE(world_answers[k], HOMCULL_VIEW_CULLED) << orthographic << ", box " << k;
+            } else {
+                EXPECT_NE(world_answers[k], HOMCULL_VISIBLE) << orthographic << ", box " << k;
+            }
+            EXPECT_EQ(model_answers[k], world_answers[k]) << orthographic << ", box " << k;
+            apart += !meets;
+            beside_a_corner += world_answers[k] == HOMCULL_VIEW_CULLED && homcull::may_meet(frustum, box);
+        }
+        EXPECT_GT(apart, world.size() / 4) << orthographic;
+        EXPECT_GE(beside_a_corner, 3u) << orthographic << ": no box beside a corner of the view, where only the exact test culls";
     }
 }
 

@@ -1,6 +1,7 @@
 #include <homcull/frustum.hpp>
 
 #include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
 
 #include <limits>
 #include <random>
@@ -142,6 +143,67 @@ TEST(Frustum, AxesWithAMarginSeparateLessThanTheExactTest) {
     const Aabb just_beyond{glm::vec3(far_point - 0.1), glm::vec3(far_point + 0.1)};
     EXPECT_TRUE(separated(exact, just_beyond));
     EXPECT_FALSE(separated(frustum_axes(f, 0.0, glm::dvec3(1.0)), just_beyond));
+}
+
+// view_volume_axes of a camera's clip-from-world matrix separates exactly the boxes that
+// intersects() finds apart from the camera's frustum when its far plane lies beyond every box,
+// perspective and orthographic; with a margin, only such boxes. From clip_from_world * model (a
+// translation and a power-of-two scale, so that a model box's world image is a box), it answers
+// for the model box what the world test answers for its image.
+TEST(Frustum, ViewVolumeOfAClipMatrixIsTheCamerasFrustumWithoutItsFarPlane) {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> pos(-60.0, 60.0), size(0.1, 15.0);
+    for (const bool orthographic : {false, true}) {
+        int apart = 0, apart_with_margin = 0, corner_boxes = 0;
+        for (int camera_trial = 0; camera_trial < 20; ++camera_trial) {
+            Camera c;
+            c.eye = {pos(rng) * 0.2, pos(rng) * 0.2, pos(rng) * 0.2};
+            c.target = {pos(rng), pos(rng), pos(rng)};
+            c.fov_y_degrees = 30.0 + double(rng() % 90);
+            c.near_plane = 0.5;
+            c.far_plane = 1e6;  // beyond every box: the volume has no far plane
+            if (orthographic) c.ortho_height = 20.0 + double(rng() % 40);
+            const double aspect = 1.6;
+            const Frustum f = make_frustum(c, aspect);
+            const glm::dmat4 clip_from_world = projection_matrix(c, aspect) * view_matrix(c);
+            const FrustumAxes exact = view_volume_axes(clip_from_world, c.near_plane, orthographic, 0.0);
+            const FrustumAxes widened = view_volume_axes(clip_from_world, c.near_plane, orthographic, 0x1.0p-20);
+            const glm::dvec3 shift(pos(rng), pos(rng), pos(rng));
+            const glm::dmat4 model = glm::scale(glm::translate(glm::dmat4(1.0), shift), glm::dvec3(2.0, 0.5, 4.0));
+            const FrustumAxes in_model = view_volume_axes(clip_from_world * model, c.near_plane, orthographic, 0.0);
+            ASSERT_GE(exact.plane_count, 5);
+            for (int k = 0; k < 2000; ++k) {
+                const glm::vec3 lo(glm::dvec3(pos(rng), pos(rng), pos(rng)));
+                const Aabb b{lo, lo + glm::vec3(glm::dvec3(size(rng), size(rng), size(rng)))};
+                const bool meets = intersects(f, b);
+                ASSERT_EQ(separated(exact, b), !meets) << "camera " << camera_trial << ", box " << k;
+                apart += !meets;
+                if (separated(widened, b)) {
+                    EXPECT_FALSE(meets);
+                    ++apart_with_margin;
+                }
+                corner_boxes += !meets && may_meet(f, b);  // apart, yet within every plane alone
+                const glm::dvec3 model_lo = (glm::dvec3(b.min) - shift) / glm::dvec3(2.0, 0.5, 4.0);
+                const glm::dvec3 model_hi = (glm::dvec3(b.max) - shift) / glm::dvec3(2.0, 0.5, 4.0);
+                const Aabb model_box{glm::vec3(model_lo), glm::vec3(model_hi)};
+                // The model box's image is b up to the float rounding of its corners: compare
+                // only where that cannot matter.
+                if (glm::dvec3(model_box.min) * glm::dvec3(2.0, 0.5, 4.0) + shift == glm::dvec3(b.min) &&
+                    glm::dvec3(model_box.max) * glm::dvec3(2.0, 0.5, 4.0) + shift == glm::dvec3(b.max)) {
+                    EXPECT_EQ(separated(in_model, model_box), !meets) << "model box " << k;
+                }
+            }
+        }
+        EXPECT_GT(apart, 10000) << orthographic;
+        EXPECT_GT(apart_with_margin, apart - 50) << orthographic;
+        EXPECT_GT(corner_boxes, 20) << orthographic << ": expected boxes beside the volume's edges that only the exact axes separate";
+    }
+    // A degenerate matrix, or one that is not finite, separates nothing.
+    const Aabb far_away{{1000, 1000, 1000}, {1001, 1001, 1001}};
+    EXPECT_FALSE(separated(view_volume_axes(glm::dmat4(0.0), 0.5, false, 0.0), far_away));
+    glm::dmat4 not_finite(1.0);
+    not_finite[2][3] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_FALSE(separated(view_volume_axes(not_finite, 0.5, false, 0.0), far_away));
 }
 
 }  // namespace

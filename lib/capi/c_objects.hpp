@@ -9,6 +9,7 @@
 #include <homcull/homcull.h>
 
 #include <homcull/detail/memory.hpp>
+#include <homcull/frustum.hpp>
 #include <homcull/occluder_clusters.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
@@ -65,6 +66,9 @@ struct homcull_buffer {
     homcull::Backface backface = homcull::Backface::cw;
     bool far_plane = false;
     glm::dvec4 far_row{0.0};  // in front of (or on) the far plane: dot(far_row, world clip) >= 0
+    // The view volume as separating axes for world boxes (view_volume_axes): test_boxes' exact
+    // frustum test, made once per frame.
+    homcull::FrustumAxes world_view_axes;
     // An orthographic frame (begin_frame configures the buffer so: BufferConfig::orthographic)
     // has the engine's clip z = (z_gl - ortho_z_offset) / ortho_z_scale; perspective frames clip
     // at near_distance (an orthographic buffer's own near_w is its near plane's).

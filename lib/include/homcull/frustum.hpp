@@ -36,6 +36,9 @@ struct FrustumAxes {
     int plane_count = 0;  // the first axes: the planes' normals
     std::array<glm::dvec3, 27> axis;
     std::array<double, 27> lo, hi;  // the frustum's corners projected on axis[k], widened by position_slack
+    // |lo| + |hi| without an infinite one (view_volume_axes: an unbounded side): the margin's
+    // frustum term.
+    std::array<double, 27> extent_magnitude;
     // How far apart, relative to the magnitudes of the box's and the frustum's terms, a box and
     // the frustum must lie to count as separated (0: exact, as intersects()).
     double relative_margin = 0.0;
@@ -44,6 +47,18 @@ struct FrustumAxes {
 // (a copy of it whose eye was rounded, say); each axis's extent is widened by that much. An axis
 // along which a corner's projection is not finite (a far plane at infinity) is left out.
 FrustumAxes frustum_axes(const Frustum& frustum, double relative_margin = 0.0, const glm::dvec3& position_slack = glm::dvec3(0.0));
+
+// The view volume of a clip-from-space matrix (column-major, the library's clip space: y up the
+// screen, w the view depth) as separating axes in that space, for boxes given in it (world
+// boxes with clip_from_world, model boxes with clip_from_model): the points with |x| <= w,
+// |y| <= w and w >= near_w, or for an orthographic matrix (w = 1, OpenGL's z) |x| <= 1,
+// |y| <= 1 and z >= -1. No far plane: the volume is unbounded beyond the near rectangle (its
+// four side edges are rays), so that a view without one is exact too; a box beyond a far plane
+// has a plane test of its own. The axes are intersects()'s: the five planes' normals, the space's
+// axes and their cross products with the side edges and the near rectangle's edges; along an
+// axis that a side edge climbs, the volume's extent is infinite on that side. A matrix whose
+// volume is degenerate or not finite gives no axis (nothing is separated).
+FrustumAxes view_volume_axes(const glm::dmat4& clip_from_space, double near_w, bool orthographic, double relative_margin);
 
 // True when some axis separates the box from the frustum by more than the margin (a box that
 // is empty is separated).

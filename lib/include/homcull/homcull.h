@@ -341,9 +341,12 @@ typedef struct homcull_rect {
 } homcull_rect;
 
 /* Boxes (in model space of model_matrix; null: world boxes), count of them, answers into
- * visibility[count]. A box crossing the near plane is visible; one wholly beyond the far plane
- * (unless the view has none) or outside a side plane is view-culled. Answers account for every
- * occluder drawn in this frame before the call. Thread-safe with other queries. */
+ * visibility[count]. A box that does not meet the view volume (the sides and the near plane, by
+ * an exact separating-axis test: a box beside a corner of the view, outside no single side, is
+ * view-culled too), or lies wholly beyond the far plane (unless the view has none), is
+ * view-culled, by a margin of 2^-20 of its terms; one crossing the near plane that meets the
+ * volume is visible. Answers account for every occluder drawn in this frame before the call.
+ * Thread-safe with other queries. */
 HOMCULL_API homcull_result homcull_buffer_test_boxes(const homcull_buffer* buffer, const homcull_box* boxes, size_t count,
                                                      const float* model_matrix, homcull_visibility* visibility);
 HOMCULL_API homcull_result homcull_buffer_test_rects(const homcull_buffer* buffer, const homcull_rect* rects, size_t count,
