@@ -29,10 +29,11 @@ void report(const char* what, const CullingTally& t) {
 
 void tally_walk(const Scene& scene, const std::vector<std::uint32_t>& occluder_ids, int frames, Resolution display, int samples,
                 CullingTally& tally, DepthTest depth = DepthTest::masked, std::uint64_t seed = 1, double hole = 0.0,
-                bool clusters = false) {
+                bool clusters = false, bool merge_coplanar = false) {
     const RayScene rays(scene);
     SceneCullerConfig config;
     config.occluder_clusters = clusters;
+    config.merge_coplanar_occluders = merge_coplanar;
     config.display = display;
     config.samples = samples;
     config.maps.depth = depth;
@@ -179,10 +180,12 @@ TEST(CullingVsTruth, SharedScenesAlongWalksHaveNoFalseCulls) {
         if (path.empty()) continue;
         ++found;
         const Scene scene = load_scene(path);
-        for (const bool clusters : {false, true}) {  // the occluders triangle by triangle, or as clusters
+        // The occluders triangle by triangle, as clusters, and as clusters of their merged
+        // coplanar regions (SceneCullerConfig::merge_coplanar_occluders).
+        for (const auto& [clusters, merged] : {std::pair{false, false}, std::pair{true, false}, std::pair{true, true}}) {
             CullingTally tally;
-            tally_walk(scene, objects_with_role(scene, ""), 5, {640, 360}, 1, tally, DepthTest::masked, 1, 0.0, clusters);
-            const std::string what = std::string(file) + (clusters ? ", clusters" : "");
+            tally_walk(scene, objects_with_role(scene, ""), 5, {640, 360}, 1, tally, DepthTest::masked, 1, 0.0, clusters, merged);
+            const std::string what = std::string(file) + (clusters ? ", clusters" : "") + (merged ? ", coplanar regions merged" : "");
             report(what.c_str(), tally);
             EXPECT_EQ(tally.false_culls, 0u) << what;
             EXPECT_GE(tally.efficiency(), floor) << what << ": culling efficiency regressed";

@@ -110,7 +110,7 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
       config_(config),
       occluder_ids_(occluders),
       anchor_(scene_anchor(scene)),
-      occluders_(gather_world_triangles(scene, occluders, anchor_)),
+      occluders_(gather_world_triangles(scene, occluders, anchor_, config.merge_coplanar_occluders)),
       hierarchy_(ObjectHierarchy::build(scene, config.hierarchy_leaf_size)),
       buffer_(scene_buffer_config(config, 0.1f)),
       maps_(buffer_, maps_config(config)) {
@@ -131,11 +131,8 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     detail::reserve_written(rank_scratch_, occluders.size());
     // Where each candidate's triangles are, and their shared edges within the object alone.
     candidate_of_.assign(scene.objects.size(), kNone);
-    first_triangle_.push_back(0);
-    for (std::size_t k = 0; k < occluders.size(); ++k) {
-        candidate_of_[occluders[k]] = std::uint32_t(k);
-        first_triangle_.push_back(first_triangle_.back() + std::uint32_t(scene.triangle_count(scene.objects[occluders[k]])));
-    }
+    for (std::size_t k = 0; k < occluders.size(); ++k) candidate_of_[occluders[k]] = std::uint32_t(k);
+    first_triangle_ = occluders_.object_first_triangle;
     own_shared_edges_.resize(occluders_.triangle_count());
     own_edge_apexes_.resize(3 * occluders_.triangle_count());
     for (std::size_t k = 0; k < occluders.size(); ++k) {

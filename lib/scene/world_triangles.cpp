@@ -1,6 +1,7 @@
 #include <homcull/world_triangles.hpp>
 
 #include "common/float_mode.hpp"
+#include "scene/coplanar_merge.hpp"
 
 namespace homcull {
 
@@ -24,7 +25,8 @@ void append_world_positions(const Scene& scene, const Object& object, std::vecto
     }
 }
 
-WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects, const glm::dvec3& anchor) {
+WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects, const glm::dvec3& anchor,
+                                      bool merge_coplanar) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     WorldTriangles out;
     for (std::uint32_t id : objects) {
@@ -32,7 +34,15 @@ WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std:
         const Mesh& mesh = scene.meshes[object.mesh];
         const auto base = std::uint32_t(out.positions.size() / 3);
         append_world_positions(scene, object, out.positions, anchor);
+        const std::size_t first = out.indices.size();
         for (std::uint32_t index : mesh.indices) out.indices.push_back(base + index);
+        if (merge_coplanar) {
+            // On the world positions, rounded as drawn and as ground truth casts at them: the
+            // merged regions are exactly those triangles' regions.
+            const std::size_t kept = detail::merge_coplanar_triangles(out.positions.data(), out.indices.data() + first, mesh.triangle_count());
+            out.indices.resize(first + 3 * kept);
+        }
+        out.object_first_triangle.push_back(std::uint32_t(out.indices.size() / 3));
     }
     out.shared_edges.resize(out.triangle_count());
     out.edge_apexes.resize(out.indices.size());

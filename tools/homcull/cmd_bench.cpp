@@ -36,7 +36,7 @@ struct BenchOptions {
     bool complexity_given = false;
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
-    std::string occludees = "auto", closed_back_faces = "skip", back_faces = "draw", pyramid = "lazy";
+    std::string occludees = "auto", closed_back_faces = "skip", back_faces = "draw", pyramid = "lazy", merge_coplanar = "off";
     int occludee_parts = 16;
 };
 
@@ -60,6 +60,7 @@ void run_frame_workload(const BenchOptions& o) {
     if (o.clusters_given) f.cull.clusters = o.clusters > 0 ? "on" : "off";
     f.cull.closed_back_faces = o.closed_back_faces;
     f.cull.back_faces = o.back_faces;
+    f.cull.merge_coplanar = o.merge_coplanar;
     f.cull.pyramid = o.pyramid;
     f.cull.occludee_parts = o.occludee_parts;
     f.cull.complexity = o.complexity;
@@ -287,6 +288,9 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--back-faces", o->back_faces,
                     "frame: draw or cull every occluder triangle facing away from the eye (cull --back-faces)")
         ->capture_default_str()->check(CLI::IsMember({"draw", "cull"}));
+    cmd->add_option("--merge-coplanar", o->merge_coplanar,
+                    "frame: re-triangulate each occluder's exactly coplanar regions when loading, or not (cull --merge-coplanar)")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     cmd->add_option("--occludee-parts", o->occludee_parts, "frame: parts per object with a box each (cull --occludee-parts)")
         ->capture_default_str()->check(CLI::Range(0, 64));
     cmd->add_option("--pyramid", o->pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")

@@ -73,6 +73,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
                    "are skipped, --closed-back-faces); cull: none is drawn (front faces counter-clockwise, glTF's convention, "
                    "as the peers' drivers draw): a faster render, and less culled where a back face is all that hides an object")
         ->capture_default_str()->check(CLI::IsMember({"draw", "cull"}));
+    app.add_option("--merge-coplanar", o.merge_coplanar,
+                   "on: when the scene is loaded, re-triangulate each occluder's exactly coplanar regions with fewer triangles "
+                   "covering the same points (brush maps: half the triangles); off: draw the triangles as the scene has them")
+        ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--occluders", o.occluders, "Occluder candidates: role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
     app.add_option("--complexity", o.complexity,
@@ -134,6 +138,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o, int threads) {
     c.sample_depth = o.sample_depth == "on";
     c.occluder_clusters = o.clusters == "on";
     c.skip_closed_back_faces = o.closed_back_faces == "skip";
+    c.merge_coplanar_occluders = o.merge_coplanar == "on";
     c.backface = o.back_faces == "cull" ? Backface::cw : Backface::none;  // cw on screen: the back of a counter-clockwise front
     c.strategy = o.strategy == "progressive" ? CullStrategy::progressive : o.strategy == "temporal" ? CullStrategy::temporal
                                                                                                  : CullStrategy::one_pass;

@@ -51,6 +51,7 @@ nlohmann::json cull_config_json(const CullOptions& o) {
             {"clusters", o.clusters},
             {"closed_back_faces", o.closed_back_faces},
             {"back_faces", o.back_faces},
+            {"merge_coplanar", o.merge_coplanar},
             {"occluders", o.occluders},
             {"complexity", o.complexity},
             {"strategy", o.strategy},

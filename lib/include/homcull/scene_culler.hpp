@@ -85,6 +85,10 @@ struct SceneCullerConfig {
     // occluder triangles out can never hide what is visible (docs/scene-culling.md, "Closed
     // occluders", has what it costs in culling).
     bool skip_closed_back_faces = true;
+    // Draw each occluder with its exactly coplanar regions re-triangulated, when the culler is
+    // made: fewer triangles covering the same points at the same depths (gather_world_triangles;
+    // docs/scene-culling.md, "Coplanar merge").
+    bool merge_coplanar_occluders = false;
     // Occludee shape: the world box alone, or, where the box is found visible, the object's
     // triangles (much tighter for objects whose box reaches past what hides them, at the cost
     // of transforming their vertices). Objects with more than triangle_test_limit triangles

@@ -16,6 +16,9 @@ struct WorldTriangles {
     std::vector<std::uint32_t> indices;
     std::vector<std::uint8_t> shared_edges;
     std::vector<std::uint32_t> edge_apexes;  // 3 per triangle (compute_shared_edges)
+    // Object k's triangles are [object_first_triangle[k], object_first_triangle[k + 1]), in the
+    // order the objects were given.
+    std::vector<std::uint32_t> object_first_triangle{0};
 
     std::size_t triangle_count() const { return indices.size() / 3; }
     TriangleInput input(const std::array<float, 16>& clip_from_world, Backface backface = Backface::cw) const;
@@ -26,9 +29,12 @@ struct WorldTriangles {
 void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions,
                             const glm::dvec3& anchor = glm::dvec3(0.0));
 
-// The triangles of the given objects, relative to `anchor`. Allocates: meant for load time or tools.
+// The triangles of the given objects, relative to `anchor`. With merge_coplanar, each object's
+// exactly coplanar regions are re-triangulated with fewer triangles covering the same points
+// (in world space, as drawn and as ground truth sees them: docs/scene-culling.md, "Coplanar
+// merge"). Allocates: meant for load time or tools.
 WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects,
-                                      const glm::dvec3& anchor = glm::dvec3(0.0));
+                                      const glm::dvec3& anchor = glm::dvec3(0.0), bool merge_coplanar = false);
 
 // Ids of the objects whose extra "role" equals `role`, or of every object when role is empty.
 std::vector<std::uint32_t> objects_with_role(const Scene& scene, std::string_view role);

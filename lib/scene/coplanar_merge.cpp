@@ -1,0 +1,246 @@
+#include "scene/coplanar_merge.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+#include <vector>
+
+namespace homcull::detail {
+namespace {
+
+// 128-bit integers (GCC and Clang): the products below reach 2^126 at most.
+__extension__ typedef __int128 Int;
+using Point = std::array<std::int64_t, 3>;
+using Vector = std::array<Int, 3>;
+
+// Coordinates need at most this many bits on the grid: differences take 41, cross products 83,
+// a plane's offset (a reduced normal times a point, summed) 126.
+constexpr int kGridBits = 40;
+
+Vector cross(const Point& o, const Point& a, const Point& b) {
+    const Int ax = a[0] - o[0], ay = a[1] - o[1], az = a[2] - o[2];
+    const Int bx = b[0] - o[0], by = b[1] - o[1], bz = b[2] - o[2];
+    return {ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx};
+}
+
+Int absolute(Int v) { return v < 0 ? -v : v; }
+
+Int gcd(Int a, Int b) {
+    a = absolute(a), b = absolute(b);
+    while (b != 0) {
+        const Int r = a % b;
+        a = b, b = r;
+    }
+    return a;
+}
+
+// A triangle's plane, exactly: its normal divided by the normal's gcd (so that every triangle of
+// the plane facing the same way has the same one) and the offset of its points along it.
+struct Plane {
+    Vector normal;
+    Int offset;
+    bool operator<(const Plane& o) const {
+        if (normal != o.normal) return normal < o.normal;
+        return offset < o.offset;
+    }
+};
+
+// The positions on the finest binary grid that holds them all: each coordinate an integer
+// multiple of 2^lowest (the lowest set bit among them). False when that takes more than
+// kGridBits bits, or a coordinate is not finite.
+bool integer_grid(const float* positions, const std::vector<std::uint32_t>& vertices, std::vector<Point>& grid) {
+    int lowest = 1 << 20;
+    float largest = 0.0f;
+    for (const std::uint32_t v : vertices)
+        for (int axis = 0; axis < 3; ++axis) {
+            const float x = positions[3 * std::size_t(v) + std::size_t(axis)];
+            if (!std::isfinite(x)) return false;
+            if (x == 0.0f) continue;
+            int exponent = 0;
+            const float mantissa = std::frexp(x, &exponent);  // |mantissa| in [0.5, 1): x = mantissa 2^exponent
+            std::uint32_t bits = std::uint32_t(std::abs(std::ldexp(double(mantissa), 24)));  // 24 significant bits, exact
+            int trailing = 0;
+            while ((bits & 1u) == 0) bits >>= 1, ++trailing;
+            lowest = std::min(lowest, exponent - 24 + trailing);
+            largest = std::max(largest, std::abs(x));
+        }
+    if (largest == 0.0f) lowest = 0;
+    if (std::ldexp(double(largest), -lowest) >= std::ldexp(1.0, kGridBits)) return false;
+    grid.resize(vertices.size());
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+        for (int axis = 0; axis < 3; ++axis)
+            grid[i][std::size_t(axis)] = std::int64_t(std::ldexp(double(positions[3 * std::size_t(vertices[i]) + std::size_t(axis)]), -lowest));
+    return true;
+}
+
+struct Merger {
+    std::vector<Point> point;                      // per welded vertex
+    std::vector<std::array<std::uint32_t, 3>> tri;  // welded vertices
+    std::vector<int> plane_of;                      // per triangle: its plane, -1 degenerate
+    std::vector<Plane> planes;
+    std::vector<int> axis_of_plane;                 // the normal's largest component: the sign test's
+    std::vector<bool> alive;
+    std::vector<std::vector<std::uint32_t>> around;  // per vertex: the triangles that used it (some dead)
+
+    // The normal's component on the plane's axis of a triangle made of a, b, c: the sign of its
+    // facing against the plane's (the three lie in the plane, so the normals are parallel).
+    Int facing(int plane, std::uint32_t a, std::uint32_t b, std::uint32_t c) const {
+        return cross(point[a], point[b], point[c])[std::size_t(axis_of_plane[std::size_t(plane)])];
+    }
+
+    // One plane's triangles around v as a fan: next[a] = c for each triangle (v, a, c).
+    struct Fan {
+        int plane;
+        std::vector<std::uint32_t> triangles;
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;  // (a, c)
+        std::uint32_t first = 0, last = 0;  // a boundary fan's ends: c0 (no triangle before), a0 (no triangle after)
+        bool boundary = false;
+    };
+
+    bool collapse(std::uint32_t v) {
+        std::vector<Fan> fans;
+        for (const std::uint32_t t : around[v]) {
+            if (!alive[t]) continue;
+            const int plane = plane_of[t];
+            if (plane < 0) return false;
+            auto fan = std::find_if(fans.begin(), fans.end(), [&](const Fan& f) { return f.plane == plane; });
+            if (fan == fans.end()) fan = fans.insert(fans.end(), Fan{plane, {}, {}});
+            const auto& x = tri[t];
+            const int i = x[0] == v ? 0 : x[1] == v ? 1 : 2;
+            fan->triangles.push_back(t);
+            fan->edges.push_back({x[std::size_t((i + 1) % 3)], x[std::size_t((i + 2) % 3)]});
+        }
+        if (fans.empty()) return false;
+        for (Fan& f : fans) {
+            // A manifold fan: each neighbour starts at most one edge and ends at most one.
+            std::vector<std::uint32_t> starts, ends;
+            for (const auto& [a, c] : f.edges) {
+                if (std::count_if(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.first == a; }) != 1) return false;
+                if (std::count_if(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.second == c; }) != 1) return false;
+                if (std::none_of(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.second == a; })) starts.push_back(a);
+                if (std::none_of(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.first == c; })) ends.push_back(c);
+            }
+            if (starts.size() > 1) return false;
+            f.boundary = starts.size() == 1;
+            if (!f.boundary) continue;
+            // v on the region's boundary, from ends[0] (before it) to starts[0] (after it):
+            // it goes only when it lies on the straight segment between them.
+            f.first = ends[0], f.last = starts[0];
+            const Vector turn = cross(point[v], point[f.last], point[f.first]);
+            if (turn[0] != 0 || turn[1] != 0 || turn[2] != 0) return false;
+            Int along = 0;
+            for (std::size_t k = 0; k < 3; ++k) along += Int(point[v][k] - point[f.first][k]) * Int(point[f.last][k] - point[v][k]);
+            if (along <= 0) return false;
+        }
+        // An interior vertex (one closed fan) may go to any neighbour; a boundary one only along
+        // its line, to the same neighbour on every plane (no crack where two planes meet).
+        std::vector<std::uint32_t> targets;
+        if (fans.size() == 1 && !fans[0].boundary) {
+            for (const auto& e : fans[0].edges) targets.push_back(e.first);
+        } else {
+            for (const Fan& f : fans)
+                if (!f.boundary) return false;
+            for (const std::uint32_t u : {fans[0].first, fans[0].last})
+                if (std::all_of(fans.begin(), fans.end(), [&](const Fan& f) { return f.first == u || f.last == u; })) targets.push_back(u);
+        }
+        for (const std::uint32_t u : targets) {
+            // Every triangle that keeps its area, re-made with u for v, must face as its plane.
+            bool valid = true;
+            for (const Fan& f : fans) {
+                const Int sign = planes[std::size_t(f.plane)].normal[std::size_t(axis_of_plane[std::size_t(f.plane)])];
+                for (const auto& [a, c] : f.edges) {
+                    if (a == u || c == u) continue;
+                    const Int n = facing(f.plane, u, a, c);
+                    if (n == 0 || (n > 0) != (sign > 0)) valid = false;
+                }
+            }
+            if (!valid) continue;
+            for (const Fan& f : fans)
+                for (const std::uint32_t t : f.triangles) {
+                    auto& x = tri[t];
+                    if (x[0] == u || x[1] == u || x[2] == u) {
+                        alive[t] = false;
+                        continue;
+                    }
+                    for (std::uint32_t& w : x)
+                        if (w == v) w = u;
+                    around[u].push_back(t);
+                }
+            around[v].clear();
+            return true;
+        }
+        return false;
+    }
+};
+
+}  // namespace
+
+std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* triangles, std::size_t triangle_count) {
+    if (triangle_count < 2) return triangle_count;
+    // Weld equal positions (by their bits; +0 and -0 apart, which only keeps a vertex): each
+    // welded vertex keeps the first index that had its position, for the output.
+    Merger m;
+    std::vector<std::uint32_t> original;  // per welded vertex
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> by_hash;
+    std::vector<std::uint32_t> welded_of(3 * triangle_count);
+    for (std::size_t i = 0; i < 3 * triangle_count; ++i) {
+        const float* p = positions + 3 * std::size_t(triangles[i]);
+        std::uint32_t bits[3];
+        std::memcpy(bits, p, sizeof bits);
+        const std::uint64_t hash = (std::uint64_t(bits[0]) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(bits[1]) * 0xC2B2AE3D27D4EB4Full) ^ bits[2];
+        std::vector<std::uint32_t>& bucket = by_hash[hash];
+        auto same = std::find_if(bucket.begin(), bucket.end(), [&](std::uint32_t w) {
+            return std::memcmp(positions + 3 * std::size_t(original[w]), p, 3 * sizeof(float)) == 0;
+        });
+        if (same == bucket.end()) {
+            bucket.push_back(std::uint32_t(original.size()));
+            original.push_back(triangles[i]);
+            same = bucket.end() - 1;
+        }
+        welded_of[i] = *same;
+    }
+    if (!integer_grid(positions, original, m.point)) return triangle_count;
+
+    std::map<Plane, int> plane_ids;
+    m.tri.resize(triangle_count);
+    m.plane_of.assign(triangle_count, -1);
+    m.alive.assign(triangle_count, true);
+    m.around.resize(original.size());
+    for (std::size_t t = 0; t < triangle_count; ++t) {
+        auto& x = m.tri[t];
+        for (std::size_t k = 0; k < 3; ++k) x[k] = welded_of[3 * t + k];
+        for (const std::uint32_t v : x) m.around[v].push_back(std::uint32_t(t));
+        if (x[0] == x[1] || x[1] == x[2] || x[0] == x[2]) continue;
+        Vector n = cross(m.point[x[0]], m.point[x[1]], m.point[x[2]]);
+        const Int g = gcd(gcd(n[0], n[1]), n[2]);
+        if (g == 0) continue;  // no area
+        for (Int& c : n) c /= g;
+        Int offset = 0;
+        for (std::size_t k = 0; k < 3; ++k) offset += n[k] * m.point[x[0]][k];
+        const auto [at, added] = plane_ids.insert({Plane{n, offset}, int(m.planes.size())});
+        if (added) {
+            m.planes.push_back(at->first);
+            std::size_t axis = 0;
+            for (std::size_t k = 1; k < 3; ++k)
+                if (absolute(n[k]) > absolute(n[axis])) axis = k;
+            m.axis_of_plane.push_back(int(axis));
+        }
+        m.plane_of[t] = at->second;
+    }
+    for (bool changed = true; changed;) {
+        changed = false;
+        for (std::uint32_t v = 0; v < std::uint32_t(original.size()); ++v) changed |= m.collapse(v);
+    }
+    std::size_t kept = 0;
+    for (std::size_t t = 0; t < triangle_count; ++t) {
+        if (!m.alive[t]) continue;
+        for (std::size_t k = 0; k < 3; ++k) triangles[3 * kept + k] = original[m.tri[t][k]];
+        ++kept;
+    }
+    return kept;
+}
+
+}  // namespace homcull::detail
