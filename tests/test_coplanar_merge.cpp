@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -56,7 +58,9 @@ struct Soup {
         for (std::size_t t = 0; t < count; ++t) sum += 0.5 * normal(t);
         return sum;
     }
-    std::size_t merge() { return detail::merge_coplanar_triangles(positions.data(), triangles.data(), triangles.size() / 3); }
+    std::size_t merge(const std::uint8_t* keep = nullptr) {
+        return detail::merge_coplanar_triangles(positions.data(), triangles.data(), triangles.size() / 3, keep);
+    }
 };
 
 TEST(CoplanarMerge, FlatGridBecomesTwoTriangles) {
@@ -103,6 +107,19 @@ TEST(CoplanarMerge, CreaseBetweenTwoPlanesKeepsOneEdgeOnBothSides) {
     }
 }
 
+// A vertex marked to stay (one another mesh uses) stays, and the straight edges through it keep
+// it: the neighbour's edges still match these.
+TEST(CoplanarMerge, VerticesMarkedToStayStay) {
+    Soup s;
+    s.grid({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 4, 1);  // vertices 0..4 along y = 0, 5..9 along y = 1
+    std::vector<std::uint8_t> keep(s.positions.size() / 3, 0);
+    keep[2] = 1;  // the middle of the lower edge, shared with a mesh below
+    const std::size_t kept = s.merge(keep.data());
+    EXPECT_EQ(kept, 3u);
+    std::set<std::uint32_t> used(s.triangles.begin(), s.triangles.begin() + std::ptrdiff_t(3 * kept));
+    EXPECT_EQ(used, (std::set<std::uint32_t>{0, 2, 4, 5, 9}));
+}
+
 TEST(CoplanarMerge, WhatIsNotExactlyFlatOrOnAGridStays) {
     Soup bent;
     bent.grid({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 3, 3);
@@ -132,7 +149,8 @@ TEST(CoplanarMerge, WhatIsNotExactlyFlatOrOnAGridStays) {
 }
 
 // The OpenArena maps, merged as the scene culler merges them (gather_world_triangles): about
-// half the triangles (brush splits), each object's area vector and bounds unchanged.
+// half the triangles (brush splits), each object's area vector and bounds unchanged, and every
+// edge two objects shared still in both (no crack between objects).
 TEST(CoplanarMerge, OpenArenaMapsHalveAndEachObjectKeepsItsSurface) {
     const std::string file = test::shared_scene("openarena_pul1duel-oa.glb");
     if (file.empty()) GTEST_SKIP() << "openarena_pul1duel-oa.glb is missing from " << test::shared_scenes_dir();
@@ -140,11 +158,36 @@ TEST(CoplanarMerge, OpenArenaMapsHalveAndEachObjectKeepsItsSurface) {
     const std::vector<std::uint32_t> all = objects_with_role(scene, "");
     const WorldTriangles original = gather_world_triangles(scene, all), merged = gather_world_triangles(scene, all, glm::dvec3(0.0), true);
     ASSERT_EQ(merged.object_first_triangle.size(), all.size() + 1);
-    EXPECT_LT(merged.triangle_count(), original.triangle_count() * 55 / 100);
+    EXPECT_LT(merged.triangle_count(), original.triangle_count() * 60 / 100);
     EXPECT_EQ(merged.positions, original.positions);
     const auto vertex = [](const WorldTriangles& w, std::size_t i) {
         return glm::dvec3(w.positions[3 * w.indices[i]], w.positions[3 * w.indices[i] + 1], w.positions[3 * w.indices[i] + 2]);
     };
+    // Undirected edges by their end positions, and the objects that have each.
+    using Position = std::array<float, 3>;
+    const auto edges_of_objects = [&](const WorldTriangles& w) {
+        std::map<std::pair<Position, Position>, std::set<std::size_t>> edges;
+        for (std::size_t k = 0; k < all.size(); ++k)
+            for (std::size_t t = w.object_first_triangle[k]; t < w.object_first_triangle[k + 1]; ++t)
+                for (std::size_t e = 0; e < 3; ++e) {
+                    const std::uint32_t a = w.indices[3 * t + e], b = w.indices[3 * t + (e + 1) % 3];
+                    Position pa{w.positions[3 * a], w.positions[3 * a + 1], w.positions[3 * a + 2]};
+                    Position pb{w.positions[3 * b], w.positions[3 * b + 1], w.positions[3 * b + 2]};
+                    if (pb < pa) std::swap(pa, pb);
+                    edges[{pa, pb}].insert(k);
+                }
+        return edges;
+    };
+    const auto before = edges_of_objects(original), after = edges_of_objects(merged);
+    std::size_t shared = 0;
+    for (const auto& [edge, owners] : before) {
+        if (owners.size() < 2) continue;
+        ++shared;
+        const auto now = after.find(edge);
+        ASSERT_TRUE(now != after.end()) << "an edge between objects is gone";
+        EXPECT_TRUE(std::includes(now->second.begin(), now->second.end(), owners.begin(), owners.end()));
+    }
+    EXPECT_GT(shared, 1000u);
     for (std::size_t k = 0; k < all.size(); ++k) {
         glm::dvec3 area[2] = {glm::dvec3(0.0), glm::dvec3(0.0)}, lo[2], hi[2];
         double unsigned_area[2] = {0.0, 0.0};

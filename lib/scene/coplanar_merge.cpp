@@ -84,6 +84,7 @@ struct Merger {
     std::vector<int> axis_of_plane;                 // the normal's largest component: the sign test's
     std::vector<bool> alive;
     std::vector<std::vector<std::uint32_t>> around;  // per vertex: the triangles that used it (some dead)
+    std::vector<std::uint8_t> kept;                  // per vertex: it stays (merge_coplanar_triangles' keep)
 
     // The normal's component on the plane's axis of a triangle made of a, b, c: the sign of its
     // facing against the plane's (the three lie in the plane, so the normals are parallel).
@@ -101,6 +102,7 @@ struct Merger {
     };
 
     bool collapse(std::uint32_t v) {
+        if (kept[v]) return false;
         std::vector<Fan> fans;
         for (const std::uint32_t t : around[v]) {
             if (!alive[t]) continue;
@@ -178,7 +180,7 @@ struct Merger {
 
 }  // namespace
 
-std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* triangles, std::size_t triangle_count) {
+std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* triangles, std::size_t triangle_count, const std::uint8_t* keep) {
     if (triangle_count < 2) return triangle_count;
     // Weld equal positions (by their bits; +0 and -0 apart, which only keeps a vertex): each
     // welded vertex keeps the first index that had its position, for the output.
@@ -203,6 +205,9 @@ std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* tria
         welded_of[i] = *same;
     }
     if (!integer_grid(positions, original, m.point)) return triangle_count;
+    m.kept.assign(original.size(), 0);
+    if (keep)
+        for (std::size_t i = 0; i < 3 * triangle_count; ++i) m.kept[welded_of[i]] |= keep[triangles[i]];
 
     std::map<Plane, int> plane_ids;
     m.tri.resize(triangle_count);

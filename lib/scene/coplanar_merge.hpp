@@ -22,7 +22,14 @@ namespace homcull::detail {
 // in 128-bit arithmetic. An object whose coordinates need more than 40 bits on that grid (widely
 // different magnitudes: a floor 1e4 wide with details of 1e-5) is left as it is, and so are its
 // degenerate triangles and the vertices they touch. Equal positions count as one vertex.
+//
+// keep (null: none), per position index: vertices that stay whatever their triangles, such as
+// those other meshes drawn beside this one also use. An edge two meshes share, the same two
+// vertices in both, keeps the rasterizer's shared-edge rule (each sample on it covered once);
+// with one side's vertex on it gone the two sides' edges would differ, and the samples exactly on
+// them would be covered by neither: a crack the farther surface shows through.
 // Allocates (load time).
-std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* triangles, std::size_t triangle_count);
+std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* triangles, std::size_t triangle_count,
+                                     const std::uint8_t* keep = nullptr);
 
 }  // namespace homcull::detail

@@ -3,6 +3,9 @@
 #include "common/float_mode.hpp"
 #include "scene/coplanar_merge.hpp"
 
+#include <cstring>
+#include <unordered_map>
+
 namespace homcull {
 
 TriangleInput WorldTriangles::input(const std::array<float, 16>& clip_from_world, Backface backface) const {
@@ -25,6 +28,48 @@ void append_world_positions(const Scene& scene, const Object& object, std::vecto
     }
 }
 
+namespace {
+
+// Each object's coplanar regions merged (merge_coplanar_triangles), on the world positions,
+// rounded as drawn and as ground truth casts at them: the merged regions are exactly those
+// triangles' regions. A vertex whose position another object's triangles use stays, so that the
+// edges objects share stay shared.
+void merge_coplanar_regions(WorldTriangles& w) {
+    const std::size_t objects = w.object_first_triangle.size() - 1;
+    std::unordered_map<std::uint64_t, std::uint32_t> object_at;  // position bits -> the object using it, or kMany
+    constexpr std::uint32_t kMany = ~0u;
+    std::vector<std::uint64_t> key(w.positions.size() / 3);
+    for (std::size_t i = 0; i < key.size(); ++i) {
+        std::uint32_t bits[3];
+        std::memcpy(bits, &w.positions[3 * i], sizeof bits);
+        // Three 32-bit patterns folded into 64 bits: a collision only keeps a vertex more.
+        key[i] = (std::uint64_t(bits[0]) << 32 | bits[1]) ^ (std::uint64_t(bits[2]) * 0x9E3779B97F4A7C15ull);
+    }
+    for (std::size_t k = 0; k < objects; ++k)
+        for (std::size_t i = 3 * std::size_t(w.object_first_triangle[k]); i < 3 * std::size_t(w.object_first_triangle[k + 1]); ++i) {
+            const auto [at, added] = object_at.insert({key[w.indices[i]], std::uint32_t(k)});
+            if (!added && at->second != k) at->second = kMany;
+        }
+    std::vector<std::uint8_t> keep(key.size());
+    for (std::size_t i = 0; i < key.size(); ++i) {
+        const auto at = object_at.find(key[i]);
+        keep[i] = at != object_at.end() && at->second == kMany;
+    }
+    std::vector<std::uint32_t> indices;
+    std::vector<std::uint32_t> first{0};
+    for (std::size_t k = 0; k < objects; ++k) {
+        const std::size_t begin = 3 * std::size_t(w.object_first_triangle[k]), end = 3 * std::size_t(w.object_first_triangle[k + 1]);
+        std::vector<std::uint32_t> own(w.indices.begin() + std::ptrdiff_t(begin), w.indices.begin() + std::ptrdiff_t(end));
+        own.resize(3 * detail::merge_coplanar_triangles(w.positions.data(), own.data(), own.size() / 3, keep.data()));
+        indices.insert(indices.end(), own.begin(), own.end());
+        first.push_back(std::uint32_t(indices.size() / 3));
+    }
+    w.indices = std::move(indices);
+    w.object_first_triangle = std::move(first);
+}
+
+}  // namespace
+
 WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects, const glm::dvec3& anchor,
                                       bool merge_coplanar) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
@@ -34,16 +79,10 @@ WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std:
         const Mesh& mesh = scene.meshes[object.mesh];
         const auto base = std::uint32_t(out.positions.size() / 3);
         append_world_positions(scene, object, out.positions, anchor);
-        const std::size_t first = out.indices.size();
         for (std::uint32_t index : mesh.indices) out.indices.push_back(base + index);
-        if (merge_coplanar) {
-            // On the world positions, rounded as drawn and as ground truth casts at them: the
-            // merged regions are exactly those triangles' regions.
-            const std::size_t kept = detail::merge_coplanar_triangles(out.positions.data(), out.indices.data() + first, mesh.triangle_count());
-            out.indices.resize(first + 3 * kept);
-        }
         out.object_first_triangle.push_back(std::uint32_t(out.indices.size() / 3));
     }
+    if (merge_coplanar) merge_coplanar_regions(out);
     out.shared_edges.resize(out.triangle_count());
     out.edge_apexes.resize(out.indices.size());
     compute_shared_edges(out.positions.data(), 3 * sizeof(float), out.positions.size() / 3, out.indices.data(),
