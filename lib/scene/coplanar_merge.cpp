@@ -101,67 +101,78 @@ struct Merger {
         bool boundary = false;
     };
 
-    bool collapse(std::uint32_t v) {
+    // Scratch reused from vertex to vertex (the first sweep visits every vertex).
+    std::vector<Fan> fan_room;
+    std::vector<std::uint32_t> starts, ends, targets;
+
+    // Collapses v into a neighbour when it can; then `moved_to` is that neighbour.
+    bool collapse(std::uint32_t v, std::uint32_t& moved_to) {
         if (kept[v]) return false;
-        std::vector<Fan> fans;
+        std::size_t fan_count = 0;
         for (const std::uint32_t t : around[v]) {
             if (!alive[t]) continue;
             const int plane = plane_of[t];
             if (plane < 0) return false;
-            auto fan = std::find_if(fans.begin(), fans.end(), [&](const Fan& f) { return f.plane == plane; });
-            if (fan == fans.end()) fan = fans.insert(fans.end(), Fan{plane, {}, {}});
+            auto fan = std::find_if(fan_room.begin(), fan_room.begin() + std::ptrdiff_t(fan_count), [&](const Fan& f) { return f.plane == plane; });
+            if (fan == fan_room.begin() + std::ptrdiff_t(fan_count)) {
+                if (fan_count == fan_room.size()) fan_room.emplace_back();
+                fan = fan_room.begin() + std::ptrdiff_t(fan_count++);
+                fan->plane = plane, fan->boundary = false;
+                fan->triangles.clear(), fan->edges.clear();
+            }
             const auto& x = tri[t];
             const int i = x[0] == v ? 0 : x[1] == v ? 1 : 2;
             fan->triangles.push_back(t);
             fan->edges.push_back({x[std::size_t((i + 1) % 3)], x[std::size_t((i + 2) % 3)]});
         }
-        if (fans.empty()) return false;
-        for (Fan& f : fans) {
+        if (fan_count == 0) return false;
+        const auto fans_begin = fan_room.begin(), fans_end = fan_room.begin() + std::ptrdiff_t(fan_count);
+        for (auto f = fans_begin; f != fans_end; ++f) {
             // A manifold fan: each neighbour starts at most one edge and ends at most one.
-            std::vector<std::uint32_t> starts, ends;
-            for (const auto& [a, c] : f.edges) {
-                if (std::count_if(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.first == a; }) != 1) return false;
-                if (std::count_if(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.second == c; }) != 1) return false;
-                if (std::none_of(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.second == a; })) starts.push_back(a);
-                if (std::none_of(f.edges.begin(), f.edges.end(), [&](const auto& e) { return e.first == c; })) ends.push_back(c);
+            starts.clear(), ends.clear();
+            for (const auto& [a, c] : f->edges) {
+                if (std::count_if(f->edges.begin(), f->edges.end(), [&](const auto& e) { return e.first == a; }) != 1) return false;
+                if (std::count_if(f->edges.begin(), f->edges.end(), [&](const auto& e) { return e.second == c; }) != 1) return false;
+                if (std::none_of(f->edges.begin(), f->edges.end(), [&](const auto& e) { return e.second == a; })) starts.push_back(a);
+                if (std::none_of(f->edges.begin(), f->edges.end(), [&](const auto& e) { return e.first == c; })) ends.push_back(c);
             }
             if (starts.size() > 1) return false;
-            f.boundary = starts.size() == 1;
-            if (!f.boundary) continue;
+            f->boundary = starts.size() == 1;
+            if (!f->boundary) continue;
             // v on the region's boundary, from ends[0] (before it) to starts[0] (after it):
             // it goes only when it lies on the straight segment between them.
-            f.first = ends[0], f.last = starts[0];
-            const Vector turn = cross(point[v], point[f.last], point[f.first]);
+            f->first = ends[0], f->last = starts[0];
+            const Vector turn = cross(point[v], point[f->last], point[f->first]);
             if (turn[0] != 0 || turn[1] != 0 || turn[2] != 0) return false;
             Int along = 0;
-            for (std::size_t k = 0; k < 3; ++k) along += Int(point[v][k] - point[f.first][k]) * Int(point[f.last][k] - point[v][k]);
+            for (std::size_t k = 0; k < 3; ++k) along += Int(point[v][k] - point[f->first][k]) * Int(point[f->last][k] - point[v][k]);
             if (along <= 0) return false;
         }
         // An interior vertex (one closed fan) may go to any neighbour; a boundary one only along
         // its line, to the same neighbour on every plane (no crack where two planes meet).
-        std::vector<std::uint32_t> targets;
-        if (fans.size() == 1 && !fans[0].boundary) {
-            for (const auto& e : fans[0].edges) targets.push_back(e.first);
+        targets.clear();
+        if (fan_count == 1 && !fans_begin->boundary) {
+            for (const auto& e : fans_begin->edges) targets.push_back(e.first);
         } else {
-            for (const Fan& f : fans)
-                if (!f.boundary) return false;
-            for (const std::uint32_t u : {fans[0].first, fans[0].last})
-                if (std::all_of(fans.begin(), fans.end(), [&](const Fan& f) { return f.first == u || f.last == u; })) targets.push_back(u);
+            for (auto f = fans_begin; f != fans_end; ++f)
+                if (!f->boundary) return false;
+            for (const std::uint32_t u : {fans_begin->first, fans_begin->last})
+                if (std::all_of(fans_begin, fans_end, [&](const Fan& f) { return f.first == u || f.last == u; })) targets.push_back(u);
         }
         for (const std::uint32_t u : targets) {
             // Every triangle that keeps its area, re-made with u for v, must face as its plane.
             bool valid = true;
-            for (const Fan& f : fans) {
-                const Int sign = planes[std::size_t(f.plane)].normal[std::size_t(axis_of_plane[std::size_t(f.plane)])];
-                for (const auto& [a, c] : f.edges) {
+            for (auto f = fans_begin; f != fans_end; ++f) {
+                const Int sign = planes[std::size_t(f->plane)].normal[std::size_t(axis_of_plane[std::size_t(f->plane)])];
+                for (const auto& [a, c] : f->edges) {
                     if (a == u || c == u) continue;
-                    const Int n = facing(f.plane, u, a, c);
+                    const Int n = facing(f->plane, u, a, c);
                     if (n == 0 || (n > 0) != (sign > 0)) valid = false;
                 }
             }
             if (!valid) continue;
-            for (const Fan& f : fans)
-                for (const std::uint32_t t : f.triangles) {
+            for (auto f = fans_begin; f != fans_end; ++f)
+                for (const std::uint32_t t : f->triangles) {
                     auto& x = tri[t];
                     if (x[0] == u || x[1] == u || x[2] == u) {
                         alive[t] = false;
@@ -172,6 +183,7 @@ struct Merger {
                     around[u].push_back(t);
                 }
             around[v].clear();
+            moved_to = u;
             return true;
         }
         return false;
@@ -235,9 +247,21 @@ std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* tria
         }
         m.plane_of[t] = at->second;
     }
-    for (bool changed = true; changed;) {
-        changed = false;
-        for (std::uint32_t v = 0; v < std::uint32_t(original.size()); ++v) changed |= m.collapse(v);
+    // Every vertex once, then again those around a collapse (their fans changed).
+    std::vector<std::uint32_t> pending(original.size());
+    std::vector<std::uint8_t> is_pending(original.size(), 1);
+    for (std::size_t v = 0; v < original.size(); ++v) pending[v] = std::uint32_t(original.size() - 1 - v);
+    while (!pending.empty()) {
+        const std::uint32_t v = pending.back();
+        pending.pop_back();
+        is_pending[v] = 0;
+        std::uint32_t u = 0;
+        if (!m.collapse(v, u)) continue;
+        for (const std::uint32_t t : m.around[u]) {
+            if (!m.alive[t]) continue;
+            for (const std::uint32_t w : m.tri[t])
+                if (!is_pending[w]) is_pending[w] = 1, pending.push_back(w);
+        }
     }
     std::size_t kept = 0;
     for (std::size_t t = 0; t < triangle_count; ++t) {
