@@ -20,6 +20,17 @@ Camera looking_down_minus_z() {
 
 Aabb box(glm::vec3 lo, glm::vec3 hi) { return Aabb{lo, hi}; }
 
+// A camera near the origin looking at a random point, with a random field of view.
+Camera random_camera(std::mt19937_64& rng, std::uniform_real_distribution<double>& pos, double far_plane) {
+    Camera c;
+    c.eye = {pos(rng) * 0.2, pos(rng) * 0.2, pos(rng) * 0.2};
+    c.target = {pos(rng), pos(rng), pos(rng)};
+    c.fov_y_degrees = 30.0 + double(rng() % 90);
+    c.near_plane = 0.5;
+    c.far_plane = far_plane;
+    return c;
+}
+
 TEST(Frustum, ObviousCases) {
     const Frustum f = make_frustum(looking_down_minus_z(), 1.0);
     EXPECT_TRUE(intersects(f, box({-1, -1, -10}, {1, 1, -8})));       // straight ahead
@@ -73,12 +84,7 @@ TEST(Frustum, ExactAgainstClippingOracleOnRandomBoxes) {
     std::uniform_real_distribution<double> pos(-60.0, 60.0), size(0.1, 15.0);
     int disagreements = 0, plane_test_keeps_outside = 0;
     for (int camera_trial = 0; camera_trial < 20; ++camera_trial) {
-        Camera c;
-        c.eye = {pos(rng) * 0.2, pos(rng) * 0.2, pos(rng) * 0.2};
-        c.target = {pos(rng), pos(rng), pos(rng)};
-        c.fov_y_degrees = 30.0 + double(rng() % 90);
-        c.near_plane = 0.5;
-        c.far_plane = 80.0;
+        const Camera c = random_camera(rng, pos, 80.0);
         const Frustum f = make_frustum(c, 1.6);
         for (int k = 0; k < 2000; ++k) {
             const glm::vec3 lo(glm::dvec3(pos(rng), pos(rng), pos(rng)));
@@ -156,12 +162,7 @@ TEST(Frustum, ViewVolumeOfAClipMatrixIsTheCamerasFrustumWithoutItsFarPlane) {
     for (const bool orthographic : {false, true}) {
         int apart = 0, apart_with_margin = 0, corner_boxes = 0;
         for (int camera_trial = 0; camera_trial < 20; ++camera_trial) {
-            Camera c;
-            c.eye = {pos(rng) * 0.2, pos(rng) * 0.2, pos(rng) * 0.2};
-            c.target = {pos(rng), pos(rng), pos(rng)};
-            c.fov_y_degrees = 30.0 + double(rng() % 90);
-            c.near_plane = 0.5;
-            c.far_plane = 1e6;  // beyond every box: the volume has no far plane
+            Camera c = random_camera(rng, pos, 1e6);  // the far plane beyond every box: the volume has none
             if (orthographic) c.ortho_height = 20.0 + double(rng() % 40);
             const double aspect = 1.6;
             const Frustum f = make_frustum(c, aspect);
