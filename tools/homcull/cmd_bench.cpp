@@ -32,12 +32,12 @@ struct BenchOptions {
     int samples = 1, threads = 1, repeat = 0, clusters = 0;
     bool clusters_given = false;  // frame: without --clusters, the culler's default (clusters)
     bool json = false, sample_depth = false, vs_scalar = false, scaling = false;
-    double complexity = kDefaultComplexity;  // frame: the candidates' complexity filter (cull --complexity)
     bool complexity_given = false;
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
-    std::string occludees = "auto", closed_back_faces = "skip", back_faces = "draw", pyramid = "lazy", merge_coplanar = "off";
-    int occludee_parts = 16;
+    // frame: the culler's options that bench passes on (cull's, with cull's defaults; bench's
+    // own --resolution, --samples and --clusters fill the others).
+    CullOptions frame;
 };
 
 constexpr const char* kCastleViews = "data/views/castle.json";
@@ -54,16 +54,10 @@ void run_frame_workload(const BenchOptions& o) {
     f.threads = o.threads;
     f.isa = o.isa;
     f.json = o.json;
+    f.cull = o.frame;
     f.cull.resolution = o.resolution.empty() ? "1280x720" : o.resolution;
     f.cull.samples = o.samples;
-    f.cull.occludees = o.occludees;
     if (o.clusters_given) f.cull.clusters = o.clusters > 0 ? "on" : "off";
-    f.cull.closed_back_faces = o.closed_back_faces;
-    f.cull.back_faces = o.back_faces;
-    f.cull.merge_coplanar = o.merge_coplanar;
-    f.cull.pyramid = o.pyramid;
-    f.cull.occludee_parts = o.occludee_parts;
-    f.cull.complexity = o.complexity;
     f.scaling = o.scaling;
     run_frame_bench(f);
 }
@@ -281,21 +275,21 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--random", o->random, "frame: N random viewpoints in the scene's free space instead of --views (random_views)")
         ->check(CLI::Range(1, 100000));
     cmd->add_option("--seed", o->seed, "frame: seed of --walk or --random")->capture_default_str();
-    cmd->add_option("--occludees", o->occludees, "frame: how objects are tested, as cull --occludees: box, rects, samples or auto")
+    cmd->add_option("--occludees", o->frame.occludees, "frame: how objects are tested, as cull --occludees: box, rects, samples or auto")
         ->capture_default_str();
-    cmd->add_option("--closed-back-faces", o->closed_back_faces, "frame: skip or draw the back faces of closed occluder meshes (cull --closed-back-faces)")
+    cmd->add_option("--closed-back-faces", o->frame.closed_back_faces, "frame: skip or draw the back faces of closed occluder meshes (cull --closed-back-faces)")
         ->capture_default_str()->check(CLI::IsMember({"skip", "draw"}));
-    cmd->add_option("--back-faces", o->back_faces,
+    cmd->add_option("--back-faces", o->frame.back_faces,
                     "frame: draw or cull every occluder triangle facing away from the eye (cull --back-faces)")
         ->capture_default_str()->check(CLI::IsMember({"draw", "cull"}));
-    cmd->add_option("--merge-coplanar", o->merge_coplanar,
+    cmd->add_option("--merge-coplanar", o->frame.merge_coplanar,
                     "frame: re-triangulate each occluder's exactly coplanar regions when loading, or not (cull --merge-coplanar)")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
-    cmd->add_option("--occludee-parts", o->occludee_parts, "frame: parts per object with a box each (cull --occludee-parts)")
+    cmd->add_option("--occludee-parts", o->frame.occludee_parts, "frame: parts per object with a box each (cull --occludee-parts)")
         ->capture_default_str()->check(CLI::Range(0, 64));
-    cmd->add_option("--pyramid", o->pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")
+    cmd->add_option("--pyramid", o->frame.pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")
         ->capture_default_str()->check(CLI::IsMember({"lazy", "always"}));
-    cmd->add_option("--complexity", o->complexity,
+    cmd->add_option("--complexity", o->frame.complexity,
                     "frame: drop occluder candidates with more than F times the median triangles per unit of their surface "
                     "(cull --complexity); 0: keep all")
         ->capture_default_str()->check(CLI::NonNegativeNumber)->each([o](const std::string&) { o->complexity_given = true; });
