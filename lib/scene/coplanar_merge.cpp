@@ -130,7 +130,8 @@ struct Merger {
         for (auto f = fans_begin; f != fans_end; ++f) {
             // A manifold fan: each neighbour starts at most one edge and ends at most one.
             starts.clear(), ends.clear();
-            for (const auto& [a, c] : f->edges) {
+            for (const auto& edge : f->edges) {
+                const std::uint32_t a = edge.first, c = edge.second;  // named, not bound: the lambdas below take them
                 if (std::count_if(f->edges.begin(), f->edges.end(), [&](const auto& e) { return e.first == a; }) != 1) return false;
                 if (std::count_if(f->edges.begin(), f->edges.end(), [&](const auto& e) { return e.second == c; }) != 1) return false;
                 if (std::none_of(f->edges.begin(), f->edges.end(), [&](const auto& e) { return e.second == a; })) starts.push_back(a);
