@@ -2,8 +2,8 @@
 // Fewer occluder triangles covering exactly the same points: each connected region of exactly
 // coplanar triangles re-triangulated by vertex collapses. Maps made of brushes (Quake's BSP,
 // OpenArena) are cut into many coplanar pieces by their compilers' splits: on the shared
-// OpenArena maps this halves the triangles, and each triangle drawn costs its set-up and its
-// rows however small it is.
+// OpenArena maps the scene culler's merge (gather_world_triangles) leaves 54 and 60 % of the
+// occluder triangles, and each triangle drawn costs its set-up and its rows however small it is.
 #include <cstddef>
 #include <cstdint>
 

@@ -75,7 +75,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
         ->capture_default_str()->check(CLI::IsMember({"draw", "cull"}));
     app.add_option("--merge-coplanar", o.merge_coplanar,
                    "on: when the scene is loaded, re-triangulate each occluder's exactly coplanar regions with fewer triangles "
-                   "covering the same points (brush maps: half the triangles); off: draw the triangles as the scene has them")
+                   "covering the same points (the OpenArena maps: 40-46 % fewer); off: draw the triangles as the scene has them")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     app.add_option("--occluders", o.occluders, "Occluder candidates: role, all, or auto (role when marked, else objects by size)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
