@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <map>
-#include <unordered_map>
 #include <vector>
+
+#include <meshoptimizer.h>
 
 namespace homcull::detail {
 namespace {
@@ -195,27 +195,23 @@ struct Merger {
 
 std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* triangles, std::size_t triangle_count, const std::uint8_t* keep) {
     if (triangle_count < 2) return triangle_count;
-    // Weld equal positions (by their bits; +0 and -0 apart, which only keeps a vertex): each
+    // Weld equal positions by their bytes (+0 and -0 apart, which only keeps a vertex), with
+    // meshoptimizer's vertex remap as the project welds elsewhere (closed_occludees.cpp): each
     // welded vertex keeps the first index that had its position, for the output.
     Merger m;
-    std::vector<std::uint32_t> original;  // per welded vertex
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> by_hash;
+    const auto [lowest_index, highest_index] = std::minmax_element(triangles, triangles + 3 * triangle_count);
+    const std::uint32_t base = *lowest_index;
+    std::vector<unsigned> local(3 * triangle_count);
+    for (std::size_t i = 0; i < local.size(); ++i) local[i] = triangles[i] - base;
+    std::vector<unsigned> remap(std::size_t(*highest_index - base) + 1);
+    const std::size_t unique = meshopt_generateVertexRemap(remap.data(), local.data(), local.size(), positions + 3 * std::size_t(base),
+                                                           remap.size(), 3 * sizeof(float));
+    std::vector<std::uint32_t> original(unique, ~0u);  // per welded vertex
     std::vector<std::uint32_t> welded_of(3 * triangle_count);
-    for (std::size_t i = 0; i < 3 * triangle_count; ++i) {
-        const float* p = positions + 3 * std::size_t(triangles[i]);
-        std::uint32_t bits[3];
-        std::memcpy(bits, p, sizeof bits);
-        const std::uint64_t hash = (std::uint64_t(bits[0]) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(bits[1]) * 0xC2B2AE3D27D4EB4Full) ^ bits[2];
-        std::vector<std::uint32_t>& bucket = by_hash[hash];
-        auto same = std::find_if(bucket.begin(), bucket.end(), [&](std::uint32_t w) {
-            return std::memcmp(positions + 3 * std::size_t(original[w]), p, 3 * sizeof(float)) == 0;
-        });
-        if (same == bucket.end()) {
-            bucket.push_back(std::uint32_t(original.size()));
-            original.push_back(triangles[i]);
-            same = bucket.end() - 1;
-        }
-        welded_of[i] = *same;
+    for (std::size_t i = 0; i < local.size(); ++i) {
+        const unsigned w = remap[local[i]];
+        welded_of[i] = w;
+        if (original[w] == ~0u) original[w] = triangles[i];
     }
     if (!integer_grid(positions, original, m.point)) return triangle_count;
     m.kept.assign(original.size(), 0);

@@ -3,8 +3,7 @@
 #include "common/float_mode.hpp"
 #include "scene/coplanar_merge.hpp"
 
-#include <cstring>
-#include <unordered_map>
+#include <meshoptimizer.h>
 
 namespace homcull {
 
@@ -35,26 +34,20 @@ namespace {
 // triangles' regions. A vertex whose position another object's triangles use stays, so that the
 // edges objects share stay shared.
 void merge_coplanar_regions(WorldTriangles& w) {
-    const std::size_t objects = w.object_first_triangle.size() - 1;
-    std::unordered_map<std::uint64_t, std::uint32_t> object_at;  // position bits -> the object using it, or kMany
-    constexpr std::uint32_t kMany = ~0u;
-    std::vector<std::uint64_t> key(w.positions.size() / 3);
-    for (std::size_t i = 0; i < key.size(); ++i) {
-        std::uint32_t bits[3];
-        std::memcpy(bits, &w.positions[3 * i], sizeof bits);
-        // Three 32-bit patterns folded into 64 bits: a collision only keeps a vertex more.
-        key[i] = (std::uint64_t(bits[0]) << 32 | bits[1]) ^ (std::uint64_t(bits[2]) * 0x9E3779B97F4A7C15ull);
-    }
+    const std::size_t objects = w.object_first_triangle.size() - 1, vertices = w.positions.size() / 3;
+    // One number per position, by bytes (meshoptimizer's vertex remap, as compute_shared_edges
+    // matches positions by bits), and the object using it, or kMany.
+    std::vector<unsigned> point(vertices);
+    meshopt_generateVertexRemap(point.data(), nullptr, vertices, w.positions.data(), vertices, 3 * sizeof(float));
+    constexpr std::uint32_t kNone = ~0u, kMany = ~0u - 1;
+    std::vector<std::uint32_t> user(vertices, kNone);
     for (std::size_t k = 0; k < objects; ++k)
         for (std::size_t i = 3 * std::size_t(w.object_first_triangle[k]); i < 3 * std::size_t(w.object_first_triangle[k + 1]); ++i) {
-            const auto [at, added] = object_at.insert({key[w.indices[i]], std::uint32_t(k)});
-            if (!added && at->second != k) at->second = kMany;
+            std::uint32_t& u = user[point[w.indices[i]]];
+            u = u == kNone || u == k ? std::uint32_t(k) : kMany;
         }
-    std::vector<std::uint8_t> keep(key.size());
-    for (std::size_t i = 0; i < key.size(); ++i) {
-        const auto at = object_at.find(key[i]);
-        keep[i] = at != object_at.end() && at->second == kMany;
-    }
+    std::vector<std::uint8_t> keep(vertices);
+    for (std::size_t i = 0; i < vertices; ++i) keep[i] = user[point[i]] == kMany;
     std::vector<std::uint32_t> indices;
     std::vector<std::uint32_t> first{0};
     for (std::size_t k = 0; k < objects; ++k) {
