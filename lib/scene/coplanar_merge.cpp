@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
+#include <numeric>
+#include <unordered_map>
 #include <vector>
 
 #include <meshoptimizer.h>
@@ -13,6 +14,7 @@ namespace {
 
 // 128-bit integers (GCC and Clang): the products below reach 2^126 at most.
 __extension__ typedef __int128 Int;
+__extension__ typedef unsigned __int128 UInt;
 using Point = std::array<std::int64_t, 3>;
 using Vector = std::array<Int, 3>;
 
@@ -30,6 +32,9 @@ Int absolute(Int v) { return v < 0 ? -v : v; }
 
 Int gcd(Int a, Int b) {
     a = absolute(a), b = absolute(b);
+    // Most normals fit in 64 bits; a 128-bit division is a library call, several times slower.
+    constexpr Int k64 = Int(1) << 63;
+    if (a < k64 && b < k64) return Int(std::gcd(std::uint64_t(a), std::uint64_t(b)));
     while (b != 0) {
         const Int r = a % b;
         a = b, b = r;
@@ -42,9 +47,18 @@ Int gcd(Int a, Int b) {
 struct Plane {
     Vector normal;
     Int offset;
-    bool operator<(const Plane& o) const {
-        if (normal != o.normal) return normal < o.normal;
-        return offset < o.offset;
+    bool operator==(const Plane& o) const { return normal == o.normal && offset == o.offset; }
+};
+
+struct PlaneHash {
+    std::size_t operator()(const Plane& p) const {
+        std::uint64_t h = 0;
+        for (const Int x : {p.normal[0], p.normal[1], p.normal[2], p.offset}) {
+            // Both halves of each 128-bit value, mixed (splitmix64's multiplier).
+            h = (h ^ std::uint64_t(x) ^ std::uint64_t(UInt(x) >> 64)) * 0x9E3779B97F4A7C15ull;
+            h ^= h >> 29;
+        }
+        return std::size_t(h);
     }
 };
 
@@ -105,9 +119,26 @@ struct Merger {
     std::vector<Fan> fan_room;
     std::vector<std::uint32_t> starts, ends, targets;
 
+    // A fan of one triangle cannot lose v (v would have to lie between the triangle's other
+    // two corners), so v can go only when each plane around it holds two of its triangles or
+    // more. Most vertices of curved meshes fail this: checked before any fan is built.
+    bool every_plane_twice(std::uint32_t v) const {
+        const auto& ts = around[v];
+        for (std::size_t i = 0; i < ts.size(); ++i) {
+            if (!alive[ts[i]]) continue;
+            const int plane = plane_of[ts[i]];
+            if (plane < 0) return false;
+            bool twice = false;
+            for (std::size_t j = 0; j < ts.size() && !twice; ++j) twice = j != i && alive[ts[j]] && plane_of[ts[j]] == plane;
+            if (!twice) return false;
+        }
+        return true;
+    }
+
     // Collapses v into a neighbour when it can; then `moved_to` is that neighbour.
     bool collapse(std::uint32_t v, std::uint32_t& moved_to) {
         if (kept[v]) return false;
+        if (!every_plane_twice(v)) return false;
         std::size_t fan_count = 0;
         for (const std::uint32_t t : around[v]) {
             if (!alive[t]) continue;
@@ -218,7 +249,7 @@ std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* tria
     if (keep)
         for (std::size_t i = 0; i < 3 * triangle_count; ++i) m.kept[welded_of[i]] |= keep[triangles[i]];
 
-    std::map<Plane, int> plane_ids;
+    std::unordered_map<Plane, int, PlaneHash> plane_ids;
     m.tri.resize(triangle_count);
     m.plane_of.assign(triangle_count, -1);
     m.alive.assign(triangle_count, true);

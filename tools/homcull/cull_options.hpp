@@ -25,7 +25,7 @@ struct CullOptions {
     int finest_level = 0, coarsest_level = -1;
     int occludee_parts = 16;
     std::string deb = "64x64", occludees = "auto", sample_depth = "on", clusters = "on", closed_back_faces = "skip", back_faces = "draw",
-                pyramid = "lazy", merge_coplanar = "off";
+                pyramid = "lazy", merge_coplanar = "on";
     std::string strategy = "temporal", rank = "none", hierarchy = "on", grid, lod = "off";
     std::size_t budget = 0, batch = 1024;
     double cut_step = TemporalCut{}.step_in_near_planes, cut_turn = TemporalCut{}.turn_degrees;

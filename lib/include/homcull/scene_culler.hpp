@@ -88,7 +88,7 @@ struct SceneCullerConfig {
     // Draw each occluder with its exactly coplanar regions re-triangulated, when the culler is
     // made: fewer triangles covering the same points at the same depths (gather_world_triangles;
     // docs/scene-culling.md, "Coplanar merge").
-    bool merge_coplanar_occluders = false;
+    bool merge_coplanar_occluders = true;
     // Occludee shape: the world box alone, or, where the box is found visible, the object's
     // triangles (much tighter for objects whose box reaches past what hides them, at the cost
     // of transforming their vertices). Objects with more than triangle_test_limit triangles
