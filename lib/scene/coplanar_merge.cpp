@@ -30,11 +30,18 @@ Vector cross(const Point& o, const Point& a, const Point& b) {
 
 Int absolute(Int v) { return v < 0 ? -v : v; }
 
+constexpr Int k63 = Int(1) << 63;
+
+// a / d for d > 0 that divides a: in 64 bits when both fit (a 128-bit division is a library
+// call, several times slower, and most normals fit).
+Int divide(Int a, Int d) {
+    if (a > -k63 && a < k63 && d < k63) return Int(std::int64_t(a) / std::int64_t(d));
+    return a / d;
+}
+
 Int gcd(Int a, Int b) {
     a = absolute(a), b = absolute(b);
-    // Most normals fit in 64 bits; a 128-bit division is a library call, several times slower.
-    constexpr Int k64 = Int(1) << 63;
-    if (a < k64 && b < k64) return Int(std::gcd(std::uint64_t(a), std::uint64_t(b)));
+    if (a < k63 && b < k63) return Int(std::gcd(std::uint64_t(a), std::uint64_t(b)));
     while (b != 0) {
         const Int r = a % b;
         a = b, b = r;
@@ -249,20 +256,50 @@ std::size_t merge_coplanar_triangles(const float* positions, std::uint32_t* tria
     if (keep)
         for (std::size_t i = 0; i < 3 * triangle_count; ++i) m.kept[welded_of[i]] |= keep[triangles[i]];
 
-    std::unordered_map<Plane, int, PlaneHash> plane_ids;
     m.tri.resize(triangle_count);
     m.plane_of.assign(triangle_count, -1);
     m.alive.assign(triangle_count, true);
     m.around.resize(original.size());
+    {
+        std::vector<std::uint32_t> uses(original.size(), 0);  // each list allocated once
+        for (const std::uint32_t w : welded_of) ++uses[w];
+        for (std::size_t v = 0; v < uses.size(); ++v) m.around[v].reserve(uses[v]);
+    }
+    // Triangles around the same vertex lie in one plane exactly when their normals point the
+    // same way (the plane through the vertex is then the same). Most triangles of curved meshes
+    // have no such neighbour: a test in double (rounding far inside its tolerance, so it can
+    // only let extra pairs through) finds the triangles that may, and only those get their
+    // exact plane; the others keep -1, which stops a collapse of their vertices just as a plane
+    // no other triangle there shares would (every_plane_twice), and which no collapse changes:
+    // a triangle that had no coplanar neighbour never gets one.
+    std::vector<std::array<double, 3>> direction(triangle_count);
+    std::vector<std::uint8_t> may_share(triangle_count, 0);
     for (std::size_t t = 0; t < triangle_count; ++t) {
         auto& x = m.tri[t];
         for (std::size_t k = 0; k < 3; ++k) x[k] = welded_of[3 * t + k];
         for (const std::uint32_t v : x) m.around[v].push_back(std::uint32_t(t));
-        if (x[0] == x[1] || x[1] == x[2] || x[0] == x[2]) continue;
+        const Vector n = cross(m.point[x[0]], m.point[x[1]], m.point[x[2]]);
+        for (std::size_t k = 0; k < 3; ++k) direction[t][k] = double(n[k]);
+    }
+    for (const auto& ts : m.around)
+        for (std::size_t i = 0; i < ts.size(); ++i)
+            for (std::size_t j = i + 1; j < ts.size(); ++j) {
+                const auto& a = direction[ts[i]];
+                const auto& b = direction[ts[j]];
+                const double c0 = a[1] * b[2] - a[2] * b[1], c1 = a[2] * b[0] - a[0] * b[2], c2 = a[0] * b[1] - a[1] * b[0];
+                const double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2], bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+                const double along = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+                if (along > 0 && c0 * c0 + c1 * c1 + c2 * c2 <= 1e-20 * aa * bb) may_share[ts[i]] = may_share[ts[j]] = 1;
+            }
+    std::unordered_map<Plane, int, PlaneHash> plane_ids;
+    for (std::size_t t = 0; t < triangle_count; ++t) {
+        const auto& x = m.tri[t];
+        if (!may_share[t] || x[0] == x[1] || x[1] == x[2] || x[0] == x[2]) continue;
         Vector n = cross(m.point[x[0]], m.point[x[1]], m.point[x[2]]);
         const Int g = gcd(gcd(n[0], n[1]), n[2]);
         if (g == 0) continue;  // no area
-        for (Int& c : n) c /= g;
+        if (g != 1)
+            for (Int& c : n) c = divide(c, g);
         Int offset = 0;
         for (std::size_t k = 0; k < 3; ++k) offset += n[k] * m.point[x[0]][k];
         const auto [at, added] = plane_ids.insert({Plane{n, offset}, int(m.planes.size())});
