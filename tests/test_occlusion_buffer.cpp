@@ -3,6 +3,7 @@
 #include "support.hpp"
 
 #include <homcull/error.hpp>
+#include <homcull/frustum.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
 #include <gtest/gtest.h>
@@ -362,6 +363,59 @@ TEST(OcclusionBuffer, AabbTestsUseTheCornersAndTheNearPlane) {
     EXPECT_EQ(buffer.test_aabb(crossing_min, crossing_max, clip), Visibility::visible);
     EXPECT_EQ(buffer.test_aabb(back_min, back_max, clip), Visibility::view_culled);
     EXPECT_EQ(buffer.test_aabb(side_min, side_max, clip), Visibility::view_culled);
+}
+
+// Boxes around the view volume's four side edges, within a few units of them on either side:
+// those beside a corner of the view (outside two side planes at once, within each alone) keep a
+// screen rectangle on the screen, and only test_aabb's exact view test culls them.
+TEST(OcclusionBuffer, BoxesBesideACornerOfTheViewAreViewCulled) {
+    for (const bool orthographic : {false, true}) {
+        Camera camera;
+        camera.eye = {0, 0, 0};
+        camera.target = {1.0, 0.35, -0.8};
+        camera.near_plane = 0.5;
+        camera.far_plane = 1000;
+        if (orthographic) camera.ortho_height = 20.0;
+        const double aspect = 16.0 / 9.0;
+        BufferConfig config;
+        config.width = 160;
+        config.height = 90;
+        config.near_w = 0.5f;
+        config.orthographic = orthographic;
+        const OcclusionBuffer buffer(config);  // empty: every box in view is visible
+        const auto clip = clip_from_world(camera, aspect);
+        const Frustum frustum = make_frustum(camera, aspect);
+        std::uint64_t seed = 777;
+        const auto uniform = [&](double lo, double hi) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            return lo + (hi - lo) * double(seed >> 11) * 0x1.0p-53;
+        };
+        std::vector<Aabb> boxes;
+        for (int k = 0; k < 2000; ++k) {
+            const std::size_t edge = std::size_t(k % 4);
+            const glm::dvec3 along = frustum.corners[edge] + uniform(0.002, 0.05) * (frustum.corners[edge + 4] - frustum.corners[edge]);
+            const glm::vec3 lo(float(along.x + uniform(-6, 3)), float(along.y + uniform(-6, 3)), float(along.z + uniform(-6, 3)));
+            const glm::vec3 size(float(uniform(0.25, 3)), float(uniform(0.25, 3)), float(uniform(0.25, 3)));
+            boxes.push_back({lo, lo + size});
+        }
+        std::vector<Visibility> batch(boxes.size());
+        buffer.test_aabbs(boxes.data(), boxes.size(), clip, batch.data());
+        std::size_t apart = 0, beside_a_corner = 0;
+        for (std::size_t k = 0; k < boxes.size(); ++k) {
+            const Visibility v = buffer.test_aabb(&boxes[k].min.x, &boxes[k].max.x, clip);
+            EXPECT_EQ(batch[k], v) << orthographic << ", box " << k;
+            if (intersects(frustum, boxes[k])) {
+                EXPECT_NE(v, Visibility::view_culled) << orthographic << ", box " << k;
+            } else {
+                // Occluded when its screen rectangle holds no sample centre: hidden either way.
+                EXPECT_NE(v, Visibility::visible) << orthographic << ", box " << k;
+            }
+            apart += !intersects(frustum, boxes[k]);
+            beside_a_corner += v == Visibility::view_culled && may_meet(frustum, boxes[k]);
+        }
+        EXPECT_GT(apart, boxes.size() / 4) << orthographic;
+        EXPECT_GE(beside_a_corner, 3u) << orthographic << ": no box beside a corner of the view, where only the exact test culls";
+    }
 }
 
 TEST(OcclusionBuffer, InvalidConfigurationsAreRejected) {

@@ -72,6 +72,10 @@ public:
     Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
     void test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const;
     void test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& model_to_clip, Visibility* results) const;
+    // The same without the exact view test (exact_view_test.hpp): for callers that make their own
+    // from a view they hold (the scene culler's frustum, the C API's double matrices).
+    Visibility test_aabb_by_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
+    void test_aabbs_by_rectangle(const Aabb* boxes, std::size_t count, const std::array<float, 16>& model_to_clip, Visibility* results) const;
     // OcclusionBuffer::test_triangles; with `solid` (seen_solid.hpp), the triangles that the
     // eye certainly sees from behind are passed over like those outside the view.
     TriangleTest test_triangles(const TriangleInput& occludee, std::uint64_t tolerated_samples = 0, std::size_t first_triangle = 0,

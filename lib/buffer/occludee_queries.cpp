@@ -4,6 +4,7 @@
 
 #include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
+#include "buffer/exact_view_test.hpp"
 #include "common/float_mode.hpp"
 #include "buffer/min_pyramid.hpp"
 #include "buffer/rect_queries.hpp"
@@ -196,6 +197,13 @@ glm::dvec4 clip_term_bounds(const float box_min[3], const float box_max[3], cons
 
 Visibility detail::BufferState::test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
+    const Visibility v = test_aabb_by_rectangle(box_min, box_max, m);
+    if (v != Visibility::visible) return v;
+    return detail::ExactViewTest(m, config_.near_w, config_.orthographic).visible_box(box_min, box_max);
+}
+
+Visibility detail::BufferState::test_aabb_by_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& m) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;
     if (!detail::box_rectangle(*kernels_, box_min, box_max, m, config_.near_w, config_.orthographic, r, decided)) return decided;
@@ -217,6 +225,14 @@ void detail::BufferState::test_rects(const ScreenRect* rects, std::size_t count,
 }
 
 void detail::BufferState::test_aabbs(const Aabb* boxes, std::size_t count, const std::array<float, 16>& m, Visibility* results) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
+    test_aabbs_by_rectangle(boxes, count, m, results);
+    detail::ExactViewTest view(m, config_.near_w, config_.orthographic);
+    for (std::size_t k = 0; k < count; ++k)
+        if (results[k] == Visibility::visible) results[k] = view.visible_box(&boxes[k].min.x, &boxes[k].max.x);
+}
+
+void detail::BufferState::test_aabbs_by_rectangle(const Aabb* boxes, std::size_t count, const std::array<float, 16>& m, Visibility* results) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     constexpr std::size_t kBlock = 64;
     ScreenRect rects[kBlock];

@@ -5,6 +5,8 @@
 #include <homcull/aabb.hpp>
 #include <homcull/frustum.hpp>
 
+#include "buffer/buffer_state.hpp"
+#include "buffer/exact_view_test.hpp"
 #include "buffer/rect_queries.hpp"  // box_rectangle
 
 #include <algorithm>
@@ -61,20 +63,6 @@ glm::dvec4 far_row_in_model(const homcull_buffer& b, const glm::dmat4& model) {
 FrustumAxes view_volume(const homcull_buffer& b, const glm::dmat4& clip_from_space) {
     const bool orthographic = b.buffer.config().orthographic;
     return view_volume_axes(clip_from_space, orthographic ? 0.0 : double(b.near_distance), orthographic, 0x1.0p-20);
-}
-
-// Whether a box's centre lies in the view volume, by the buffer's float model-to-clip matrix: the
-// box then meets the volume and the exact test (view_volume) has nothing to find. Most visible
-// boxes end here, without the volume's axes. (Where the float matrix's rounding puts a centre
-// inside that is not, the box is kept visible: never a wrong view cull.)
-bool centre_in_view(const std::array<float, 16>& m, const Aabb& box, float near_w, bool orthographic) {
-    const glm::dvec3 centre = (glm::dvec3(box.min) + glm::dvec3(box.max)) * 0.5;
-    glm::dvec4 clip;
-    for (int row = 0; row < 4; ++row)
-        clip[row] = double(m[std::size_t(row)]) * centre.x + double(m[std::size_t(4 + row)]) * centre.y +
-                    double(m[std::size_t(8 + row)]) * centre.z + double(m[std::size_t(12 + row)]);
-    const bool beyond_near = orthographic ? clip.z >= -clip.w : clip.w >= double(near_w);
-    return beyond_near && std::abs(clip.x) <= clip.w && std::abs(clip.y) <= clip.w;
 }
 
 // Whether a box lies wholly outside the view: before the near plane, or its screen rectangle
@@ -440,11 +428,10 @@ homcull_result homcull_buffer_test_boxes(const homcull_buffer* b, const homcull_
         const glm::dmat4 model = read_model(*b, model_matrix);
         const std::array<float, 16> clip_from_model = capi::float_clip_from_model(b->clip_from_world, model);
         const glm::dvec4 far_row = far_row_in_model(*b, model);
-        // The exact frustum test of the boxes the buffer finds visible: its own view test is by
-        // the box's screen rectangle and clip planes, which keeps a box beside a corner of the
-        // view (outside two side planes at once, within each alone). Only boxes whose centre
-        // lies outside the view can be apart (centre_in_view). Model boxes need the volume in
-        // model space: made once per call, when a box first needs it.
+        // The exact view test of the boxes the buffer's rectangles find visible
+        // (buffer/exact_view_test.hpp), here with the volume of the frame's double matrices
+        // rather than the float one: world boxes use the axes made at begin_frame, model boxes
+        // make them in model space once per call, when a box first needs them.
         const FrustumAxes* volume = model_matrix ? nullptr : &b->world_view_axes;
         FrustumAxes model_volume;
         // The library's boxes (glm) filled from the C ones a block at a time, on the stack.
@@ -458,12 +445,12 @@ homcull_result homcull_buffer_test_boxes(const homcull_buffer* b, const homcull_
                 block[k].min = {c.min[0], c.min[1], c.min[2]};
                 block[k].max = {c.max[0], c.max[1], c.max[2]};
             }
-            b->buffer.test_aabbs(block, n, clip_from_model, answers);
+            b->buffer.state().test_aabbs_by_rectangle(block, n, clip_from_model, answers);
             for (std::size_t k = 0; k < n; ++k) {
                 homcull_visibility v = as_c(answers[k]);
                 if (v != HOMCULL_VIEW_CULLED && b->far_plane && capi::box_beyond_far(far_row, boxes[base + k].min, boxes[base + k].max))
                     v = HOMCULL_VIEW_CULLED;
-                if (v == HOMCULL_VISIBLE && !centre_in_view(clip_from_model, block[k], b->near_distance, b->buffer.config().orthographic)) {
+                if (v == HOMCULL_VISIBLE && !detail::centre_in_view(clip_from_model, &block[k].min.x, &block[k].max.x, b->near_distance, b->buffer.config().orthographic)) {
                     if (!volume) {
                         model_volume = view_volume(*b, b->clip_from_world * model);
                         volume = &model_volume;

@@ -246,7 +246,11 @@ public:
     Visibility test_rect(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
     // The same answers, by visiting every subtile: the definition test_rect is checked against.
     Visibility test_rect_exhaustive(float ndc_min_x, float ndc_min_y, float ndc_max_x, float ndc_max_y, float w_min) const;
-    // World (or model) AABB under a model-to-clip matrix (column-major).
+    // World (or model) AABB under a model-to-clip matrix (column-major). view_culled when the
+    // box lies before the near plane or outside the view volume the matrix gives (x and y
+    // within w, no far plane), by an exact separating-axis test with a margin of 2^-20 of the
+    // terms (homcull/frustum.hpp, view_volume_axes), so that a box beside a corner of the view
+    // is culled too; else the box's screen rectangle at its nearest w, as test_rect.
     Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
     // Batches: results[k] is what test_rect / test_aabb answer for item k, bit for bit.
     // rects/boxes and results must hold `count` elements (they may be null when count is 0). The
