@@ -4,7 +4,7 @@
 // keeps a box that lies beside a corner of the view: outside two side planes at once, though
 // within each alone. The separating-axis test against the view volume (view_volume_axes,
 // homcull/frustum.hpp) finds it apart. Only a box whose centre lies outside the view can be,
-// so most visible boxes end at centre_in_view, and the volume's axes are made once per batch,
+// so most visible boxes end at point_of_box_in_view, and the volume's axes are made once per batch,
 // the first time a box needs them (one whose centre and corners all lie outside the view).
 #include <homcull/frustum.hpp>
 #include <homcull/occlusion_buffer.hpp>
@@ -13,12 +13,10 @@
 
 namespace homcull::detail {
 
-// Whether the box's centre lies in the view by the model-to-clip matrix (taken in double): then
-// the box meets the volume and the exact test has nothing to find. Rounding that puts a centre
-// inside that is not only keeps a box visible.
-bool centre_in_view(const std::array<float, 16>& model_to_clip, const float box_min[3], const float box_max[3], float near_w, bool orthographic);
-// The same for any of the box's eight corners.
-bool corner_in_view(const std::array<float, 16>& model_to_clip, const float box_min[3], const float box_max[3], float near_w, bool orthographic);
+// Whether the box's centre or one of its corners lies in the view, by the model-to-clip matrix
+// (taken in double): the box then meets the view and the exact test has nothing to find.
+// Rounding that puts a point inside that is not only keeps a box visible.
+bool point_of_box_in_view(const std::array<float, 16>& model_to_clip, const float box_min[3], const float box_max[3], float near_w, bool orthographic);
 
 // The view volume of a float model-to-clip matrix (its entries as they are, in double), apart
 // by at least 2^-20 of the terms (as the scene culler's frustum test): a margin far above the

@@ -450,7 +450,8 @@ homcull_result homcull_buffer_test_boxes(const homcull_buffer* b, const homcull_
                 homcull_visibility v = as_c(answers[k]);
                 if (v != HOMCULL_VIEW_CULLED && b->far_plane && capi::box_beyond_far(far_row, boxes[base + k].min, boxes[base + k].max))
                     v = HOMCULL_VIEW_CULLED;
-                if (v == HOMCULL_VISIBLE && !detail::centre_in_view(clip_from_model, &block[k].min.x, &block[k].max.x, b->near_distance, b->buffer.config().orthographic)) {
+                if (v == HOMCULL_VISIBLE &&
+                    !detail::point_of_box_in_view(clip_from_model, &block[k].min.x, &block[k].max.x, b->near_distance, b->buffer.config().orthographic)) {
                     if (!volume) {
                         model_volume = view_volume(*b, b->clip_from_world * model);
                         volume = &model_volume;
