@@ -38,6 +38,9 @@ Visibility OcclusionBuffer::test_rect_exhaustive(float ndc_min_x, float ndc_min_
 Visibility OcclusionBuffer::test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const {
     return state_->test_aabb(box_min, box_max, model_to_clip);
 }
+Visibility OcclusionBuffer::test_aabb_by_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const {
+    return state_->test_aabb_by_rectangle(box_min, box_max, model_to_clip);
+}
 void OcclusionBuffer::test_rects(const ScreenRect* rects, std::size_t count, Visibility* results) const {
     state_->test_rects(rects, count, results);
 }

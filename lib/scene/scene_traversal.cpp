@@ -4,7 +4,6 @@
 
 #include "scene/scene_culler_state.hpp"
 
-#include "buffer/buffer_state.hpp"
 #include "common/float_round.hpp"
 #include "common/run_tasks.hpp"
 #include "scene/scene_culler_frame.hpp"
@@ -197,7 +196,7 @@ OccludeeAnswer detail::SceneCullerState::box_answer(const Frame& frame, const Aa
     // Without the buffer's exact view test, which would make the view volume's axes at each
     // call: a node or part whose box lies beside a corner of the view stays visible
     // (conservative), and each object gets the frame's frustum test in test_object.
-    a.visibility = buffer_.state().test_aabb_by_rectangle(&box.min.x, &box.max.x, frame.clip);
+    a.visibility = buffer_.test_aabb_by_rectangle(&box.min.x, &box.max.x, frame.clip);
     a.level_of_visibility = a.visibility == Visibility::visible ? 1.0f : 0.0f;
     return a;
 }

@@ -252,6 +252,11 @@ public:
     // terms (homcull/frustum.hpp, view_volume_axes), so that a box beside a corner of the view
     // is culled too; else the box's screen rectangle at its nearest w, as test_rect.
     Visibility test_aabb(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
+    // test_aabb without the exact view test: the screen rectangle and the clip planes alone, so a
+    // box beside a corner of the view may be visible. For callers that test boxes against a view
+    // of their own first (the scene culler, against its frustum), to whom the volume made at
+    // each call would be a cost for nothing.
+    Visibility test_aabb_by_rectangle(const float box_min[3], const float box_max[3], const std::array<float, 16>& model_to_clip) const;
     // Batches: results[k] is what test_rect / test_aabb answer for item k, bit for bit.
     // rects/boxes and results must hold `count` elements (they may be null when count is 0). The
     // rectangles' first stage (validity, frustum, sample span, nearest depth and the coarse
