@@ -5,6 +5,7 @@
 #include <homcull/error.hpp>
 #include <homcull/frustum.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/occlusion_maps.hpp>
 
 #include <gtest/gtest.h>
 
@@ -415,6 +416,19 @@ TEST(OcclusionBuffer, BoxesBesideACornerOfTheViewAreViewCulled) {
         }
         EXPECT_GT(apart, boxes.size() / 4) << orthographic;
         EXPECT_GE(beside_a_corner, 3u) << orthographic << ": no box beside a corner of the view, where only the exact test culls";
+        if (orthographic) continue;  // the maps take perspective buffers
+        // The occlusion maps' box test makes the same view test (with or without pyramids).
+        for (const PyramidBuild pyramid : {PyramidBuild::always, PyramidBuild::lazy}) {
+            OcclusionMapsConfig mc;
+            mc.display_width = buffer.sample_width();
+            mc.display_height = buffer.sample_height();
+            mc.pyramid = pyramid;
+            OcclusionMaps maps(buffer, mc);
+            maps.build(buffer);
+            for (std::size_t k = 0; k < boxes.size(); ++k) {
+                EXPECT_EQ(maps.test_aabb(boxes[k], clip).visibility, batch[k]) << "maps, box " << k;
+            }
+        }
     }
 }
 

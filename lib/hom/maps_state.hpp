@@ -24,6 +24,7 @@ public:
     void build(const OcclusionBuffer& buffer);
     OccludeeAnswer test_rect(const ScreenRect& rect) const;
     OccludeeAnswer test_aabb(const Aabb& box, const std::array<float, 16>& model_to_clip) const;
+    OccludeeAnswer test_aabb_by_rectangle(const Aabb& box, const std::array<float, 16>& model_to_clip) const;
     double hole_budget() const;
     OccludeeAnswer test_rect_within(const ScreenRect& rect, double& budget) const;
     // test_rect_within's work, for callers already under a StandardFloatMode (each guard reads

@@ -12,6 +12,7 @@
 
 #include "buffer/buffer_kernels.hpp"
 #include "buffer/buffer_state.hpp"
+#include "buffer/exact_view_test.hpp"
 #include "hom/map_kernels.hpp"
 #include "hom/maps_state.hpp"
 #include "common/float_mode.hpp"
@@ -359,6 +360,15 @@ OccludeeAnswer detail::MapsState::answer_rect(const ScreenRect& rect, double& bu
 }
 
 OccludeeAnswer detail::MapsState::test_aabb(const Aabb& box, const std::array<float, 16>& m) const {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
+    OccludeeAnswer answer = test_aabb_by_rectangle(box, m);
+    if (answer.visibility == Visibility::visible &&
+        detail::ExactViewTest(m, built().config().near_w, false).visible_box(&box.min.x, &box.max.x) == Visibility::view_culled)
+        answer = decided_answer(Visibility::view_culled);
+    return answer;
+}
+
+OccludeeAnswer detail::MapsState::test_aabb_by_rectangle(const Aabb& box, const std::array<float, 16>& m) const {
     const detail::StandardFloatMode mode;  // float_mode.hpp
     ScreenRect r;
     Visibility decided;

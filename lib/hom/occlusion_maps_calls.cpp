@@ -18,6 +18,9 @@ void OcclusionMaps::build_pyramid() { state_->build_pyramid(); }
 bool OcclusionMaps::pyramid_built() const { return state_->pyramid_built_; }
 OccludeeAnswer OcclusionMaps::test_rect(const ScreenRect& rect) const { return state_->test_rect(rect); }
 OccludeeAnswer OcclusionMaps::test_aabb(const Aabb& box, const std::array<float, 16>& model_to_clip) const { return state_->test_aabb(box, model_to_clip); }
+OccludeeAnswer OcclusionMaps::test_aabb_by_rectangle(const Aabb& box, const std::array<float, 16>& model_to_clip) const {
+    return state_->test_aabb_by_rectangle(box, model_to_clip);
+}
 double OcclusionMaps::hole_budget() const { return state_->hole_budget(); }
 OccludeeAnswer OcclusionMaps::test_rect_within(const ScreenRect& rect, double& budget) const { return state_->test_rect_within(rect, budget); }
 const OcclusionMapsConfig& OcclusionMaps::config() const { return state_->config(); }

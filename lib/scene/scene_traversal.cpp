@@ -191,7 +191,7 @@ void detail::SceneCullerState::traverse_in_tasks(const Frame& frame, std::vector
 // (PyramidBuild::lazy) the buffer answers, without the uncovered share the maps would work out
 // for a visible box.
 OccludeeAnswer detail::SceneCullerState::box_answer(const Frame& frame, const Aabb& box) const {
-    if (maps_.pyramid_built()) return maps_.test_aabb(box, frame.clip);
+    if (maps_.pyramid_built()) return maps_.test_aabb_by_rectangle(box, frame.clip);
     OccludeeAnswer a;
     // Without the buffer's exact view test, which would make the view volume's axes at each
     // call: a node or part whose box lies beside a corner of the view stays visible
@@ -211,7 +211,7 @@ OccludeeAnswer detail::SceneCullerState::box_answer(const Frame& frame, const Aa
 // (their triangles all off the screen), and most of the triangles those tests went through.
 OccludeeAnswer detail::SceneCullerState::test_object(const Frame& frame, std::uint32_t id, TestTally& tally) {
     const Object& object = scene_->objects[id];
-    OccludeeAnswer answer = maps_.test_aabb(object_boxes_[id], frame.clip);
+    OccludeeAnswer answer = maps_.test_aabb_by_rectangle(object_boxes_[id], frame.clip);  // separated() below is its view test
     ++tally.objects;
     ++tally.exits[answer.overlap_exit];
     if (answer.visibility == Visibility::visible && separated(frame.frustum, object_boxes_[id])) {

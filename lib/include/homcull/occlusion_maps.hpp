@@ -139,7 +139,12 @@ public:
     // outlive them and stay unchanged (render or clear it, then build() again). Thread-safe
     // with each other. Throws homcull::Error before the first build().
     OccludeeAnswer test_rect(const ScreenRect& rect) const;
+    // A box: its screen rectangle as test_rect, and a box found visible that lies outside the
+    // view volume is view_culled (OcclusionBuffer::test_aabb's exact view test).
+    // test_aabb_by_rectangle leaves that test out, for callers that test boxes against a view
+    // of their own first (the scene culler).
     OccludeeAnswer test_aabb(const Aabb& box, const std::array<float, 16>& model_to_clip) const;
+    OccludeeAnswer test_aabb_by_rectangle(const Aabb& box, const std::array<float, 16>& model_to_clip) const;
     // One occludee tested as several rectangles (its triangles, say) must share one hole
     // budget, or each rectangle would tolerate L pixels of holes: test_rect_within starts from
     // `budget` (samples; hole_budget() for a fresh occludee) and, when it answers occluded,
