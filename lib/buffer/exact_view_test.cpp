@@ -30,11 +30,15 @@ bool point_of_box_in_view(const std::array<float, 16>& m, const float box_min[3]
     return false;
 }
 
+FrustumAxes view_volume_of(const glm::dmat4& clip_from_space, float near_w, bool orthographic) {
+    return view_volume_axes(clip_from_space, orthographic ? 0.0 : double(near_w), orthographic, 0x1.0p-20);
+}
+
 FrustumAxes view_volume_of(const std::array<float, 16>& m, float near_w, bool orthographic) {
     glm::dmat4 clip_from_space;
     for (int column = 0; column < 4; ++column)
         for (int row = 0; row < 4; ++row) clip_from_space[column][row] = double(m[std::size_t(4 * column + row)]);
-    return view_volume_axes(clip_from_space, orthographic ? 0.0 : double(near_w), orthographic, 0x1.0p-20);
+    return view_volume_of(clip_from_space, near_w, orthographic);
 }
 
 Visibility ExactViewTest::visible_box(const float box_min[3], const float box_max[3]) {

@@ -18,9 +18,11 @@ namespace homcull::detail {
 // Rounding that puts a point inside that is not only keeps a box visible.
 bool point_of_box_in_view(const std::array<float, 16>& model_to_clip, const float box_min[3], const float box_max[3], float near_w, bool orthographic);
 
-// The view volume of a float model-to-clip matrix (its entries as they are, in double), apart
-// by at least 2^-20 of the terms (as the scene culler's frustum test): a margin far above the
-// rounding of the engine's float transforms and of box_rectangle's.
+// The view volume of a model-to-clip matrix as separating axes (view_volume_axes), apart by at
+// least 2^-20 of the terms (as the scene culler's frustum test): a margin far above the
+// rounding of the engine's float transforms and of box_rectangle's. The float form takes the
+// entries as they are, in double. (The C API passes its double matrices.)
+FrustumAxes view_volume_of(const glm::dmat4& clip_from_space, float near_w, bool orthographic);
 FrustumAxes view_volume_of(const std::array<float, 16>& model_to_clip, float near_w, bool orthographic);
 
 // One batch's exact view test: `visible` boxes of one matrix, the volume made when first needed.

@@ -57,12 +57,10 @@ glm::dvec4 far_row_in_model(const homcull_buffer& b, const glm::dmat4& model) {
     return row;
 }
 
-// The view volume of a frame's camera as separating axes for boxes in the space clip_from_space
-// maps from (view_volume_axes), apart by at least 2^-20 of their terms (as the scene culler's
-// frustum test): a margin far above the rounding of the engine's float transforms.
+// The view volume of the frame for boxes in the space clip_from_space maps from
+// (buffer/exact_view_test.hpp).
 FrustumAxes view_volume(const homcull_buffer& b, const glm::dmat4& clip_from_space) {
-    const bool orthographic = b.buffer.config().orthographic;
-    return view_volume_axes(clip_from_space, orthographic ? 0.0 : double(b.near_distance), orthographic, 0x1.0p-20);
+    return detail::view_volume_of(clip_from_space, b.near_distance, b.buffer.config().orthographic);
 }
 
 // Whether a box lies wholly outside the view: before the near plane, or its screen rectangle
