@@ -38,6 +38,7 @@ configs=(
   "triangles, clusters (default)|"
   "triangles, clusters, back faces culled|--back-faces cull"
   "triangles|--clusters 0"
+  "triangles, clusters, every object cheap for its surface an occluder|--occluders all --complexity 0.25"
 )
 run_config() {
   local name=${1%%|*} args=${1#*|} pass=$2 file

@@ -418,12 +418,13 @@ TEST(Cli, BenchPrintsItsTimingsAndRefusesBadOptions) {
 TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
     for (const std::string views : {"--random 3", "--walk 3"}) {
         const CliRun r = run_cli("bench --workload frame --scene gen:city:seed=2,blocks=3 " + views +
-                                 " --resolution 160x90 --repeat 2 --occludees box --clusters 64 --json");
+                                 " --resolution 160x90 --repeat 2 --occludees box --clusters 64 --occluders all --json");
         ASSERT_EQ(r.exit_code, 0) << r.err;
         const nlohmann::json j = nlohmann::json::parse(r.out);
         EXPECT_EQ(j["workload"], "frame");
         EXPECT_EQ(j["display"][0], 160);
         EXPECT_EQ(j["config"]["occludees"], "box");
+        EXPECT_EQ(j["config"]["occluders"], "all");
         EXPECT_EQ(j["config"]["clusters"], "on");
         ASSERT_EQ(j["per_view"].size(), 3u) << views;
         for (const nlohmann::json& v : j["per_view"]) {
@@ -452,7 +453,9 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
 // are the machine's.
 TEST(Cli, FrameBenchScalingReportsTheThreadsBesideTheMachinesCeiling) {
     expect_refused("bench --workload frame --scene gen:city --random 2 --scaling", 1, "give --threads N with N >= 2, got 1");
-    expect_refused("bench --workload s1 --complexity 2", 1, "--scaling and --complexity are for --workload frame");
+    expect_refused("bench --workload s1 --complexity 2", 1, "--scaling, --complexity and --occluders are for --workload frame");
+    expect_refused("bench --workload castle --occluders all", 1, "--scaling, --complexity and --occluders are for --workload frame");
+    expect_refused("bench --workload frame --scene gen:city --random 2 --occluders some", 105, "--occluders");
     expect_refused("bench --workload frame --scene gen:city --random 2 --complexity -1", 105, "--complexity");
     if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one hardware thread: no ceiling to measure";
     const CliRun r = run_cli("bench --workload frame --scene gen:city:seed=2,blocks=3 --random 2 --resolution 160x90 --repeat 2 "

@@ -32,7 +32,7 @@ struct BenchOptions {
     int samples = 1, threads = 1, repeat = 0, clusters = 0;
     bool clusters_given = false;  // frame: without --clusters, the culler's default (clusters)
     bool json = false, sample_depth = false, vs_scalar = false, scaling = false;
-    bool complexity_given = false;
+    bool complexity_given = false, occluders_given = false;
     int walk = 0, random = 0;  // frame: views from a walk or random viewpoints instead of --views
     std::uint64_t seed = 1;
     // frame: the culler's options that bench passes on (cull's, with cull's defaults; bench's
@@ -168,7 +168,8 @@ void run_bench(const BenchOptions& o) {
     if (o.workload == "frame") return run_frame_workload(o);
     if (o.workload != "s1" && o.workload != "castle") throw Error("bench: unknown workload '" + o.workload + "' (s1, castle or frame)");
     if (o.walk != 0 || o.random != 0) throw Error("bench: --walk and --random are for --workload frame");
-    if (o.scaling || o.complexity_given) throw Error("bench: --scaling and --complexity are for --workload frame");
+    if (o.scaling || o.complexity_given || o.occluders_given)
+        throw Error("bench: --scaling, --complexity and --occluders are for --workload frame");
     if (o.clusters != 0 && o.workload != "castle") throw Error("bench: --clusters is for --workload castle");
     if (o.clusters < 0) throw Error("bench: --clusters must be 0 (the triangles as one input) or triangles per cluster, got " +
                                     std::to_string(o.clusters));
@@ -289,6 +290,10 @@ void register_bench(CLI::App& app) {
         ->capture_default_str()->check(CLI::Range(0, 64));
     cmd->add_option("--pyramid", o->frame.pyramid, "frame: lazy or always build the maps' pyramids (cull --pyramid)")
         ->capture_default_str()->check(CLI::IsMember({"lazy", "always"}));
+    cmd->add_option("--occluders", o->frame.occluders,
+                    "frame: the occluder candidates, role, all or auto (cull --occluders); with --complexity, the objects "
+                    "cheap for their surface among every object: --occluders all --complexity 0.25")
+        ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}))->each([o](const std::string&) { o->occluders_given = true; });
     cmd->add_option("--complexity", o->frame.complexity,
                     "frame: drop occluder candidates with more than F times the median triangles per unit of their surface "
                     "(cull --complexity); 0: keep all")
