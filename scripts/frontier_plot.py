@@ -83,6 +83,9 @@ def load_homcull(out):
             label += ', ' + (f'{parts} parts' if parts > 1 else 'no parts')
         if c.get('back_faces', 'draw') == 'cull':
             label += ', back faces culled'
+        occluders, complexity = c.get('occluders', 'role'), c.get('complexity', 256)
+        if occluders != 'role' or complexity != 256:  # the defaults; others are named
+            label += f', {occluders} occluders' + (f' at complexity {complexity:g}' if complexity != 256 else '')
         points.setdefault(label, {})[kind] = doc
     return points
 
