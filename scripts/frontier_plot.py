@@ -86,6 +86,8 @@ def load_homcull(out):
         occluders, complexity = c.get('occluders', 'role'), c.get('complexity', 256)
         if occluders != 'role' or complexity != 256:  # the defaults; others are named
             label += f', {occluders} occluders' + (f' at complexity {complexity:g}' if complexity != 256 else '')
+        if kind in points.get(label, {}):  # one would hide the other in the plot and the table
+            sys.exit(f'frontier_plot.py: two configurations are both named "{label}"; name what tells them apart in load_homcull')
         points.setdefault(label, {})[kind] = doc
     return points
 
