@@ -442,7 +442,8 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
     }
     expect_refused("bench --workload frame --scene gen:city --random 2 --walk 2", 1, "give exactly one of --views P, --walk N and --random N");
     expect_refused("bench --workload frame --scene gen:city --random 2 --vs-scalar", 1, "--vs-scalar and --sample-depth are for s1 and castle");
-    expect_refused("bench --workload s1 --walk 3", 1, "--walk and --random are for --workload frame");
+    expect_refused("bench --workload s1 --walk 3", 1, "--walk is for --workload frame");
+    expect_refused("bench --workload castle --back-faces cull", 1, "--back-faces is for --workload frame");
     expect_refused("bench --workload frame --scene gen:city --random 2 --repeat -1", 1, "--repeat must be at least 1");
     expect_refused("bench --workload frame --scene /nonexistent.glb --random 2", 1, "/nonexistent.glb");
 }
@@ -453,8 +454,8 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
 // are the machine's.
 TEST(Cli, FrameBenchScalingReportsTheThreadsBesideTheMachinesCeiling) {
     expect_refused("bench --workload frame --scene gen:city --random 2 --scaling", 1, "give --threads N with N >= 2, got 1");
-    expect_refused("bench --workload s1 --complexity 2", 1, "--scaling, --complexity and --occluders are for --workload frame");
-    expect_refused("bench --workload castle --occluders all", 1, "--scaling, --complexity and --occluders are for --workload frame");
+    expect_refused("bench --workload s1 --complexity 2", 1, "--complexity is for --workload frame");
+    expect_refused("bench --workload castle --occluders all", 1, "--occluders is for --workload frame");
     expect_refused("bench --workload frame --scene gen:city --random 2 --occluders some", 105, "--occluders");
     expect_refused("bench --workload frame --scene gen:city --random 2 --complexity -1", 105, "--complexity");
     if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one hardware thread: no ceiling to measure";
