@@ -39,6 +39,7 @@ configs=(
   "triangles, clusters, back faces culled|--back-faces cull"
   "triangles|--clusters 0"
   "triangles, clusters, every object cheap for its surface an occluder|--occluders all --complexity 0.25"
+  "triangles, clusters, every object cheap for its surface an occluder where large on screen|--occluders all --complexity 0.25 --min-occluder-size 0.02"
 )
 run_config() {
   local name=${1%%|*} args=${1#*|} pass=$2 file

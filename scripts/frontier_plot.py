@@ -77,15 +77,24 @@ def load_homcull(out):
     for (_, kind), docs in sorted(runs.items()):
         doc = merge_passes(docs)
         c = doc['config']
+        defaults = doc.get('defaults')
+        if defaults is None:
+            sys.exit('frontier_plot.py: %s has no "defaults" (a bench older than this script): rerun frontier.sh' % kind)
+        changed = {key for key, value in c.items() if defaults.get(key) != value}
         label = ('boxes' if c['occludees'] == 'box' else 'triangles') + (', clusters' if c['clusters'] == 'on' else '')
-        parts = c.get('occludee_parts', 16)
-        if parts != 16:  # the default; others are named
+        changed -= {'occludees', 'clusters'}
+        # The options frontier.sh varies, in words; any other that differs from the defaults by its name.
+        if 'occludee_parts' in changed:
+            parts = c['occludee_parts']
             label += ', ' + (f'{parts} parts' if parts > 1 else 'no parts')
-        if c.get('back_faces', 'draw') == 'cull':
-            label += ', back faces culled'
-        occluders, complexity = c.get('occluders', 'role'), c.get('complexity', 256)
-        if occluders != 'role' or complexity != 256:  # the defaults; others are named
-            label += f', {occluders} occluders' + (f' at complexity {complexity:g}' if complexity != 256 else '')
+        if 'back_faces' in changed:
+            label += f", back faces {'culled' if c['back_faces'] == 'cull' else c['back_faces']}"
+        if changed & {'occluders', 'complexity'}:
+            label += f", {c['occluders']} occluders" + (f" at complexity {c['complexity']:g}" if 'complexity' in changed else '')
+        if 'min_occluder_size' in changed:
+            label += f", those at least {c['min_occluder_size']:g} sr"
+        for key in sorted(changed - {'occludee_parts', 'back_faces', 'occluders', 'complexity', 'min_occluder_size'}):
+            label += f', {key} {c[key]}'
         if kind in points.get(label, {}):  # one would hide the other in the plot and the table
             sys.exit(f'frontier_plot.py: two configurations are both named "{label}"; name what tells them apart in load_homcull')
         points.setdefault(label, {})[kind] = doc

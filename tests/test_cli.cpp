@@ -418,7 +418,7 @@ TEST(Cli, BenchPrintsItsTimingsAndRefusesBadOptions) {
 TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
     for (const std::string views : {"--random 3", "--walk 3"}) {
         const CliRun r = run_cli("bench --workload frame --scene gen:city:seed=2,blocks=3 " + views +
-                                 " --resolution 160x90 --repeat 2 --occludees box --clusters 64 --occluders all --json");
+                                 " --resolution 160x90 --repeat 2 --occludees box --clusters 64 --occluders all --min-occluder-size 0.001 --json");
         ASSERT_EQ(r.exit_code, 0) << r.err;
         const nlohmann::json j = nlohmann::json::parse(r.out);
         EXPECT_EQ(j["workload"], "frame");
@@ -426,6 +426,10 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
         EXPECT_EQ(j["config"]["occludees"], "box");
         EXPECT_EQ(j["config"]["occluders"], "all");
         EXPECT_EQ(j["config"]["clusters"], "on");
+        EXPECT_EQ(j["config"]["min_occluder_size"], 0.001);
+        // cull's defaults beside the configuration, for readers that name what differs (frontier_plot.py).
+        EXPECT_EQ(j["defaults"]["occluders"], "role");
+        EXPECT_EQ(j["defaults"]["min_occluder_size"], 0.0);
         ASSERT_EQ(j["per_view"].size(), 3u) << views;
         for (const nlohmann::json& v : j["per_view"]) {
             EXPECT_GT(v["frame_ms"].get<double>(), 0.0);
@@ -456,6 +460,8 @@ TEST(Cli, FrameBenchScalingReportsTheThreadsBesideTheMachinesCeiling) {
     expect_refused("bench --workload frame --scene gen:city --random 2 --scaling", 1, "give --threads N with N >= 2, got 1");
     expect_refused("bench --workload s1 --complexity 2", 1, "--complexity is for --workload frame");
     expect_refused("bench --workload castle --occluders all", 1, "--occluders is for --workload frame");
+    expect_refused("bench --workload castle --min-occluder-size 0.1", 1, "--min-occluder-size is for --workload frame");
+    expect_refused("bench --workload frame --scene gen:city --random 2 --min-occluder-size -1", 105, "--min-occluder-size");
     expect_refused("bench --workload frame --scene gen:city --random 2 --occluders some", 105, "--occluders");
     expect_refused("bench --workload frame --scene gen:city --random 2 --complexity -1", 105, "--complexity");
     if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one hardware thread: no ceiling to measure";

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <limits>
 #include <cstdio>
@@ -109,6 +110,28 @@ TEST(OccluderSelection, RankingKeepsTheFrustumOrderAndTheBudget) {
     // Area: the largest projected size first.
     rank_occluders(scene, candidates, camera, aspect, {OccluderRanking::area, 0}, chosen, scratch);
     EXPECT_EQ(chosen.size(), in_frustum);
+
+    // A size limit: the candidates in the frustum whose box looks at least that large, (box
+    // diagonal / distance)^2, the distance at least the near plane's; large_enough_to_draw agrees.
+    for (const double limit : {0.001, 0.01, 0.1}) {
+        OccluderBudget budget;
+        budget.min_projected_size = limit;
+        rank_occluders(scene, candidates, camera, aspect, budget, chosen, scratch);
+        std::size_t large = 0;
+        for (std::uint32_t id : candidates) {
+            const Aabb& b = scene.objects[id].world_bounds;
+            const glm::dvec3 nearest = glm::clamp(camera.eye, glm::dvec3(b.min), glm::dvec3(b.max));
+            const double d = std::max(glm::length(camera.eye - nearest), camera.near_plane);
+            const double diagonal = glm::length(glm::dvec3(b.extent()));
+            const bool kept = std::find(chosen.begin(), chosen.end(), id) != chosen.end();
+            const bool is_large = diagonal * diagonal / (d * d) >= limit;
+            EXPECT_EQ(kept, is_large && may_meet(frustum, b)) << "object " << id << ", limit " << limit;
+            EXPECT_EQ(large_enough_to_draw(b, camera, budget), is_large) << "object " << id << ", limit " << limit;
+            large += kept;
+        }
+        EXPECT_GT(large, 0u) << limit;
+        EXPECT_LT(large, in_frustum) << limit;
+    }
 }
 
 TEST(OccluderSelection, ComplexityFilterDropsObjectsDenseForTheirSurface) {
@@ -173,6 +196,8 @@ const StrategyCase kStrategies[] = {
     {"one-pass, clusters", CullStrategy::one_pass, {}, true, false, true},
     {"progressive, clusters", CullStrategy::progressive, {}, true, false, true},
     {"temporal, distance budget, LOD, clusters", CullStrategy::temporal, {OccluderRanking::distance, 3000}, true, true, true},
+    {"progressive, size limit", CullStrategy::progressive, {OccluderRanking::none, 0, nullptr, 0.02}, true},
+    {"temporal, size limit, clusters", CullStrategy::temporal, {OccluderRanking::none, 0, nullptr, 0.02}, true, false, true},
 };
 constexpr std::size_t kOnePassLod = 8;
 
@@ -691,13 +716,14 @@ TEST(SceneCulling, BackfaceCullingLeavesOutEveryOccluderTriangleFacingAway) {
 struct SeamedWall {
     std::uint32_t left, right, stick;
 };
-SeamedWall add_seamed_wall(Scene& scene) {
+// right_end: where the right half ends (x); narrower than the left half, it looks smaller.
+SeamedWall add_seamed_wall(Scene& scene, float right_end = 10.0f) {
     // The seam 2^-12 sample right of the column's centres: inside the left half by less than the
     // margin (2^-10 sample). (A sample centre exactly on a shared edge is covered by neither side.)
     const float seam = 5.0f * (65.0f / 33.0f) * (2.0f / 65.0f) * 0x1.0p-12f;
     SeamedWall w;
     w.left = test::add_quad(scene, "left half", {-10, -10, -5}, {seam, -10, -5}, {seam, 10, -5}, {-10, 10, -5});
-    w.right = test::add_quad(scene, "right half", {seam, -10, -5}, {10, -10, -5}, {10, 10, -5}, {seam, 10, -5});
+    w.right = test::add_quad(scene, "right half", {seam, -10, -5}, {right_end, -10, -5}, {right_end, 10, -5}, {seam, 10, -5});
     w.stick = test::add_box(scene, "stick behind the seam", {-1e-4f, -1, -10}, {1e-4f, 1, -9});
     return w;
 }
@@ -734,6 +760,50 @@ TEST(SceneCulling, EdgesSharedAcrossObjectsCloseTheSeamAsTrianglesAndAsClusters)
         ASSERT_EQ(culler.drawn_occluders(), std::vector<std::uint32_t>{left}) << (clusters ? "clusters" : "triangles");
         EXPECT_EQ(answers[stick].visibility, Visibility::visible) << (clusters ? "clusters" : "triangles") << ", the left half alone";
     }
+}
+
+// A size limit (OccluderBudget::min_projected_size) that leaves the narrower right half out
+// leaves the seam open, as a budget does: the left half's edge on it keeps its margin, and the
+// stick shows through; with both halves large enough, the seam closes.
+TEST(SceneCulling, ASizeLimitLeavesTheSeamOpenWithTheNeighbourLeftOut) {
+    Scene scene;
+    const auto [left, right, stick] = add_seamed_wall(scene, 1.0f);
+    scene.finalize();
+    const Camera camera = test::camera_down_minus_z(90.0);
+    // From the eye, 5 before the wall: the left half's box 20 x 10, (diagonal / 5)^2 = 20; the right
+    // half's 20 x 1, 16.04.
+    for (const bool clusters : {false, true}) {
+        for (const double limit : {18.0, 15.0}) {
+            SceneCullerConfig config;
+            config.display = {65, 33};
+            config.occluder_clusters = clusters;
+            config.occluder_budget.min_projected_size = limit;
+            SceneCuller culler(scene, {left, right}, config);
+            std::vector<OccludeeAnswer> answers;
+            culler.cull(camera, answers);
+            const std::string label = std::string(clusters ? "clusters" : "triangles") + ", limit " + std::to_string(limit);
+            if (limit == 18.0) {
+                EXPECT_EQ(culler.drawn_occluders(), std::vector<std::uint32_t>{left}) << label;
+                EXPECT_EQ(answers[stick].visibility, Visibility::visible) << label;
+            } else {
+                EXPECT_EQ(culler.drawn_occluders().size(), 2u) << label;
+                EXPECT_EQ(answers[stick].visibility, Visibility::occluded) << label;
+            }
+        }
+    }    // A limit below 0 or not a number is refused, naming the value; infinity draws nothing.
+    for (const double limit : {-1.0, std::nan("")}) {
+        SceneCullerConfig config;
+        config.occluder_budget.min_projected_size = limit;
+        EXPECT_THROW(SceneCuller(scene, {left, right}, config), Error) << limit;
+    }
+    SceneCullerConfig config;
+    config.display = {65, 33};
+    config.occluder_budget.min_projected_size = std::numeric_limits<double>::infinity();
+    SceneCuller culler(scene, {left, right}, config);
+    std::vector<OccludeeAnswer> answers;
+    culler.cull(camera, answers);
+    EXPECT_TRUE(culler.drawn_occluders().empty());
+    EXPECT_EQ(answers[stick].visibility, Visibility::visible);
 }
 
 // Temporal culling draws last frame's visible candidates, then those that came into view: an

@@ -104,6 +104,7 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
         // Smaller keys first. The near plane bounds the distance below: every object that
         // reaches in front of it ranks alike by size.
         const double distance = std::max(distance_to_box(camera.eye, box), camera.near_plane);
+        if (budget.min_projected_size > 0.0 && projected_size(box, distance) < budget.min_projected_size) continue;  // large_enough_to_draw
         double key = distance;
         if (budget.ranking == OccluderRanking::area) {
             key = -projected_size(box, distance);
@@ -125,6 +126,11 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
         chosen.push_back(id);
         left -= n;
     }
+}
+
+bool large_enough_to_draw(const Aabb& box, const Camera& camera, const OccluderBudget& budget) {
+    if (!(budget.min_projected_size > 0.0)) return true;
+    return projected_size(box, std::max(distance_to_box(camera.eye, box), camera.near_plane)) >= budget.min_projected_size;
 }
 
 std::size_t occluder_triangles_drawn(const Scene& scene, std::uint32_t id, const Camera& camera, const OccluderLods* lods) {

@@ -120,6 +120,9 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
         throw Error("progressive culling needs a batch of at least one triangle");
     if (config.occluder_budget.ranking == OccluderRanking::baked && !config.occluder_budget.grid)
         throw Error("baked occluder ranking needs a visibility grid");
+    if (!(config.occluder_budget.min_projected_size >= 0.0))  // infinity allowed: no occluder drawn
+        throw Error("an occluder's minimum projected size must be at least 0 square radians, got " +
+                    std::to_string(config.occluder_budget.min_projected_size));
     if (config.occludee_parts < 0 || config.occludee_parts > 64)
         throw Error("occludee parts must be 0 to 64 per object, got " + std::to_string(config.occludee_parts));
     if (!(config.temporal_cut.step_in_near_planes >= 0.0))
@@ -274,7 +277,8 @@ void detail::SceneCullerState::select_occluders(const Frame& frame) {
     // neighbour is drawn.
     bool any_lod = false;
     for (std::size_t i = 0; i < ranked_.size() && !any_lod; ++i) any_lod = draws_lod(ranked_[i], *frame.camera);
-    const bool every_candidate_in_frustum = pool == &occluder_ids_ && config_.occluder_budget.triangles == 0 && !any_lod;
+    const bool every_candidate_in_frustum =
+        pool == &occluder_ids_ && config_.occluder_budget.triangles == 0 && !(config_.occluder_budget.min_projected_size > 0.0) && !any_lod;
     const EdgeFlags flags = every_candidate_in_frustum ? EdgeFlags::across_objects : any_lod ? EdgeFlags::own_object : EdgeFlags::drawn_neighbours;
     for (std::uint32_t id : ranked_) append_occluder(id, frame, flags);
     timings_.select_ms += ms_since(start);
@@ -590,6 +594,7 @@ void detail::SceneCullerState::draw_newly_visible(const Frame& frame, std::vecto
         const std::uint32_t id = occluder_ids_[k];
         if (drawn_[k] || answers[id].visibility != Visibility::visible) continue;
         const Aabb& box = scene_->objects[id].world_bounds;
+        if (!large_enough_to_draw(box, *frame.camera, config_.occluder_budget)) continue;
         const glm::dvec3 eye = frame.camera->eye;
         rank_scratch_.emplace_back(float(glm::length(eye - glm::clamp(eye, glm::dvec3(box.min), glm::dvec3(box.max)))), id);
     }

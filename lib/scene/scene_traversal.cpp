@@ -85,6 +85,7 @@ void detail::SceneCullerState::traverse(const Frame& frame, std::vector<Occludee
             add_tally(tally);
             // progressive: a visible candidate is drawn with the next batch, within the budget.
             if (progressive && answers[id].visibility == Visibility::visible && candidate_of_[id] != kNone &&
+                large_enough_to_draw(scene_->objects[id].world_bounds, *frame.camera, config_.occluder_budget) &&
                 work_.occluder_triangles + occluder_triangles_drawn(*scene_, id, *frame.camera, config_.lods) <= budget) {
                 append_occluder(id, frame, EdgeFlags::drawn_neighbours);
                 waiting_nearest_far = std::min(waiting_nearest_far, farthest_distance2(frame.camera->eye, scene_->objects[id].world_bounds));

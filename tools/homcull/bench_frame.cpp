@@ -151,6 +151,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
             {"threads", o.threads},
             {"rounds", o.rounds},
             {"config", cull_config_json(o.cull)},
+            {"defaults", cull_config_json(CullOptions{})},  // cull's: what a reader of "config" compares against
             {"per_view", per_view},
             {"summary", summary}};
         if (o.scaling) out["scaling"] = scaling;

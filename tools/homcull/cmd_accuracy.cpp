@@ -134,7 +134,7 @@ void register_accuracy(CLI::App& app) {
     cmd->callback([o, cmd] {
         if (o->scene.file.empty())  // S1 has its own buffer and no scene: these would be silently ignored
             for (const char* name : {"--path", "--walk", "--orbit", "--buffer", "--mode", "--hole", "--distribution", "--transparency",
-                                     "--soup-cells", "--depth", "--deb", "--finest-level", "--pyramid", "--occludee-parts", "--random", "--offset", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--complexity", "--strategy", "--rank", "--grid", "--lod", "--budget", "--batch",
+                                     "--soup-cells", "--depth", "--deb", "--finest-level", "--pyramid", "--occludee-parts", "--random", "--offset", "--coarsest-level", "--occludees", "--sample-depth", "--occluders", "--complexity", "--strategy", "--rank", "--grid", "--lod", "--budget", "--min-occluder-size", "--batch",
                                      "--hierarchy"})
                 if (cmd->get_option(name)->count() > 0) throw Error(std::string("accuracy: ") + name + " needs --scene");
         if (!o->scene.file.empty()) {

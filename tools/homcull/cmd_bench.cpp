@@ -297,6 +297,10 @@ void register_bench(CLI::App& app) {
                     "frame: drop occluder candidates with more than F times the median triangles per unit of their surface "
                     "(cull --complexity); 0: keep all")
         ->capture_default_str()->check(CLI::NonNegativeNumber);
+    cmd->add_option("--min-occluder-size", o->frame.min_occluder_size,
+                    "frame: draw only the occluder candidates whose box looks at least this large from the eye, in square "
+                    "radians (cull --min-occluder-size); 0: every one")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
     cmd->add_flag("--scaling", o->scaling,
                   "frame, --threads N >= 2: also time one thread, N threads and N single-threaded copies at once (the "
                   "machine's ceiling) in alternation, and report the threads' speed-up beside the ceiling and beside the time a "
@@ -308,7 +312,7 @@ void register_bench(CLI::App& app) {
     cmd->add_flag("--json", o->json, "Print JSON on stdout");
     cmd->callback([o, cmd] {
         for (const char* name : {"--walk", "--random", "--seed", "--occludees", "--closed-back-faces", "--back-faces", "--merge-coplanar",
-                                 "--occludee-parts", "--pyramid", "--occluders", "--complexity", "--scaling"})
+                                 "--occludee-parts", "--pyramid", "--occluders", "--complexity", "--min-occluder-size", "--scaling"})
             if (o->frame_option_given.empty() && cmd->count(name) > 0) o->frame_option_given = name;
         run_bench(*o);
     });

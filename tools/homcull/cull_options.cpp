@@ -106,6 +106,10 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--budget", o.budget, "Occluder triangles per frame at most (0: no limit)")
         ->capture_default_str()
         ->check(kWholeNumber);
+    app.add_option("--min-occluder-size", o.min_occluder_size,
+                   "Draw only the occluder candidates whose box looks at least this large from the eye: (box diagonal / "
+                   "distance)^2, in square radians (a box as wide as it is far: 1); 0: every one")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
     app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
         ->capture_default_str()->check(CLI::PositiveNumber);
     app.add_option("--hierarchy", o.hierarchy, "on: test the object hierarchy's nodes and skip what a hidden node holds; off: test "
@@ -148,6 +152,7 @@ SceneCullerConfig scene_culler_config(const CullOptions& o, int threads) {
                                                    : OccluderRanking::none;
     if ((o.rank == "baked") != !o.grid.empty()) throw Error("--rank baked and --grid FILE (from homcull bake) go together");
     c.occluder_budget.triangles = o.budget;
+    c.occluder_budget.min_projected_size = o.min_occluder_size;
     c.progressive_batch_triangles = o.batch;
     c.hierarchy = o.hierarchy == "on";
     return c;

@@ -30,6 +30,7 @@ struct CullOptions {
     std::size_t budget = 0, batch = 1024;
     double cut_step = TemporalCut{}.step_in_near_planes, cut_turn = TemporalCut{}.turn_degrees;
     double complexity = kDefaultComplexity;
+    double min_occluder_size = 0.0;  // square radians (OccluderBudget::min_projected_size)
 };
 
 // with_display: also --resolution and --samples (commands that define their own leave them out

@@ -61,6 +61,7 @@ nlohmann::json cull_config_json(const CullOptions& o) {
             {"grid", o.grid},
             {"lod", o.lod},
             {"budget", o.budget},
+            {"min_occluder_size", o.min_occluder_size},
             {"batch", o.batch},
             {"hierarchy", o.hierarchy}};
 }

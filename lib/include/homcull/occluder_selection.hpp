@@ -57,6 +57,11 @@ struct OccluderBudget {
     std::size_t triangles = 0;
     // baked: the grid (not owned; it must outlive the ranking's users).
     const VisibilityGrid* grid = nullptr;
+    // Candidates whose box looks smaller than this from the eye are not drawn: its projected
+    // size, (box diagonal / distance to the box)^2 in square radians (the size area ranking
+    // sorts by), below the limit. Zhang's occluder selection keeps the objects that are large on
+    // the screen: a near pillar hides a room, a far one a few pixels. 0 = no limit.
+    double min_projected_size = 0.0;
 };
 
 // Per frame: the candidates whose box meets the camera's frustum (plane test), in rank
@@ -67,6 +72,11 @@ struct OccluderBudget {
 void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candidates, const Camera& camera, double aspect,
                     const OccluderBudget& budget, std::vector<std::uint32_t>& chosen,
                     std::vector<std::pair<float, std::uint32_t>>& scratch, const OccluderLods* lods = nullptr);
+
+// Whether a candidate with this box is large enough to draw from the camera's eye
+// (OccluderBudget::min_projected_size; always, without a limit). Every per-frame choice of
+// occluders (rank_occluders, temporal's second pass, progressive's draws) asks it.
+bool large_enough_to_draw(const Aabb& box, const Camera& camera, const OccluderBudget& budget);
 
 // The triangles an occluder is drawn with this frame: its LOD's when it has one and
 // lod_usable() allows it, else its mesh's. `lods` may be null.
