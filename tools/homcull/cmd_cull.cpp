@@ -8,6 +8,7 @@
 #include <homcull/io/scene_io.hpp>
 #include <homcull/truth/culling_accuracy.hpp>
 #include <homcull/truth/ground_truth.hpp>
+#include <homcull/truth/occluder_bound.hpp>
 #include <homcull/truth/ray_scene.hpp>
 
 #include <fmt/core.h>
@@ -70,6 +71,23 @@ void run_cull(const CullCommandOptions& o) {
 
     CullingTally tally;
     if (o.truth) tally_answers(scene, truth, answers, camera, tally);
+    // The occluders' bound: which of the objects hidden outright the occluders this frame drew
+    // could hide at all (truth/occluder_bound.hpp), and so which misses selection would mend.
+    struct {
+        std::size_t hidden = 0, hideable = 0, missed_hideable = 0, missed_not_hideable = 0;
+        double trace_ms = 0.0;
+    } bound;
+    if (o.truth) {
+        const OccluderBound b = occluder_bound(*rays, scene, camera, config.display, culler.drawn_occluders());
+        bound.trace_ms = b.trace_ms;
+        for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+            const ObjectVisibility& v = truth.objects[id];
+            if (!v.in_frustum || v.visible_samples > 0 || v.tie_samples > 0) continue;  // hidden outright only
+            ++bound.hidden;
+            bound.hideable += b.hideable[id];
+            if (answers[id].visibility == Visibility::visible) ++(b.hideable[id] ? bound.missed_hideable : bound.missed_not_hideable);
+        }
+    }
     std::size_t counts[3] = {};
     std::uint64_t triangles = 0, after_frustum = 0, after_occlusion = 0;
     nlohmann::json objects = nlohmann::json::array();
@@ -115,7 +133,15 @@ void run_cull(const CullCommandOptions& o) {
                             {"missed_culls", tally.missed_culls()}, {"efficiency", tally.efficiency()},
                             {"hidden_through_ties", tally.hidden_through_ties}, {"culled_through_ties", tally.culled_through_ties},
                             {"robust_efficiency", tally.robust_efficiency()},
-                            {"false_cull_reports", tally.false_cull_reports}, {"trace_ms", truth_ms}};
+                            {"false_cull_reports", tally.false_cull_reports}, {"trace_ms", truth_ms},
+                            {"occluder_bound",
+                             {{"occluders_drawn", culler.drawn_occluders().size()},
+                              {"hidden_outright", bound.hidden},
+                              {"hideable", bound.hideable},
+                              {"efficiency_bound", bound.hidden ? double(bound.hideable) / double(bound.hidden) : 1.0},
+                              {"missed_hideable", bound.missed_hideable},
+                              {"missed_not_hideable", bound.missed_not_hideable},
+                              {"trace_ms", bound.trace_ms}}}};
         }
         fmt::print("{}\n", out.dump(1));
         return;
@@ -136,6 +162,11 @@ void run_cull(const CullCommandOptions& o) {
                    "trace {:.0f} ms\n",
                    tally.false_culls, tally.culled_hidden, tally.hidden_in_frustum, 100.0 * tally.efficiency(), tally.hidden_through_ties,
                    truth_ms);
+        fmt::print("bound      the {} occluders drawn could hide {} of the {} objects hidden outright ({:.1f} %); of the misses, {} "
+                   "they could hide, {} they could not; trace {:.0f} ms\n",
+                   culler.drawn_occluders().size(), bound.hideable, bound.hidden,
+                   100.0 * (bound.hidden ? double(bound.hideable) / double(bound.hidden) : 1.0), bound.missed_hideable,
+                   bound.missed_not_hideable, bound.trace_ms);
         for (const std::string& line : tally.false_cull_reports) fmt::print("false cull: {}\n", line);
     }
     fmt::print("(--json lists every object)\n");

@@ -1,0 +1,33 @@
+#pragma once
+// The most a culler drawing a given set of occluders can cull from one view: a diagnostic that
+// splits a culler's misses into those its occluders could not hide at all (a matter of which
+// objects are drawn: occluder selection) and those they could (a matter of how they are drawn
+// and tested: margins, bounds, depth estimates).
+//
+// Rays go through the display's pixel centres, as compute_ground_truth casts them (S = 1), and
+// stop only at the occluders' geometry: every other object met before the first occluder hit
+// is seen there. An object is hideable by the occluders when no ray sees it: wherever a ray
+// meets it, an occluder lies strictly nearer. An occluder met first is seen too (nothing
+// drawn hides it there). Objects no ray meets (hidden or outside the view) are hideable.
+#include <homcull/camera.hpp>
+#include <homcull/scene.hpp>
+#include <homcull/truth/ray_scene.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace homcull {
+
+struct OccluderBound {
+    std::vector<std::uint8_t> hideable;  // per object id: 1 when the occluders hide it at every pixel centre
+    std::uint64_t rays = 0;              // one per pixel centre
+    std::uint64_t hits = 0;              // hits met before each ray's first occluder, or its end
+    double trace_ms = 0.0;
+};
+
+// Throws homcull::Error on an invalid or orthographic camera, an invalid resolution, a ray
+// scene built from another scene, or an occluder id out of range. Uses all cores (oneTBB).
+OccluderBound occluder_bound(const RayScene& rays, const Scene& scene, const Camera& camera, Resolution display,
+                             const std::vector<std::uint32_t>& occluders);
+
+}  // namespace homcull

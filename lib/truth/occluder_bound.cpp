@@ -1,0 +1,115 @@
+// The occluders' bound (homcull/truth/occluder_bound.hpp): one ray per pixel centre that stops
+// at the first occluder hit, recording the other objects met before it; in parallel over rows
+// (oneTBB).
+#include "truth/embree_scene.hpp"
+
+#include <homcull/error.hpp>
+#include <homcull/frustum.hpp>
+#include <homcull/truth/occluder_bound.hpp>
+
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <string>
+
+namespace homcull {
+namespace {
+
+struct Hit {
+    float t;
+    std::uint32_t object;
+};
+
+// The context the filter sees. An occluder's hit is accepted, so that Embree shortens the ray
+// to it and shows only nearer hits after it; any other object's is recorded and rejected, so
+// that traversal goes on past it (Embree 3 sets the ray's tfar to the hit's distance before
+// calling the filter).
+struct StopAtOccluders {
+    RTCIntersectContext context;  // first, so that the filter can cast back
+    const std::uint8_t* is_occluder;
+    std::vector<Hit>* passed;
+};
+
+void stop_at_occluders(const RTCFilterFunctionNArguments* args) {
+    auto* c = reinterpret_cast<StopAtOccluders*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const std::uint32_t object = RTCHitN_geomID(args->hit, args->N, i);
+        if (c->is_occluder[object]) continue;
+        c->passed->push_back({RTCRayN_tfar(args->ray, args->N, i), object});
+        args->valid[i] = 0;
+    }
+}
+
+}  // namespace
+
+OccluderBound occluder_bound(const RayScene& rays, const Scene& scene, const Camera& camera, Resolution display,
+                             const std::vector<std::uint32_t>& occluders) {
+    validate_camera(camera);
+    validate_resolution(display);
+    if (camera.ortho_height > 0.0) throw Error("occluder bound: orthographic cameras are not supported (rays start at the eye)");
+    const std::size_t objects = scene.objects.size();
+    if (rays.object_count() != objects) throw Error("occluder bound: the ray scene was built from another scene");
+    std::vector<std::uint8_t> is_occluder(objects, 0);
+    for (std::uint32_t id : occluders) {
+        if (id >= objects) throw Error("occluder bound: occluder id " + std::to_string(id) + " is out of range (" + std::to_string(objects) + " objects)");
+        is_occluder[id] = 1;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const RTCScene rtc = rays.impl().scene;
+    const CameraBasis basis = camera_basis(camera);
+    const double aspect = display.aspect();
+    const glm::vec3 eye(camera.eye - rays.anchor());
+    const float t_near = float(camera.near_plane), t_far = float(camera.far_plane);
+
+    struct Local {
+        std::vector<std::uint8_t> seen;
+        std::uint64_t hits = 0;
+    };
+    tbb::combinable<Local> locals;
+    tbb::parallel_for(tbb::blocked_range<int>(0, display.height, 4), [&](const tbb::blocked_range<int>& rows) {
+        Local& local = locals.local();
+        if (local.seen.empty()) local.seen.assign(objects, 0);
+        std::vector<Hit> passed;
+        StopAtOccluders context;
+        rtcInitIntersectContext(&context.context);
+        context.context.filter = stop_at_occluders;
+        context.is_occluder = is_occluder.data();
+        context.passed = &passed;
+        for (int y = rows.begin(); y < rows.end(); ++y)
+            for (int x = 0; x < display.width; ++x) {
+                const glm::vec3 d(ray_direction(camera, basis, aspect, pixel_to_ndc(display, x + 0.5, y + 0.5)));
+                RTCRayHit rh{};
+                rh.ray.org_x = eye.x, rh.ray.org_y = eye.y, rh.ray.org_z = eye.z;
+                rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+                rh.ray.tnear = t_near;
+                rh.ray.tfar = t_far;
+                rh.ray.mask = 0xFFFFFFFFu;
+                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                passed.clear();
+                rtcIntersect1(rtc, &context.context, &rh);
+                // The first occluder hit is seen; so is every other object met no farther than it
+                // (a tie with an occluder's surface counts as seen: it decides nothing either way).
+                if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) local.seen[rh.hit.geomID] = 1;
+                for (const Hit& h : passed)
+                    if (h.t <= rh.ray.tfar) local.seen[h.object] = 1;
+                local.hits += passed.size();
+            }
+    });
+
+    OccluderBound bound;
+    bound.rays = std::uint64_t(display.width) * std::uint64_t(display.height);
+    bound.hideable.assign(objects, 1);
+    locals.combine_each([&](const Local& l) {
+        bound.hits += l.hits;
+        for (std::size_t id = 0; id < l.seen.size(); ++id)
+            if (l.seen[id]) bound.hideable[id] = 0;
+    });
+    bound.trace_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return bound;
+}
+
+}  // namespace homcull
