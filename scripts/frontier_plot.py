@@ -171,8 +171,9 @@ def main():
         some = next(iter(next(iter(homcull.values())).values()))
         f.write('homcull: each view\'s whole frame is its median over %d pass(es) of %d rounds in all, the configurations\' order '
                 'alternating from pass to pass.\n\n' % (some.get('passes', 1), some['rounds']))
-        f.write('| culler | view | frame ms | passes\' range | efficiency, hidden outright | efficiency, all hidden | false culls |\n')
-        f.write('|---|---|---|---|---|---|---|\n')
+        f.write('| culler | view | frame ms | passes\' range | efficiency, hidden outright | efficiency, all hidden | '
+                'the occluders\' bound | false culls |\n')
+        f.write('|---|---|---|---|---|---|---|---|\n')
         for label, docs in sorted(homcull.items()):
             for kind in ('castle', 'random'):
                 if kind not in docs:
@@ -182,12 +183,15 @@ def main():
                 s = doc['summary']
                 rows.append(('%s, mean of %d' % (kind, s['views']), dict(s, frame_ms=s['frame_ms']['mean'], frame_ms_passes=s['frame_ms_passes'])))
                 for name, v in rows:
-                    f.write('| homcull %s | %s | %.3f | %.3f-%.3f | %.1f %% | %.1f %% | %d |\n' % (
+                    # The share of the objects hidden outright that the occluders drawn hide at every
+                    # pixel centre (bench's occluder_bound): no culler drawing them culls more.
+                    bound = '%.1f %%' % (100 * v['occluder_bound']['efficiency_bound']) if 'occluder_bound' in v else ''
+                    f.write('| homcull %s | %s | %.3f | %.3f-%.3f | %.1f %% | %.1f %% | %s | %d |\n' % (
                         label, name, v['frame_ms'], min(v['frame_ms_passes']), max(v['frame_ms_passes']), 100 * v['efficiency'],
-                        100 * v['efficiency_plain'], v['false_culls']))
+                        100 * v['efficiency_plain'], bound, v['false_culls']))
         for label, per_view in sorted(peers.items()):
             for v, (ms, eff) in enumerate(per_view):
-                f.write('| %s | C%d | %.3f | | | %.1f %% | |\n' % (label, v, ms, eff))
+                f.write('| %s | C%d | %.3f | | | %.1f %% | | |\n' % (label, v, ms, eff))
     print('frontier_plot.py: wrote %s and %s' % (os.path.join(out, 'frontier.png'), os.path.join(out, 'frontier.md')))
 
 

@@ -439,7 +439,17 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
             EXPECT_GE(v["efficiency"].get<double>(), 0.0);
             EXPECT_LE(v["efficiency"].get<double>(), 1.0);
             EXPECT_LE(v["culled_outright"].get<std::size_t>(), v["hidden_outright"].get<std::size_t>());
+            // The occluders' bound: a conservative culler culls no object its occluders cannot hide,
+            // so every object hidden outright is culled, or missed with the bound saying why.
+            const nlohmann::json& bound = v["occluder_bound"];
+            EXPECT_EQ(bound["hidden_outright"], v["hidden_outright"]);
+            EXPECT_LE(v["culled_outright"].get<std::size_t>(), bound["hideable"].get<std::size_t>()) << views;
+            EXPECT_EQ(bound["missed_hideable"].get<std::size_t>() + bound["missed_not_hideable"].get<std::size_t>(),
+                      v["hidden_outright"].get<std::size_t>() - v["culled_outright"].get<std::size_t>())
+                << views;
+            EXPECT_GT(bound["occluders_drawn"].get<std::size_t>(), 0u);
         }
+        EXPECT_TRUE(j["summary"].contains("occluder_bound"));
         EXPECT_EQ(j["summary"]["views"], 3);
         EXPECT_EQ(j["summary"]["false_culls"], 0);
         EXPECT_GE(j["summary"]["frame_ms"]["max"].get<double>(), j["summary"]["frame_ms"]["mean"].get<double>());

@@ -64,6 +64,22 @@ TEST(OccluderBound, HidesWhatTheOccludersCoverAndNothingTheyDoNot) {
     EXPECT_EQ(b.hideable[r.in_view], 0);
     EXPECT_EQ(b.hideable[r.behind_eye], 1);  // no ray meets it
 
+    // Beside a culler's answers, over the two boxes hidden outright: every object answered
+    // visible misses both, one the wall could hide and one it could not; every object culled
+    // misses none.
+    std::vector<OccludeeAnswer> answers(r.scene.objects.size(), OccludeeAnswer{Visibility::visible, 1.0f, 0});
+    OccluderBoundTally t = tally_bound(truth, b, answers);
+    EXPECT_EQ(t.hidden, 2u);
+    EXPECT_EQ(t.hideable, 1u);
+    EXPECT_DOUBLE_EQ(t.efficiency_bound(), 0.5);
+    EXPECT_EQ(t.missed_hideable, 1u);
+    EXPECT_EQ(t.missed_not_hideable, 1u);
+    for (OccludeeAnswer& a : answers) a.visibility = Visibility::occluded;
+    t = tally_bound(truth, b, answers);
+    EXPECT_EQ(t.missed_hideable + t.missed_not_hideable, 0u);
+    answers.pop_back();
+    EXPECT_THROW(tally_bound(truth, b, answers), Error);
+
     // The decoration drawn too: both boxes behind are hideable.
     b = occluder_bound(rays, r.scene, camera, display, {r.wall, r.decoration});
     EXPECT_EQ(b.hideable[r.behind_wall], 1);

@@ -112,4 +112,26 @@ OccluderBound occluder_bound(const RayScene& rays, const Scene& scene, const Cam
     return bound;
 }
 
+OccluderBoundTally& OccluderBoundTally::operator+=(const OccluderBoundTally& o) {
+    hidden += o.hidden;
+    hideable += o.hideable;
+    missed_hideable += o.missed_hideable;
+    missed_not_hideable += o.missed_not_hideable;
+    return *this;
+}
+
+OccluderBoundTally tally_bound(const TruthResult& truth, const OccluderBound& bound, const std::vector<OccludeeAnswer>& answers) {
+    if (truth.objects.size() != bound.hideable.size() || answers.size() != bound.hideable.size())
+        throw Error("occluder bound: the truth, the bound and the answers are not of one scene");
+    OccluderBoundTally t;
+    for (std::size_t id = 0; id < answers.size(); ++id) {
+        const ObjectVisibility& v = truth.objects[id];
+        if (!v.in_frustum || v.visible_samples > 0 || v.tie_samples > 0) continue;
+        ++t.hidden;
+        t.hideable += bound.hideable[id];
+        if (answers[id].visibility == Visibility::visible) ++(bound.hideable[id] ? t.missed_hideable : t.missed_not_hideable);
+    }
+    return t;
+}
+
 }  // namespace homcull

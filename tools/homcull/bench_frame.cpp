@@ -12,6 +12,7 @@
 #include <homcull/scene_culler.hpp>
 #include <homcull/truth/culling_accuracy.hpp>
 #include <homcull/truth/ground_truth.hpp>
+#include <homcull/truth/occluder_bound.hpp>
 #include <homcull/truth/ray_scene.hpp>
 #include <homcull/truth/walk_path.hpp>
 
@@ -108,6 +109,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     TruthOptions truth_options;
     truth_options.resolution = config.display;
     CullingTally total;
+    OccluderBoundTally total_bound;
     nlohmann::json per_view = nlohmann::json::array();
     std::vector<double> frame_medians;
     for (std::size_t v = 0; v < views; ++v) {
@@ -116,6 +118,10 @@ void run_frame_bench(const FrameBenchOptions& o) {
         const TruthResult truth = compute_ground_truth(rays, scene, camera, truth_options);
         ViewFigures& f = figures[v];
         tally_answers(scene, truth, answers, camera, f.tally);
+        // What the occluders this frame drew could hide at all (truth/occluder_bound.hpp).
+        const OccluderBoundTally bound =
+            tally_bound(truth, occluder_bound(rays, scene, camera, config.display, culler.drawn_occluders()), answers);
+        total_bound += bound;
         for (const OccludeeAnswer& a : answers) ++f.counts[int(a.visibility)];
         total += f.tally;
         frame_medians.push_back(median(f.frame));
@@ -126,6 +132,8 @@ void run_frame_bench(const FrameBenchOptions& o) {
                                {"stages_ms", stages[v].medians()},
                                {"answers", {{"visible", f.counts[0]}, {"occluded", f.counts[1]}, {"view_culled", f.counts[2]}}}};
         view.update(accuracy_json(f.tally));
+        view["occluder_bound"] = occluder_bound_json(bound);
+        view["occluder_bound"]["occluders_drawn"] = culler.drawn_occluders().size();
         per_view.push_back(std::move(view));
     }
     double mean_frame = 0.0;
@@ -137,6 +145,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
                               {"frame_ms", {{"mean", mean_frame}, {"max", worst_frame}, {"median", median(frame_medians)}}},
                               {"stages_ms_mean", stage_means(stages)}};
     summary.update(accuracy_json(total));
+    summary["occluder_bound"] = occluder_bound_json(total_bound);
     const std::string source = !o.views.empty() ? o.views : o.walk > 0 ? "walk:" + std::to_string(o.walk) + ",seed=" + std::to_string(o.seed)
                                                                         : "random:" + std::to_string(o.random) + ",seed=" + std::to_string(o.seed);
     if (o.json) {
@@ -161,16 +170,17 @@ void run_frame_bench(const FrameBenchOptions& o) {
     fmt::print("frame bench: {} ({} objects), {} views from {}, {}x{} display, {} rounds, {} thread(s), {}\n", scene.source,
                scene.objects.size(), views, source, config.display.width, config.display.height, o.rounds, o.threads,
                culler.buffer().config().isa);
-    fmt::print("view  frame ms  (select  render    maps   tests)  efficiency (plain)  false culls\n");
+    fmt::print("view  frame ms  (select  render    maps   tests)  efficiency (plain)  occluders' bound  false culls\n");
     for (const nlohmann::json& v : per_view)
-        fmt::print("{:4}  {:8.3f}  ({:6.3f} {:7.3f} {:7.3f} {:7.3f})  {:8.1f} % ({:5.1f} %)  {}\n", v["view"].get<std::size_t>(),
+        fmt::print("{:4}  {:8.3f}  ({:6.3f} {:7.3f} {:7.3f} {:7.3f})  {:8.1f} % ({:5.1f} %)  {:13.1f} %  {}\n", v["view"].get<std::size_t>(),
                    v["frame_ms"].get<double>(), v["stages_ms"]["select"].get<double>(), v["stages_ms"]["render"].get<double>(),
                    v["stages_ms"]["maps"].get<double>(), v["stages_ms"]["tests"].get<double>(), 100.0 * v["efficiency"].get<double>(),
-                   100.0 * v["efficiency_plain"].get<double>(), v["false_culls"].get<std::size_t>());
+                   100.0 * v["efficiency_plain"].get<double>(), 100.0 * v["occluder_bound"]["efficiency_bound"].get<double>(),
+                   v["false_culls"].get<std::size_t>());
     fmt::print("all   mean {:.3f} ms, worst {:.3f} ms; efficiency {:.1f} % of {} objects hidden outright ({:.1f} % of all hidden); "
-               "{} false culls\n",
+               "{} false culls; the occluders drawn could hide {:.1f} %\n",
                mean_frame, worst_frame, 100.0 * total.robust_efficiency(), total.hidden_in_frustum - total.hidden_through_ties,
-               100.0 * total.efficiency(), total.false_culls);
+               100.0 * total.efficiency(), total.false_culls, 100.0 * total_bound.efficiency_bound());
     if (o.scaling) {
         const nlohmann::json& ms = scaling.at("frame_ms_mean");
         const nlohmann::json& trip = scaling.at("cross_core_round_trip_ns");

@@ -73,20 +73,12 @@ void run_cull(const CullCommandOptions& o) {
     if (o.truth) tally_answers(scene, truth, answers, camera, tally);
     // The occluders' bound: which of the objects hidden outright the occluders this frame drew
     // could hide at all (truth/occluder_bound.hpp), and so which misses selection would mend.
-    struct {
-        std::size_t hidden = 0, hideable = 0, missed_hideable = 0, missed_not_hideable = 0;
-        double trace_ms = 0.0;
-    } bound;
+    OccluderBoundTally bound;
+    double bound_ms = 0.0;
     if (o.truth) {
         const OccluderBound b = occluder_bound(*rays, scene, camera, config.display, culler.drawn_occluders());
-        bound.trace_ms = b.trace_ms;
-        for (std::size_t id = 0; id < scene.objects.size(); ++id) {
-            const ObjectVisibility& v = truth.objects[id];
-            if (!v.in_frustum || v.visible_samples > 0 || v.tie_samples > 0) continue;  // hidden outright only
-            ++bound.hidden;
-            bound.hideable += b.hideable[id];
-            if (answers[id].visibility == Visibility::visible) ++(b.hideable[id] ? bound.missed_hideable : bound.missed_not_hideable);
-        }
+        bound = tally_bound(truth, b, answers);
+        bound_ms = b.trace_ms;
     }
     std::size_t counts[3] = {};
     std::uint64_t triangles = 0, after_frustum = 0, after_occlusion = 0;
@@ -134,14 +126,9 @@ void run_cull(const CullCommandOptions& o) {
                             {"hidden_through_ties", tally.hidden_through_ties}, {"culled_through_ties", tally.culled_through_ties},
                             {"robust_efficiency", tally.robust_efficiency()},
                             {"false_cull_reports", tally.false_cull_reports}, {"trace_ms", truth_ms},
-                            {"occluder_bound",
-                             {{"occluders_drawn", culler.drawn_occluders().size()},
-                              {"hidden_outright", bound.hidden},
-                              {"hideable", bound.hideable},
-                              {"efficiency_bound", bound.hidden ? double(bound.hideable) / double(bound.hidden) : 1.0},
-                              {"missed_hideable", bound.missed_hideable},
-                              {"missed_not_hideable", bound.missed_not_hideable},
-                              {"trace_ms", bound.trace_ms}}}};
+                            {"occluder_bound", occluder_bound_json(bound)}};
+            out["truth"]["occluder_bound"]["occluders_drawn"] = culler.drawn_occluders().size();
+            out["truth"]["occluder_bound"]["trace_ms"] = bound_ms;
         }
         fmt::print("{}\n", out.dump(1));
         return;
@@ -164,9 +151,8 @@ void run_cull(const CullCommandOptions& o) {
                    truth_ms);
         fmt::print("bound      the {} occluders drawn could hide {} of the {} objects hidden outright ({:.1f} %); of the misses, {} "
                    "they could hide, {} they could not; trace {:.0f} ms\n",
-                   culler.drawn_occluders().size(), bound.hideable, bound.hidden,
-                   100.0 * (bound.hidden ? double(bound.hideable) / double(bound.hidden) : 1.0), bound.missed_hideable,
-                   bound.missed_not_hideable, bound.trace_ms);
+                   culler.drawn_occluders().size(), bound.hideable, bound.hidden, 100.0 * bound.efficiency_bound(), bound.missed_hideable,
+                   bound.missed_not_hideable, bound_ms);
         for (const std::string& line : tally.false_cull_reports) fmt::print("false cull: {}\n", line);
     }
     fmt::print("(--json lists every object)\n");

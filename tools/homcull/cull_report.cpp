@@ -66,4 +66,12 @@ nlohmann::json cull_config_json(const CullOptions& o) {
             {"hierarchy", o.hierarchy}};
 }
 
+nlohmann::json occluder_bound_json(const OccluderBoundTally& bound) {
+    return {{"hidden_outright", bound.hidden},
+            {"hideable", bound.hideable},
+            {"efficiency_bound", bound.efficiency_bound()},
+            {"missed_hideable", bound.missed_hideable},
+            {"missed_not_hideable", bound.missed_not_hideable}};
+}
+
 }  // namespace homcull::cli

@@ -3,6 +3,7 @@
 // DESIGN.md's format, stage timings, the culler's work, the configuration.
 #include <homcull/scene_culler.hpp>
 #include <homcull/truth/ground_truth.hpp>
+#include <homcull/truth/occluder_bound.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -17,5 +18,7 @@ struct CullOptions;
 // Every culling option as given (cull_options.hpp), so that a JSON output says which
 // configuration made it: {"mode", "depth", "occludees", "clusters", "back_faces", ...}.
 nlohmann::json cull_config_json(const CullOptions& options);
+// {"hidden_outright","hideable","efficiency_bound","missed_hideable","missed_not_hideable"}.
+nlohmann::json occluder_bound_json(const OccluderBoundTally& bound);
 
 }  // namespace homcull::cli

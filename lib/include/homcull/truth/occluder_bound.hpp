@@ -10,7 +10,9 @@
 // meets it, an occluder lies strictly nearer. An occluder met first is seen too (nothing
 // drawn hides it there). Objects no ray meets (hidden or outside the view) are hideable.
 #include <homcull/camera.hpp>
+#include <homcull/occlusion_maps.hpp>
 #include <homcull/scene.hpp>
+#include <homcull/truth/ground_truth.hpp>
 #include <homcull/truth/ray_scene.hpp>
 
 #include <cstdint>
@@ -29,5 +31,19 @@ struct OccluderBound {
 // scene built from another scene, or an occluder id out of range. Uses all cores (oneTBB).
 OccluderBound occluder_bound(const RayScene& rays, const Scene& scene, const Camera& camera, Resolution display,
                              const std::vector<std::uint32_t>& occluders);
+
+// A culler's answers beside the bound, over the objects ground truth finds hidden outright (in
+// the view frustum, no sample seeing them, no tie: the objects CullingTally::robust_efficiency
+// counts).
+struct OccluderBoundTally {
+    std::size_t hidden = 0;               // hidden outright
+    std::size_t hideable = 0;             // of those, hideable by the occluders
+    std::size_t missed_hideable = 0;      // answered visible though hideable: lost to how the occluders are drawn and tested
+    std::size_t missed_not_hideable = 0;  // answered visible and not hideable: lost to which objects are drawn
+    double efficiency_bound() const { return hidden ? double(hideable) / double(hidden) : 1.0; }
+    OccluderBoundTally& operator+=(const OccluderBoundTally& o);  // a walk sums its frames'
+};
+// answers[id] and truth.objects[id] per object id, as bound.hideable.
+OccluderBoundTally tally_bound(const TruthResult& truth, const OccluderBound& bound, const std::vector<OccludeeAnswer>& answers);
 
 }  // namespace homcull
