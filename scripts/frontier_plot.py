@@ -130,7 +130,7 @@ def main():
     columns = min(3, panels)
     rows = (panels + columns - 1) // columns
     fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows + 1.0), sharey=True, squeeze=False)
-    markers = 'osD^vP*X'
+    markers = 'osD^vP*Xh<>p'  # one per configuration: a repeated marker would merge two in the plot
     for p in range(rows * columns):
         ax = axes[p // columns][p % columns]
         if p >= panels:
