@@ -3,6 +3,7 @@
 #include <homcull/truth/ray_scene.hpp>
 
 #include <embree3/rtcore.h>
+#include <glm/vec3.hpp>
 
 #include <mutex>
 #include <string>
@@ -21,5 +22,19 @@ struct RayScene::Impl {
 
     ~Impl();
 };
+
+// A single ray from `origin` (relative to the ray scene's anchor) along `direction` over
+// [t_near, t_far], every mask bit set, with no hit yet: the ray rtcIntersect1 takes.
+inline RTCRayHit single_ray(const glm::vec3& origin, const glm::vec3& direction, float t_near, float t_far) {
+    RTCRayHit rh{};
+    rh.ray.org_x = origin.x, rh.ray.org_y = origin.y, rh.ray.org_z = origin.z;
+    rh.ray.dir_x = direction.x, rh.ray.dir_y = direction.y, rh.ray.dir_z = direction.z;
+    rh.ray.tnear = t_near;
+    rh.ray.tfar = t_far;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+}
 
 }  // namespace homcull

@@ -83,19 +83,7 @@ glm::dvec3 RayScene::anchor() const { return impl_->anchor; }
 RayHit RayScene::intersect(const glm::dvec3& world_origin, const glm::vec3& direction, float t_near, float t_far) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRayHit rh{};
-    const glm::vec3 origin(world_origin - impl_->anchor);
-    rh.ray.org_x = origin.x;
-    rh.ray.org_y = origin.y;
-    rh.ray.org_z = origin.z;
-    rh.ray.dir_x = direction.x;
-    rh.ray.dir_y = direction.y;
-    rh.ray.dir_z = direction.z;
-    rh.ray.tnear = t_near;
-    rh.ray.tfar = t_far;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = single_ray(glm::vec3(world_origin - impl_->anchor), direction, t_near, t_far);
     rtcIntersect1(impl_->scene, &context, &rh);
     RayHit hit;
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {

@@ -113,14 +113,7 @@ SortTruth occlusion_edges(const RayScene& rays, std::size_t objects, const Camer
         for (int y = rows.begin(); y < rows.end(); ++y)
             for (int x = 0; x < display.width; ++x) {
                 const glm::vec3 d(ray_direction(camera, basis, aspect, pixel_to_ndc(display, x + 0.5, y + 0.5)));
-                RTCRayHit rh{};
-                rh.ray.org_x = eye.x, rh.ray.org_y = eye.y, rh.ray.org_z = eye.z;
-                rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
-                rh.ray.tnear = t_near;
-                rh.ray.tfar = t_far;
-                rh.ray.mask = 0xFFFFFFFFu;
-                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                RTCRayHit rh = single_ray(eye, d, t_near, t_far);
                 hits.clear();
                 rtcIntersect1(rtc, &collector.context, &rh);
                 local.hits += hits.size();
