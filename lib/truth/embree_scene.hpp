@@ -1,5 +1,6 @@
 #pragma once
 // What RayScene holds, for the truth library's own files that talk to Embree directly.
+#include <homcull/camera.hpp>
 #include <homcull/truth/ray_scene.hpp>
 
 #include <embree3/rtcore.h>
@@ -36,5 +37,28 @@ inline RTCRayHit single_ray(const glm::vec3& origin, const glm::vec3& direction,
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     return rh;
 }
+
+// One ray per display pixel centre from a perspective camera's eye, as the sort truth and the
+// occluder bound cast them (one at a time, with a filter that sees every hit).
+struct PixelCentreRays {
+    PixelCentreRays(const RayScene& rays, const Camera& view, Resolution screen)
+        : scene(rays.impl().scene),
+          camera(view),
+          basis(camera_basis(view)),
+          display(screen),
+          eye(view.eye - rays.anchor()),
+          t_near(float(view.near_plane)),
+          t_far(float(view.far_plane)) {}
+    RTCRayHit at(int x, int y) const {
+        const glm::vec3 d(ray_direction(camera, basis, display.aspect(), pixel_to_ndc(display, x + 0.5, y + 0.5)));
+        return single_ray(eye, d, t_near, t_far);
+    }
+    RTCScene scene;
+    Camera camera;
+    CameraBasis basis;
+    Resolution display;
+    glm::vec3 eye;  // relative to the anchor in double, then rounded
+    float t_near, t_far;
+};
 
 }  // namespace homcull

@@ -58,11 +58,7 @@ OccluderBound occluder_bound(const RayScene& rays, const Scene& scene, const Cam
         is_occluder[id] = 1;
     }
     const auto start = std::chrono::steady_clock::now();
-    const RTCScene rtc = rays.impl().scene;
-    const CameraBasis basis = camera_basis(camera);
-    const double aspect = display.aspect();
-    const glm::vec3 eye(camera.eye - rays.anchor());
-    const float t_near = float(camera.near_plane), t_far = float(camera.far_plane);
+    const PixelCentreRays pixel_rays(rays, camera, display);
 
     struct Local {
         std::vector<std::uint8_t> seen;
@@ -80,10 +76,9 @@ OccluderBound occluder_bound(const RayScene& rays, const Scene& scene, const Cam
         context.passed = &passed;
         for (int y = rows.begin(); y < rows.end(); ++y)
             for (int x = 0; x < display.width; ++x) {
-                const glm::vec3 d(ray_direction(camera, basis, aspect, pixel_to_ndc(display, x + 0.5, y + 0.5)));
-                RTCRayHit rh = single_ray(eye, d, t_near, t_far);
+                RTCRayHit rh = pixel_rays.at(x, y);
                 passed.clear();
-                rtcIntersect1(rtc, &context.context, &rh);
+                rtcIntersect1(pixel_rays.scene, &context.context, &rh);
                 // The first occluder hit is seen; so is every other object met no farther than it
                 // (a tie with an occluder's surface counts as seen: it decides nothing either way).
                 if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) local.seen[rh.hit.geomID] = 1;

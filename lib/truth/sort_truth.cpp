@@ -92,11 +92,7 @@ SortTruth occlusion_edges(const RayScene& rays, std::size_t objects, const Camer
     validate_resolution(display);
     if (camera.ortho_height > 0.0) throw Error("sort truth: orthographic cameras are not supported (rays start at the eye)");
     if (rays.object_count() != objects) throw Error("sort truth: the ray scene was built from another scene");
-    const RTCScene rtc = rays.impl().scene;
-    const CameraBasis basis = camera_basis(camera);
-    const double aspect = display.aspect();
-    const glm::vec3 eye(camera.eye - rays.anchor());
-    const float t_near = float(camera.near_plane), t_far = float(camera.far_plane);
+    const PixelCentreRays pixel_rays(rays, camera, display);
 
     struct Local {
         std::vector<std::uint64_t> edges;  // one per ray that shows it
@@ -112,10 +108,9 @@ SortTruth occlusion_edges(const RayScene& rays, std::size_t objects, const Camer
         collector.hits = &hits;
         for (int y = rows.begin(); y < rows.end(); ++y)
             for (int x = 0; x < display.width; ++x) {
-                const glm::vec3 d(ray_direction(camera, basis, aspect, pixel_to_ndc(display, x + 0.5, y + 0.5)));
-                RTCRayHit rh = single_ray(eye, d, t_near, t_far);
+                RTCRayHit rh = pixel_rays.at(x, y);
                 hits.clear();
-                rtcIntersect1(rtc, &collector.context, &rh);
+                rtcIntersect1(pixel_rays.scene, &collector.context, &rh);
                 local.hits += hits.size();
                 std::sort(hits.begin(), hits.end());
                 // Consecutive distinct objects; the same object again after another is a new
