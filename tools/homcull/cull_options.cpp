@@ -108,7 +108,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
         ->check(kWholeNumber);
     app.add_option("--min-occluder-size", o.min_occluder_size,
                    "Draw only the occluder candidates whose box looks at least this large from the eye: (box diagonal / "
-                   "distance)^2, in square radians (a box as wide as it is far: 1); 0: every one")
+                   "distance)^2, in square radians (a box whose diagonal is as long as it is far: 1); 0: every one")
         ->capture_default_str()->check(CLI::NonNegativeNumber);
     app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
         ->capture_default_str()->check(CLI::PositiveNumber);
