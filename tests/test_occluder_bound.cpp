@@ -9,7 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <numeric>
+#include <random>
 #include <vector>
 
 namespace homcull {
@@ -113,6 +115,53 @@ TEST(OccluderBound, WithEveryObjectAnOccluderIsGroundTruth) {
             hidden += truth.objects[id].in_frustum && truth.objects[id].visible_samples == 0;
         }
         EXPECT_GT(hidden, 0u) << spec;
+    }
+}
+
+// Against a reference that walks each pixel-centre ray hit by hit (RayScene::intersect from just
+// past the last hit) and stops at the first occluder: random boxes, floating and overlapping
+// (no two surfaces meet a pixel centre at one distance but by chance), a random half of them
+// occluders. Embree's traversal meets far hits before near ones here, so the bound must keep
+// only the hits before the ray's final occluder hit.
+TEST(OccluderBound, EqualsAHitByHitWalkOfEveryRay) {
+    std::mt19937 random(5);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (int trial = 0; trial < 4; ++trial) {
+        Scene scene;
+        std::vector<std::uint32_t> occluders;
+        for (int k = 0; k < 60; ++k) {
+            const glm::vec3 centre{-12.0f + 24.0f * unit(random), -7.0f + 14.0f * unit(random), -40.0f + 34.0f * unit(random)};
+            const glm::vec3 half{0.3f + 2.5f * unit(random), 0.3f + 2.5f * unit(random), 0.3f + 2.5f * unit(random)};
+            const std::uint32_t id = add_box(scene, "box " + std::to_string(k), centre - half, centre + half);
+            if (unit(random) < 0.5f) occluders.push_back(id);
+        }
+        scene.finalize();
+        const RayScene rays(scene);
+        const Camera camera = camera_down_minus_z(60.0);
+        const Resolution display{61, 37};
+        const OccluderBound b = occluder_bound(rays, scene, camera, display, occluders);
+
+        std::vector<std::uint8_t> is_occluder(scene.objects.size(), 0), seen(scene.objects.size(), 0);
+        for (std::uint32_t id : occluders) is_occluder[id] = 1;
+        const CameraBasis basis = camera_basis(camera);
+        for (int y = 0; y < display.height; ++y)
+            for (int x = 0; x < display.width; ++x) {
+                const glm::vec3 d(ray_direction(camera, basis, display.aspect(), pixel_to_ndc(display, x + 0.5, y + 0.5)));
+                float t_near = float(camera.near_plane);
+                for (;;) {
+                    const RayHit hit = rays.intersect(camera.eye, d, t_near, float(camera.far_plane));
+                    if (!hit.hit()) break;
+                    seen[hit.object] = 1;
+                    if (is_occluder[hit.object]) break;
+                    t_near = std::nextafter(hit.t, INFINITY);
+                }
+            }
+        std::size_t hideable = 0;
+        for (std::uint32_t id = 0; id < scene.objects.size(); ++id) {
+            EXPECT_EQ(b.hideable[id], seen[id] ? 0 : 1) << "trial " << trial << ", object " << id;
+            hideable += b.hideable[id];
+        }
+        EXPECT_GT(hideable, 0u) << trial;  // the check needs some objects hidden by the occluders alone
     }
 }
 
