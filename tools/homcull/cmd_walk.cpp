@@ -157,7 +157,9 @@ void run_walk(const WalkCommandOptions& o) {
             {"scene", scene.source},
             {"path", o.path + " (" + std::to_string(measured.size()) + " frames)"},
             {"strategy", o.cull.strategy},
-            {"occluders", o.cull.occluders + ", rank " + o.cull.rank + ", budget " + std::to_string(o.cull.budget) + ", LOD " + o.cull.lod},
+            {"occluders", o.cull.occluders + ", rank " + o.cull.rank + ", budget " + std::to_string(o.cull.budget) +
+                              (o.cull.min_occluder_size > 0.0 ? fmt::format(", at least {:g} sr", o.cull.min_occluder_size) : "") +
+                              ", LOD " + o.cull.lod},
             {"display", std::to_string(config.display.width) + "x" + std::to_string(config.display.height) + ", " + o.cull.mode +
                             ", depth " + o.cull.depth},
             {"efficiency", rays ? fmt::format("{:.1f} % of the hidden objects culled, {} false culls", 100.0 * efficiency, tally.false_culls)
