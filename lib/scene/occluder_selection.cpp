@@ -75,6 +75,12 @@ double projected_size(const Aabb& box, double distance) {
     return (diagonal * diagonal) / (distance * distance);
 }
 
+// The size limit (OccluderBudget::min_projected_size) for a box at `distance` from the eye (the
+// near plane bounding it below): the one rule rank_occluders and large_enough_to_draw apply.
+bool below_size_limit(const Aabb& box, double distance, const OccluderBudget& budget) {
+    return budget.min_projected_size > 0.0 && projected_size(box, distance) < budget.min_projected_size;
+}
+
 // The hidden objects credited to an occluder whose box diagonal subtends one radian, on top of
 // its baked score. The grid's rays are a few degrees apart (4,096 over the sphere), so the
 // scores are small counts (mostly 1 to 4 on the castle) and many occluders that do hide
@@ -104,7 +110,7 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
         // Smaller keys first. The near plane bounds the distance below: every object that
         // reaches in front of it ranks alike by size.
         const double distance = std::max(distance_to_box(camera.eye, box), camera.near_plane);
-        if (budget.min_projected_size > 0.0 && projected_size(box, distance) < budget.min_projected_size) continue;  // large_enough_to_draw
+        if (below_size_limit(box, distance, budget)) continue;
         double key = distance;
         if (budget.ranking == OccluderRanking::area) {
             key = -projected_size(box, distance);
@@ -129,8 +135,7 @@ void rank_occluders(const Scene& scene, const std::vector<std::uint32_t>& candid
 }
 
 bool large_enough_to_draw(const Aabb& box, const Camera& camera, const OccluderBudget& budget) {
-    if (!(budget.min_projected_size > 0.0)) return true;
-    return projected_size(box, std::max(distance_to_box(camera.eye, box), camera.near_plane)) >= budget.min_projected_size;
+    return !below_size_limit(box, std::max(distance_to_box(camera.eye, box), camera.near_plane), budget);
 }
 
 std::size_t occluder_triangles_drawn(const Scene& scene, std::uint32_t id, const Camera& camera, const OccluderLods* lods) {

@@ -83,8 +83,10 @@ OccluderBound occluder_bound(const RayScene& rays, const Scene& scene, const Cam
                 // (a tie with an occluder's surface counts as seen: it decides nothing either way).
                 if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) local.seen[rh.hit.geomID] = 1;
                 for (const Hit& h : passed)
-                    if (h.t <= rh.ray.tfar) local.seen[h.object] = 1;
-                local.hits += passed.size();
+                    if (h.t <= rh.ray.tfar) {
+                        local.seen[h.object] = 1;
+                        ++local.hits;
+                    }
             }
     });
 
@@ -113,8 +115,7 @@ OccluderBoundTally tally_bound(const TruthResult& truth, const OccluderBound& bo
         throw Error("occluder bound: the truth, the bound and the answers are not of one scene");
     OccluderBoundTally t;
     for (std::size_t id = 0; id < answers.size(); ++id) {
-        const ObjectVisibility& v = truth.objects[id];
-        if (!v.in_frustum || v.visible_samples > 0 || v.tie_samples > 0) continue;
+        if (!hidden_outright(truth.objects[id])) continue;
         ++t.hidden;
         t.hideable += bound.hideable[id];
         if (answers[id].visibility == Visibility::visible) ++(bound.hideable[id] ? t.missed_hideable : t.missed_not_hideable);

@@ -34,6 +34,10 @@ struct ObjectVisibility {
     std::uint64_t tie_samples = 0;
 };
 
+// Hidden outright: in the frustum, no sample sees it, and no tie could have shown it (the
+// objects a robust efficiency counts: DESIGN.md, "coincident surfaces").
+inline bool hidden_outright(const ObjectVisibility& v) { return v.in_frustum && v.visible_samples == 0 && v.tie_samples == 0; }
+
 // "visible" (some sample sees it), "occluded" (in the frustum, no sample sees it) or
 // "view_culled": the per-object result of DESIGN.md's format.
 inline const char* truth_result_name(const ObjectVisibility& v) {
