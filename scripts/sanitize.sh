@@ -39,7 +39,7 @@ generator=()
 if [ ! -f "$dir/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DHOMCULL_BUILD_TESTS=ON \
   -DHOMCULL_SANITIZE="$kind" -DCMAKE_CXX_FLAGS="$flags -g1" -DCMAKE_C_FLAGS="$flags -g1" \
-  -DCMAKE_EXE_LINKER_FLAGS="$flags" -DCMAKE_SHARED_LINKER_FLAGS="$flags"
+  -DCMAKE_EXE_LINKER_FLAGS="$flags" -DCMAKE_SHARED_LINKER_FLAGS="$flags" -DCMAKE_MODULE_LINKER_FLAGS="$flags"
 cmake --build "$dir" --parallel "$(nproc)"
 cd "$dir"
 ctest --output-on-failure --parallel "$(nproc)" --timeout 1800 "${filter[@]}" "$@"

@@ -2,11 +2,9 @@
 #include <homcull/io/dumps.hpp>
 #include <homcull/io/write_file.hpp>
 
+#include "io/image_backend.hpp"
 #include "io/legend_font.hpp"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -147,41 +145,29 @@ void write_maps_exr(const std::vector<DumpPart>& parts, const std::string& path)
         full_w = std::max(full_w, p.width);
         full_h = std::max(full_h, p.height);
     }
-    std::vector<OIIO::ImageSpec> specs;
+    std::vector<detail::ImagePart> images;
     for (const DumpPart& p : parts) {
-        OIIO::ImageSpec spec(p.width, p.height, 1, OIIO::TypeDesc::FLOAT);
-        spec.full_x = spec.full_y = 0;
-        spec.full_width = full_w;
-        spec.full_height = full_h;
-        spec.channelnames = {"Y"};
+        detail::ImagePart image;
+        image.width = p.width;
+        image.height = p.height;
+        image.channels = 1;
+        image.type = detail::PixelType::float32;
+        image.pixels = p.values.data();
+        image.full_width = full_w;
+        image.full_height = full_h;
+        image.channel_names = {"Y"};
         // The EXR part name ("name" in the header): OIIO's openexr writer takes it from here.
-        spec.attribute("oiio:subimagename", p.name);
-        spec.attribute("homcull:quantity", p.quantity);
-        spec.attribute("compression", "zip");  // lossless
-        specs.push_back(std::move(spec));
+        image.attributes = {{"oiio:subimagename", p.name}, {"homcull:quantity", p.quantity}, {"compression", "zip"}};  // zip: lossless
+        images.push_back(std::move(image));
     }
     // `oiiotool --info -v` prints the metadata of the first part only (`-a` prints all): the
     // first part also lists every part's name, so that one look shows them all.
-    if (!specs.empty()) {
-        std::string names;
-        for (const DumpPart& p : parts) names += (names.empty() ? "" : ", ") + p.name;
-        specs.front().attribute("homcull:parts", names);
-    }
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw Error(path + ": cannot write an image of this type (" + OIIO::geterror() + ")");
-    if (!out->supports("multiimage")) throw Error(path + ": the " + std::string(out->format_name()) + " format holds one image, not a dump");
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-        // The first open declares every part (multi-part EXR writes its headers up front); the
-        // others append, in the same order.
-        const bool opened = i == 0 ? out->open(path, int(specs.size()), specs.data())
-                                   : out->open(path, specs[i], OIIO::ImageOutput::AppendSubimage);
-        if (!opened || !out->write_image(OIIO::TypeDesc::FLOAT, parts[i].values.data())) {
-            const std::string why = out->geterror();
-            out->close();
-            throw Error(path + ": " + (why.empty() ? "cannot write part " + parts[i].name : why));
-        }
-    }
-    if (!out->close()) throw Error(path + ": " + out->geterror());
+    std::string names;
+    for (const DumpPart& p : parts) names += (names.empty() ? "" : ", ") + p.name;
+    images.front().attributes.emplace_back("homcull:parts", names);
+    // Two or more parts: the format must hold several images (a PNG cannot hold a dump).
+    const std::string why = detail::image_backend().write(path, images.data(), images.size(), "");
+    if (!why.empty()) throw Error(path + ": " + why);
 }
 
 ColormapPng colormap_png_size(int width, int height) {
@@ -224,9 +210,8 @@ ColormapPng write_colormap_png(const DumpPart& part, const std::string& path) {
         return part.larger_is_nearer ? t : 1.0 - t;
     };
 
-    OIIO::ImageBuf image(OIIO::ImageSpec(r.width, r.height, 3, OIIO::TypeDesc::UINT8));
-    auto* pixels = static_cast<std::uint8_t*>(image.localpixels());
-    if (!pixels) throw Error(path + ": cannot allocate the image");
+    std::vector<std::uint8_t> image_rgb(std::size_t(r.width) * std::size_t(r.height) * 3);
+    std::uint8_t* const pixels = image_rgb.data();
     auto put = [&](int x, int y, const std::uint8_t* rgb) {
         std::uint8_t* p = pixels + (std::size_t(y) * std::size_t(r.width) + std::size_t(x)) * 3;
         p[0] = rgb[0];
@@ -269,25 +254,31 @@ ColormapPng write_colormap_png(const DumpPart& part, const std::string& path) {
         second_left = part.name;
         second_right = "green: no occluder (" + std::to_string(r.no_occluder) + " px)";
     }
+    const detail::ImageBackend& images = detail::image_backend();
     const detail::LegendFont& font = detail::legend_font();
     r.text_drawn = font.found;
     if (font.found) {
+        const detail::RgbCanvas canvas{r.width, r.height, pixels};
         const float white[3] = {0.92f, 0.92f, 0.92f}, green[3] = {0.0f, 200.0f / 255.0f, 90.0f / 255.0f};
-        bool ok = OIIO::ImageBufAlgo::render_text(image, bar_x0, y0 + 31, left, 13, font.name, white);
-        if (!right.empty())
-            ok = ok && OIIO::ImageBufAlgo::render_text(image, bar_x1, y0 + 31, right, 13, font.name, white, OIIO::ImageBufAlgo::TextAlignX::Right);
-        ok = ok && OIIO::ImageBufAlgo::render_text(image, bar_x0, y0 + 45, second_left, 12, font.name, white);
-        if (!second_right.empty())
-            ok = ok && OIIO::ImageBufAlgo::render_text(image, bar_x1, y0 + 45, second_right, 12, font.name, green,
-                                                      OIIO::ImageBufAlgo::TextAlignX::Right);
+        std::string why;
+        bool ok = images.render_text(canvas, bar_x0, y0 + 31, left, 13, font.name, white, false, &why);
+        if (!right.empty()) ok = ok && images.render_text(canvas, bar_x1, y0 + 31, right, 13, font.name, white, true, &why);
+        ok = ok && images.render_text(canvas, bar_x0, y0 + 45, second_left, 12, font.name, white, false, &why);
+        if (!second_right.empty()) ok = ok && images.render_text(canvas, bar_x1, y0 + 45, second_right, 12, font.name, green, true, &why);
         if (!ok) {
             r.text_drawn = false;
-            r.note = "legend text failed: " + image.geterror();
+            r.note = "legend text failed: " + why;
         }
     } else {
         r.note = font.reason;
     }
-    if (!image.write(path, OIIO::TypeDesc::UINT8, "png")) throw Error(path + ": " + image.geterror());
+    detail::ImagePart image;
+    image.width = r.width;
+    image.height = r.height;
+    image.channels = 3;
+    image.pixels = pixels;
+    const std::string why = images.write(path, &image, 1, "png");
+    if (!why.empty()) throw Error(path + ": " + why);
     return r;
 }
 

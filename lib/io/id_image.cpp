@@ -1,7 +1,7 @@
 #include <homcull/error.hpp>
 #include <homcull/io/id_image.hpp>
 
-#include <OpenImageIO/imageio.h>
+#include "io/image_backend.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -22,19 +22,22 @@ std::uint32_t id_color(std::uint32_t id) {
 void write_rgb_image(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
     if (width < 1 || height < 1 || rgb.size() != 3 * std::size_t(width) * std::size_t(height))
         throw Error(path + ": pixel buffer does not match the image size");
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw Error(path + ": cannot write an image of this type (" + OIIO::geterror() + ")");
-    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-    if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
-        throw Error(path + ": " + out->geterror());
+    detail::ImagePart image;
+    image.width = width;
+    image.height = height;
+    image.channels = 3;
+    image.pixels = rgb.data();
+    const std::string why = detail::image_backend().write(path, &image, 1, "");
+    if (!why.empty()) throw Error(path + ": " + why);
 }
 
 void write_id_image(const std::string& path, int width, int height, const std::vector<std::uint32_t>& ids) {
     if (width < 1 || height < 1 || ids.size() != std::size_t(width) * std::size_t(height))
         throw Error(path + ": id buffer does not match the image size");
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw Error(path + ": cannot write an image of this type (" + OIIO::geterror() + ")");
-    std::string format = out->format_name();
+    const detail::ImageBackend& images = detail::image_backend();
+    std::string why;
+    const std::string format = images.format_for(path, &why);
+    if (format.empty()) throw Error(path + ": " + why);
     const bool eight_bit = format == "png" || format == "jpeg" || format == "bmp" || format == "targa" ||
                            format == "gif" || format == "webp" || format == "pnm";
     if (eight_bit) {
@@ -50,11 +53,16 @@ void write_id_image(const std::string& path, int width, int height, const std::v
     }
     std::vector<std::uint32_t> stored(ids.size());
     std::transform(ids.begin(), ids.end(), stored.begin(), [](std::uint32_t id) { return id == kNoObject ? 0u : id + 1; });
-    OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::UINT32);
-    spec.channelnames = {"id"};
-    spec.attribute("homcull:id_encoding", "object id + 1, 0 = no object");
-    if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT32, stored.data()) || !out->close())
-        throw Error(path + ": " + out->geterror());
+    detail::ImagePart image;
+    image.width = width;
+    image.height = height;
+    image.channels = 1;
+    image.type = detail::PixelType::uint32;
+    image.pixels = stored.data();
+    image.channel_names = {"id"};
+    image.attributes = {{"homcull:id_encoding", "object id + 1, 0 = no object"}};
+    why = images.write(path, &image, 1, "");
+    if (!why.empty()) throw Error(path + ": " + why);
 }
 
 }  // namespace homcull

@@ -1,21 +1,26 @@
 #include "io/legend_font.hpp"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
+#include "io/image_backend.hpp"
+
+#include <cstdint>
+#include <vector>
 
 namespace homcull::detail {
 
 const LegendFont& legend_font() {
     static const LegendFont font = [] {
+        const ImageBackend& images = image_backend();
         LegendFont f;
         for (const char* name : {"DejaVuSans", ""}) {
-            OIIO::ImageBuf probe(OIIO::ImageSpec(64, 24, 3, OIIO::TypeDesc::UINT8));
-            if (OIIO::ImageBufAlgo::render_text(probe, 2, 16, "0.5", 13, name)) {
+            std::vector<std::uint8_t> pixels(64 * 24 * 3);
+            const float white[3] = {1.0f, 1.0f, 1.0f};
+            std::string why;
+            if (images.render_text(RgbCanvas{64, 24, pixels.data()}, 2, 16, "0.5", 13, name, white, false, &why)) {
                 f.found = true;
                 f.name = name;
                 return f;
             }
-            f.reason += std::string(*name ? name : "OIIO's default font") + ": " + probe.geterror() + "; ";
+            f.reason += std::string(*name ? name : "OIIO's default font") + ": " + why + "; ";
         }
         f.reason = "no TrueType font could be rendered (" + f.reason.substr(0, f.reason.size() - 2) +
                    "); install fonts-dejavu-core for the legend text";
