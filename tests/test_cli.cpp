@@ -430,6 +430,9 @@ TEST(Cli, FrameBenchReportsTimesStagesAndAccuracyPerView) {
         // cull's defaults beside the configuration, for readers that name what differs (frontier_plot.py).
         EXPECT_EQ(j["defaults"]["occluders"], "role");
         EXPECT_EQ(j["defaults"]["min_occluder_size"], 0.0);
+        // What loading costs, once: the scene file (generated here), then the culler's preparation.
+        EXPECT_GE(j["load_ms"].get<double>(), 0.0);
+        EXPECT_GT(j["setup_ms"].get<double>(), 0.0);
         ASSERT_EQ(j["per_view"].size(), 3u) << views;
         for (const nlohmann::json& v : j["per_view"]) {
             EXPECT_GT(v["frame_ms"].get<double>(), 0.0);

@@ -68,12 +68,18 @@ void run_frame_bench(const FrameBenchOptions& o) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
     const ParallelFor parallel = command_job_system(o.threads);
     SceneCullerConfig config = scene_culler_config(o.cull, o.threads);
+    long long start = now_ns();
     const Scene scene = load_chosen_scene(SceneChoice{o.scene, 0});
+    const double load_ms = elapsed_ms(start);
     const RayScene rays(scene);
     const CameraPath path = frame_bench_views(o, rays, scene);
     if (path.frames.empty()) throw Error("bench --workload frame: the camera path has no views");
+    // What an engine pays once, when the scene loads: the occluders chosen, then the culler's
+    // own preparation (clusters, shared edges, occludee parts, closed meshes, the hierarchy).
+    start = now_ns();
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     SceneCuller culler(scene, resources.occluders, config);
+    const double setup_ms = elapsed_ms(start);
 
     // One untimed cull per view (the scratch grows to the largest frame), then the timed rounds,
     // the views interleaved so that the machine's load spreads over all of them alike. A walk's
@@ -96,7 +102,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     for (int r = 0; r < o.rounds; ++r)
         for (std::size_t v = 0; v < views; ++v) {
             forget_before(v);
-            const long long start = now_ns();
+            start = now_ns();
             culler.cull(path.frames[v], answers, parallel);
             const double frame_ms = elapsed_ms(start);
             const SceneCullTimings& t = culler.timings();
@@ -159,6 +165,8 @@ void run_frame_bench(const FrameBenchOptions& o) {
             {"isa", culler.buffer().config().isa},
             {"threads", o.threads},
             {"rounds", o.rounds},
+            {"load_ms", load_ms},
+            {"setup_ms", setup_ms},
             {"config", cull_config_json(o.cull)},
             {"defaults", cull_config_json(CullOptions{})},  // cull's: what a reader of "config" compares against
             {"per_view", per_view},
@@ -167,9 +175,10 @@ void run_frame_bench(const FrameBenchOptions& o) {
         fmt::print("{}\n", out.dump(1));
         return;
     }
-    fmt::print("frame bench: {} ({} objects), {} views from {}, {}x{} display, {} rounds, {} thread(s), {}\n", scene.source,
-               scene.objects.size(), views, source, config.display.width, config.display.height, o.rounds, o.threads,
-               culler.buffer().config().isa);
+    fmt::print("frame bench: {} ({} objects), {} views from {}, {}x{} display, {} rounds, {} thread(s), {}; load {:.1f} ms, "
+               "setup {:.1f} ms\n",
+               scene.source, scene.objects.size(), views, source, config.display.width, config.display.height, o.rounds, o.threads,
+               culler.buffer().config().isa, load_ms, setup_ms);
     fmt::print("view  frame ms  (select  render    maps   tests)  efficiency (plain)  occluders' bound  false culls\n");
     for (const nlohmann::json& v : per_view)
         fmt::print("{:4}  {:8.3f}  ({:6.3f} {:7.3f} {:7.3f} {:7.3f})  {:8.1f} % ({:5.1f} %)  {:13.1f} %  {}\n", v["view"].get<std::size_t>(),
