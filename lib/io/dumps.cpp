@@ -165,7 +165,7 @@ void write_maps_exr(const std::vector<DumpPart>& parts, const std::string& path)
     std::string names;
     for (const DumpPart& p : parts) names += (names.empty() ? "" : ", ") + p.name;
     images.front().attributes.emplace_back("homcull:parts", names);
-    // Two or more parts: the format must hold several images (a PNG cannot hold a dump).
+    // Several parts need a format that holds several images: a PNG cannot hold a dump.
     const std::string why = detail::image_backend().write(path, images.data(), images.size(), "");
     if (!why.empty()) throw Error(path + ": " + why);
 }
