@@ -477,6 +477,12 @@ TEST(Cli, FrameBenchScalingReportsTheThreadsBesideTheMachinesCeiling) {
     expect_refused("bench --workload frame --scene gen:city --random 2 --min-occluder-size -1", 105, "--min-occluder-size");
     expect_refused("bench --workload frame --scene gen:city --random 2 --occluders some", 105, "--occluders");
     expect_refused("bench --workload frame --scene gen:city --random 2 --complexity -1", 105, "--complexity");
+    // NaN is no number at least 0 (CLI11's own check let it through), in bench, cull and bake alike.
+    expect_refused("bench --workload frame --scene gen:city --random 2 --complexity nan", 105,
+                   "--complexity: must be a number at least 0 (inf allowed), got nan");
+    expect_refused("cull --scene gen:city --eye 0,2,0 --target 1,2,0 --min-occluder-size nan", 105, "got nan");
+    expect_refused("cull --scene gen:city --eye 0,2,0 --target 1,2,0 --min-occluder-size -inf", 105, "got -inf");
+    expect_refused("bake --scene gen:city --spacing nan --out x.json", 105, "--spacing");
     if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one hardware thread: no ceiling to measure";
     const CliRun r = run_cli("bench --workload frame --scene gen:city:seed=2,blocks=3 --random 2 --resolution 160x90 --repeat 2 "
                              "--occludees box --threads 2 --scaling --complexity 0 --json");

@@ -105,14 +105,14 @@ void register_bake(CLI::App& app) {
     cmd->add_option("--occluders", o->occluders, "Occluder candidates: role, all, or auto (as for cull)")
         ->capture_default_str()->check(CLI::IsMember({"role", "all", "auto"}));
     cmd->add_option("--complexity", o->complexity, "Zhang's complexity filter on the candidates (as for cull); 0: keep all")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(kAtLeastZero);
     cmd->add_option("--layout", o->layout, "floors: points at eye height above each floor (walkthroughs); volume: a 3D lattice of "
                                            "free points (flying cameras)")
         ->capture_default_str()->check(CLI::IsMember({"floors", "volume"}));
     cmd->add_option("--spacing", o->spacing, "Lattice step in scene units (0: the scene's longer horizontal extent / 64)")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(kAtLeastZero);
     cmd->add_option("--eye-height", o->eye_height, "floors: eye above the floor (0: as homcull path's walk)")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(kAtLeastZero);
     cmd->add_option("--rays", o->rays, "Directions cast from each point")->capture_default_str()->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--keep", o->keep, "Occluders kept per point, best first")->capture_default_str()->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--shard", o->shard, "Bake only shard i of N (columns c with c % N == i), e.g. $SLURM_ARRAY_TASK_ID/64")

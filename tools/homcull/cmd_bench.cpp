@@ -296,11 +296,11 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--complexity", o->frame.complexity,
                     "frame: drop occluder candidates with more than F times the median triangles per unit of their surface "
                     "(cull --complexity); 0: keep all")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(kAtLeastZero);
     cmd->add_option("--min-occluder-size", o->frame.min_occluder_size,
                     "frame: draw only the occluder candidates whose box looks at least this large from the eye, in square "
                     "radians (cull --min-occluder-size); 0: every one")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(kAtLeastZero);
     cmd->add_flag("--scaling", o->scaling,
                   "frame, --threads N >= 2: also time one thread, N threads and N single-threaded copies at once (the "
                   "machine's ceiling) in alternation, and report the threads' speed-up beside the ceiling and beside the time a "

@@ -82,7 +82,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--complexity", o.complexity,
                    "Drop candidates with more than F times the median triangles per unit of their surface (Zhang's "
                    "complexity filter); 0: keep all")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(kAtLeastZero);
     app.add_option("--strategy", o.strategy,
                    "one-pass (select, render, test), progressive (render visible candidates in batches while traversing front "
                    "to back) or temporal (last frame's visible candidates plus those new in the frustum; one-pass on the "
@@ -109,7 +109,7 @@ void add_cull_options(CLI::App& app, CullOptions& o, bool with_display) {
     app.add_option("--min-occluder-size", o.min_occluder_size,
                    "Draw only the occluder candidates whose box looks at least this large from the eye: (box diagonal / "
                    "distance)^2, in square radians (a box whose diagonal is as long as it is far: 1); 0: every one")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()->check(kAtLeastZero);
     app.add_option("--batch", o.batch, "progressive: render the waiting occluders every time this many triangles wait")
         ->capture_default_str()->check(CLI::PositiveNumber);
     app.add_option("--hierarchy", o.hierarchy, "on: test the object hierarchy's nodes and skip what a hidden node holds; off: test "

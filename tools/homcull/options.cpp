@@ -13,6 +13,14 @@
 
 namespace homcull::cli {
 
+const CLI::Validator kAtLeastZero(
+    [](const std::string& text) {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !(v >= 0.0)) return "must be a number at least 0 (inf allowed), got " + text;
+        return std::string();
+    },
+    "NUMBER >= 0");
+
 void add_scene_option(CLI::App& app, SceneChoice& scene, bool required, const std::string& help) {
     auto* option = app.add_option("--scene", scene.file, help);
     if (required) option->required();

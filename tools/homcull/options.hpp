@@ -39,6 +39,10 @@ void add_camera_options(CLI::App& app, CameraOptions& options);
 // Throws homcull::Error when the options do not make a valid camera.
 Camera resolve_camera(const CameraOptions& options);
 
+// A number >= 0 on the command line, infinity included; NaN refused (CLI11's NonNegativeNumber
+// lets NaN through, since no comparison with it fails, and names its bound as 309 digits).
+extern const CLI::Validator kAtLeastZero;
+
 glm::dvec3 parse_vec3(const std::string& text, const char* what);
 // "WxH" (also "W,H"), each in [1, 65536]; errors name `option` (the command-line option read).
 Resolution parse_resolution(const std::string& text, const std::string& option = "--resolution");
