@@ -59,12 +59,17 @@ std::string write(const std::string& path, const ImagePart* parts, std::size_t c
 }
 
 std::string format_for(const std::string& path, std::string* error) {
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) {
-        *error = "cannot write an image of this type (" + OIIO::geterror() + ")";
+    try {
+        auto out = OIIO::ImageOutput::create(path);
+        if (!out) {
+            *error = "cannot write an image of this type (" + OIIO::geterror() + ")";
+            return "";
+        }
+        return out->format_name();
+    } catch (const std::exception& e) {
+        *error = e.what();
         return "";
     }
-    return out->format_name();
 }
 
 // The canvas as an ImageBuf over its own pixels: drawing changes them in place.
@@ -74,21 +79,33 @@ OIIO::ImageBuf wrap(const RgbCanvas& canvas) {
 
 bool render_text(const RgbCanvas& canvas, int x, int y, const std::string& text, int size, const std::string& font, const float rgb[3],
                  bool align_right, std::string* error) {
-    OIIO::ImageBuf image = wrap(canvas);
-    const bool ok = OIIO::ImageBufAlgo::render_text(image, x, y, text, size, font, {rgb, 3},
-                                                    align_right ? OIIO::ImageBufAlgo::TextAlignX::Right : OIIO::ImageBufAlgo::TextAlignX::Left);
-    if (!ok) *error = image.geterror();
-    return ok;
+    try {
+        OIIO::ImageBuf image = wrap(canvas);
+        const bool ok = OIIO::ImageBufAlgo::render_text(image, x, y, text, size, font, {rgb, 3},
+                                                        align_right ? OIIO::ImageBufAlgo::TextAlignX::Right : OIIO::ImageBufAlgo::TextAlignX::Left);
+        if (!ok) *error = image.geterror();
+        return ok;
+    } catch (const std::exception& e) {
+        *error = e.what();
+        return false;
+    }
 }
 
+// Lines and boxes are decoration (plots): one that cannot be drawn is left out.
 void render_line(const RgbCanvas& canvas, int x0, int y0, int x1, int y1, const float rgb[3]) {
-    OIIO::ImageBuf image = wrap(canvas);
-    OIIO::ImageBufAlgo::render_line(image, x0, y0, x1, y1, {rgb, 3});
+    try {
+        OIIO::ImageBuf image = wrap(canvas);
+        OIIO::ImageBufAlgo::render_line(image, x0, y0, x1, y1, {rgb, 3});
+    } catch (const std::exception&) {
+    }
 }
 
 void render_box(const RgbCanvas& canvas, int x0, int y0, int x1, int y1, const float rgb[3], bool fill) {
-    OIIO::ImageBuf image = wrap(canvas);
-    OIIO::ImageBufAlgo::render_box(image, x0, y0, x1, y1, {rgb, 3}, fill);
+    try {
+        OIIO::ImageBuf image = wrap(canvas);
+        OIIO::ImageBufAlgo::render_box(image, x0, y0, x1, y1, {rgb, 3}, fill);
+    } catch (const std::exception&) {
+    }
 }
 
 const ImageBackend kBackend = {kImageBackendVersion, &write, &format_for, &render_text, &render_line, &render_box};

@@ -1,4 +1,5 @@
 #include <homcull/error.hpp>
+#include <homcull/io/id_image.hpp>
 #include <homcull/io/plots.hpp>
 
 #include "io/image_backend.hpp"
@@ -75,13 +76,7 @@ bool write_line_plot(const LinePlot& plot, const std::string& path) {
         }
         text(right - 8 * int(plot.y_label.size()), 22, plot.y_label, 12, black);
     }
-    detail::ImagePart image;
-    image.width = plot.width;
-    image.height = plot.height;
-    image.channels = 3;
-    image.pixels = pixels.data();
-    const std::string why = images.write(path, &image, 1, "");
-    if (!why.empty()) throw Error(path + ": " + why);
+    write_rgb_image(path, plot.width, plot.height, pixels);
     return font.found;
 }
 
