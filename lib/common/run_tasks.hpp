@@ -11,9 +11,11 @@
 #include <homcull/detail/memory.hpp>
 #include <homcull/parallel_for.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <exception>
+#include <type_traits>
 
 namespace homcull::detail {
 
@@ -40,6 +42,22 @@ inline void run_tasks(const ParallelFor& parallel, std::size_t count, void (*tas
         }
     }, &wrapped);
     if (wrapped.failed.load()) std::rethrow_exception(wrapped.error);
+}
+
+// Calls body(i) once for every i in [0, count): `per_task` consecutive indices a task, through
+// run_tasks (so on the calling thread, in order, without a job system). For load-time loops
+// whose every index writes only its own results: the bits are then those of one thread.
+template <typename Body>
+void for_each_index(const ParallelFor& parallel, std::size_t count, std::size_t per_task, Body&& body) {
+    if (per_task == 0) per_task = 1;
+    struct Job {
+        std::remove_reference_t<Body>* body;
+        std::size_t count, per_task;
+    } job{&body, count, per_task};
+    run_tasks(parallel, (count + per_task - 1) / per_task, [](void* data, std::size_t k) {
+        const Job& j = *static_cast<const Job*>(data);
+        for (std::size_t i = k * j.per_task, end = std::min(j.count, i + j.per_task); i < end; ++i) (*j.body)(i);
+    }, &job);
 }
 
 }  // namespace homcull::detail

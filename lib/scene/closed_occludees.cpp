@@ -3,13 +3,14 @@
 // volumes from its world positions, as ground truth has them.
 #include "scene/closed_occludees.hpp"
 
+#include "common/run_tasks.hpp"
+
 #include <homcull/triangle_input.hpp>
 
 #include <meshoptimizer.h>
 
 #include <algorithm>
 #include <numeric>
-#include <optional>
 #include <unordered_map>
 
 namespace homcull::detail {
@@ -98,17 +99,22 @@ std::int8_t object_orientation(const Mesh& mesh, const MeshPieces& pieces, const
 }  // namespace
 
 std::vector<std::int8_t> closed_occludee_orientations(const Scene& scene, const std::vector<float>& world_positions,
-                                                      const std::vector<std::size_t>& first_vertex, std::size_t not_gathered) {
+                                                      const std::vector<std::size_t>& first_vertex, std::size_t not_gathered,
+                                                      const ParallelFor& parallel) {
+    const std::size_t objects = std::min(scene.objects.size(), first_vertex.size());
+    std::vector<std::uint8_t> needed(scene.meshes.size(), 0);
+    for (std::size_t id = 0; id < objects; ++id)
+        if (first_vertex[id] != not_gathered) needed[scene.objects[id].mesh] = 1;
+    std::vector<MeshPieces> meshes(scene.meshes.size());
+    for_each_index(parallel, scene.meshes.size(), 4, [&](std::size_t m) {
+        if (needed[m]) meshes[m] = mesh_pieces(scene.meshes[m]);
+    });
     std::vector<std::int8_t> orientation(scene.objects.size(), 0);
-    std::vector<std::optional<MeshPieces>> meshes(scene.meshes.size());
-    for (std::size_t id = 0; id < scene.objects.size() && id < first_vertex.size(); ++id) {
-        if (first_vertex[id] == not_gathered) continue;
+    for_each_index(parallel, objects, 16, [&](std::size_t id) {
         const std::size_t mesh_id = scene.objects[id].mesh;
-        const Mesh& mesh = scene.meshes[mesh_id];
-        if (!meshes[mesh_id]) meshes[mesh_id] = mesh_pieces(mesh);
-        if (!meshes[mesh_id]->closed) continue;
-        orientation[id] = object_orientation(mesh, *meshes[mesh_id], world_positions.data() + 3 * first_vertex[id]);
-    }
+        if (first_vertex[id] == not_gathered || !meshes[mesh_id].closed) return;
+        orientation[id] = object_orientation(scene.meshes[mesh_id], meshes[mesh_id], world_positions.data() + 3 * first_vertex[id]);
+    });
     return orientation;
 }
 

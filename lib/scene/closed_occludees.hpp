@@ -19,6 +19,7 @@
 // The scene culler applies this to the parts of occludees tested triangle by triangle
 // (scene_traversal.cpp): the buffer's test passes over the triangles that the eye certainly
 // sees from behind (buffer/seen_solid.hpp) once they are known to lie within the view's sides.
+#include <homcull/parallel_for.hpp>
 #include <homcull/scene.hpp>
 
 #include <cstddef>
@@ -31,8 +32,10 @@ namespace homcull::detail {
 // the mesh's indices; kNotGathered: not gathered, 0) form closed surfaces whose every connected
 // piece encloses a clearly positive volume (fronts facing out), -1 when every piece's volume is
 // clearly negative (a mirroring transform: fronts facing in), 0 otherwise (open, mixed, or too
-// flat to tell). Meant for load time: it allocates per mesh.
+// flat to tell). Meant for load time: it allocates per mesh. With a job system, the meshes and
+// then the objects are taken in its tasks: the same answers.
 std::vector<std::int8_t> closed_occludee_orientations(const Scene& scene, const std::vector<float>& world_positions,
-                                                      const std::vector<std::size_t>& first_vertex, std::size_t not_gathered);
+                                                      const std::vector<std::size_t>& first_vertex, std::size_t not_gathered,
+                                                      const ParallelFor& parallel = {});
 
 }  // namespace homcull::detail

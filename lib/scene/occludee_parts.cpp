@@ -2,6 +2,8 @@
 // each object's part boxes under its transform.
 #include "scene/occludee_parts.hpp"
 
+#include "common/run_tasks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -45,61 +47,86 @@ void split(std::vector<std::uint32_t>& order, const std::vector<glm::vec3>& cent
 
 }  // namespace
 
-void OccludeeParts::build(const Scene& scene, int max_parts, std::size_t triangle_limit, const glm::dvec3& anchor) {
+void OccludeeParts::build(const Scene& scene, int max_parts, std::size_t triangle_limit, const glm::dvec3& anchor,
+                          const ParallelFor& parallel) {
     object_first_.assign(scene.objects.size() + 1, 0);
     mesh_indices_.clear(), mesh_first_index_.clear(), mesh_first_part_.assign(1, 0), mesh_part_begin_.clear();
     boxes_.clear(), part_first_triangle_.clear(), part_triangle_count_.clear();
     if (max_parts < 2) return;
 
-    std::vector<glm::vec3> centres;
-    std::vector<std::uint32_t> order;
-    for (const Mesh& mesh : scene.meshes) {
-        mesh_first_index_.push_back(mesh_indices_.size());
+    // Each mesh's split in a task of its own, then the meshes' in their order.
+    struct MeshSplit {
+        std::vector<std::uint32_t> indices, part_begin;
+    };
+    std::vector<MeshSplit> splits(scene.meshes.size());
+    for_each_index(parallel, scene.meshes.size(), 4, [&](std::size_t m) {
+        const Mesh& mesh = scene.meshes[m];
         const std::size_t n = mesh.triangle_count();
+        MeshSplit& out = splits[m];
         if (n >= 2 && n <= triangle_limit) {
-            centres.resize(n);
+            std::vector<glm::vec3> centres(n);
             for (std::size_t t = 0; t < n; ++t)
                 centres[t] = (mesh.positions[mesh.indices[3 * t]] + mesh.positions[mesh.indices[3 * t + 1]] +
                               mesh.positions[mesh.indices[3 * t + 2]]) / 3.0f;
-            order.resize(n);
+            std::vector<std::uint32_t> order(n);
             std::iota(order.begin(), order.end(), 0u);
-            split(order, centres, 0, n, max_parts, mesh_part_begin_);
-            mesh_part_begin_.push_back(std::uint32_t(n));
-            for (std::uint32_t t : order) mesh_indices_.insert(mesh_indices_.end(), mesh.indices.begin() + 3 * t, mesh.indices.begin() + 3 * t + 3);
-        } else {
-            mesh_part_begin_.push_back(std::uint32_t(n));  // no parts: a lone end
+            split(order, centres, 0, n, max_parts, out.part_begin);
+            out.indices.resize(3 * n);
+            std::uint32_t* indices = out.indices.data();
+            for (std::uint32_t t : order) indices = std::copy_n(mesh.indices.begin() + 3 * std::ptrdiff_t(t), 3, indices);
         }
+        out.part_begin.push_back(std::uint32_t(n));  // after the parts' beginnings; alone: no parts
+    });
+    for (const MeshSplit& split : splits) {
+        mesh_first_index_.push_back(mesh_indices_.size());
+        mesh_indices_.insert(mesh_indices_.end(), split.indices.begin(), split.indices.end());
+        mesh_part_begin_.insert(mesh_part_begin_.end(), split.part_begin.begin(), split.part_begin.end());
         mesh_first_part_.push_back(std::uint32_t(mesh_part_begin_.size()));
     }
 
+    // Each object's part boxes in its own slots, objects in tasks; those with a vertex that is
+    // not finite are then left out (a box would say nothing: the object keeps its own box alone).
+    const auto mesh_parts = [&](std::uint32_t mesh) { return mesh_first_part_[mesh + 1] - mesh_first_part_[mesh] - 1; };
     for (std::size_t id = 0; id < scene.objects.size(); ++id) {
-        object_first_[id + 1] = object_first_[id];
+        const std::uint32_t parts = mesh_parts(scene.objects[id].mesh);
+        object_first_[id + 1] = object_first_[id] + (parts < 2 ? 0 : parts);
+    }
+    boxes_.resize(object_first_.back()), part_first_triangle_.resize(object_first_.back()), part_triangle_count_.resize(object_first_.back());
+    std::vector<std::uint8_t> finite(scene.objects.size(), 1);
+    for_each_index(parallel, scene.objects.size(), 16, [&](std::size_t id) {
         const Object& object = scene.objects[id];
         const Mesh& mesh = scene.meshes[object.mesh];
         const std::uint32_t* part_begin = mesh_part_begin_.data() + mesh_first_part_[object.mesh];
-        const std::uint32_t parts = mesh_first_part_[object.mesh + 1] - mesh_first_part_[object.mesh] - 1;
-        if (parts < 2) continue;
+        const std::uint32_t parts = object_first_[id + 1] - object_first_[id];
         const std::uint32_t* indices = mesh_indices_.data() + mesh_first_index_[object.mesh];
-        const std::size_t first_box = boxes_.size();
-        bool finite = true;
-        for (std::uint32_t p = 0; p < parts && finite; ++p) {
-            // As Scene::finalize bounds the object: transform_point's floats, then anchored_box's widening.
-            Aabb world;
+        if (parts == 0) return;
+        // As Scene::finalize bounds the object: transform_point's floats, then anchored_box's
+        // widening; each vertex transformed once.
+        std::vector<glm::vec3> world(mesh.positions.size());
+        for (std::size_t v = 0; v < world.size(); ++v) world[v] = transform_point(object.world, mesh.positions[v]);
+        for (std::uint32_t p = 0; p < parts; ++p) {
+            Aabb box;
             for (std::uint32_t i = 3 * part_begin[p]; i < 3 * part_begin[p + 1]; ++i) {
-                const glm::vec3 w = transform_point(object.world, mesh.positions[indices[i]]);
-                finite = finite && std::isfinite(w.x + w.y + w.z);
-                world.extend(w);
+                const glm::vec3 w = world[indices[i]];
+                if (!std::isfinite(w.x + w.y + w.z)) finite[id] = 0;
+                box.extend(w);
             }
-            boxes_.push_back(anchored_box(world, anchor));
-            part_first_triangle_.push_back(part_begin[p]);
-            part_triangle_count_.push_back(part_begin[p + 1] - part_begin[p]);
+            boxes_[object_first_[id] + p] = anchored_box(box, anchor);
+            part_first_triangle_[object_first_[id] + p] = part_begin[p];
+            part_triangle_count_[object_first_[id] + p] = part_begin[p + 1] - part_begin[p];
         }
-        if (!finite) {  // a box would say nothing: the object keeps its own box alone
-            boxes_.resize(first_box), part_first_triangle_.resize(first_box), part_triangle_count_.resize(first_box);
-            continue;
-        }
-        object_first_[id + 1] = std::uint32_t(boxes_.size());
+    });
+    if (std::find(finite.begin(), finite.end(), 0) == finite.end()) return;
+    std::uint32_t kept = 0;
+    for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+        const std::uint32_t first = object_first_[id], count = object_first_[id + 1] - first;
+        object_first_[id] = kept;
+        if (!finite[id]) continue;
+        for (std::uint32_t p = first; p < first + count; ++p, ++kept)
+            boxes_[kept] = boxes_[p], part_first_triangle_[kept] = part_first_triangle_[p], part_triangle_count_[kept] = part_triangle_count_[p];
     }
+    object_first_.back() = kept;
+    boxes_.resize(kept), part_first_triangle_.resize(kept), part_triangle_count_.resize(kept);
 }
 
 }  // namespace homcull::detail

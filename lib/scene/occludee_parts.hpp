@@ -7,6 +7,7 @@
 // part's box is visible, only that part's triangles need a closer test. Every box holds its
 // part's triangles as ground truth places them (widened as anchored_box widens object boxes),
 // so a hidden box hides them all. Private to the scene layer.
+#include <homcull/parallel_for.hpp>
 #include <homcull/scene.hpp>
 
 #include <cstdint>
@@ -17,8 +18,9 @@ namespace homcull::detail {
 class OccludeeParts {
 public:
     // Parts for the objects with at most triangle_limit triangles (the others get none); boxes
-    // relative to `anchor`. max_parts below 2: no parts at all. Allocates (load time).
-    void build(const Scene& scene, int max_parts, std::size_t triangle_limit, const glm::dvec3& anchor);
+    // relative to `anchor`. max_parts below 2: no parts at all. Allocates (load time). With a job
+    // system, the meshes' splits and the objects' boxes run in its tasks: the same parts.
+    void build(const Scene& scene, int max_parts, std::size_t triangle_limit, const glm::dvec3& anchor, const ParallelFor& parallel = {});
 
     // The parts of object `id`: [first(id), first(id) + count(id)) index part_box and the
     // per-part triangle ranges; count is 0 for an object without parts.

@@ -7,6 +7,7 @@
 #include "scene/scene_culler_state.hpp"
 
 #include "common/float_mode.hpp"
+#include "common/run_tasks.hpp"
 #include "scene/closed_occludees.hpp"
 #include "scene/scene_culler_frame.hpp"
 
@@ -105,12 +106,13 @@ OccludeeShape resolved_occludee_shape(const SceneCullerConfig& config) {
     return config.maps.depth == DepthTest::masked ? OccludeeShape::samples : OccludeeShape::rectangles;
 }
 
-detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config)
+detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
+                                           const ParallelFor& parallel)
     : scene_(&scene),
       config_(config),
       occluder_ids_(occluders),
       anchor_(scene_anchor(scene)),
-      occluders_(gather_world_triangles(scene, occluders, anchor_, config.merge_coplanar_occluders)),
+      occluders_(gather_world_triangles(scene, occluders, anchor_, config.merge_coplanar_occluders, parallel)),
       hierarchy_(ObjectHierarchy::build(scene, config.hierarchy_leaf_size)),
       buffer_(scene_buffer_config(config, 0.1f)),
       maps_(buffer_, maps_config(config)) {
@@ -138,13 +140,13 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     first_triangle_ = occluders_.object_first_triangle;
     own_shared_edges_.resize(occluders_.triangle_count());
     own_edge_apexes_.resize(3 * occluders_.triangle_count());
-    for (std::size_t k = 0; k < occluders.size(); ++k) {
+    for_each_index(parallel, occluders.size(), 8, [&](std::size_t k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
-        if (count == 0) continue;
+        if (count == 0) return;
         compute_shared_edges(occluders_.positions.data(), 3 * sizeof(float), occluders_.positions.size() / 3,
                              occluders_.indices.data() + 3 * first, count, own_shared_edges_.data() + first,
                              own_edge_apexes_.data() + 3 * first);
-    }
+    });
     // The boxes the buffer and the maps test, relative to the anchor as the triangles are.
     object_boxes_.reserve(scene.objects.size());
     for (const Object& object : scene.objects) object_boxes_.push_back(anchored_box(object.world_bounds, anchor_));
@@ -152,7 +154,7 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     for (const ObjectHierarchy::Node& node : hierarchy_.nodes) node_boxes_.push_back(anchored_box(node.bounds, anchor_));
     find_closed_candidates();
     gather_lods();
-    build_clusters();
+    build_clusters(parallel);
     find_triangle_neighbours();
     reserve_frame_room();
     drawn_.assign(occluders.size(), 0);
@@ -169,18 +171,25 @@ detail::SceneCullerState::SceneCullerState(const Scene& scene, const std::vector
     task_stacks_.resize(task_tallies_.size() * task_stack_room_);
 
     // Approximate mode: each part would tolerate the holes again, so no parts.
-    parts_.build(scene, config.maps.hole_pixels == 0.0 ? config.occludee_parts : 0, config.triangle_test_limit, anchor_);
+    parts_.build(scene, config.maps.hole_pixels == 0.0 ? config.occludee_parts : 0, config.triangle_test_limit, anchor_, parallel);
     first_visible_part_.assign(scene.objects.size(), 0);
     if (resolved_occludee_shape(config) != OccludeeShape::samples) return;
     occludee_first_vertex_.assign(scene.objects.size(), kNotGathered);
     first_visible_triangle_.assign(scene.objects.size(), 0);
+    std::size_t vertices = 0;
     for (std::size_t id = 0; id < scene.objects.size(); ++id) {
         const Object& object = scene.objects[id];
         if (scene.triangle_count(object) > config.triangle_test_limit) continue;
-        occludee_first_vertex_[id] = occludee_positions_.size() / 3;
-        append_world_positions(scene, object, occludee_positions_, anchor_);
+        occludee_first_vertex_[id] = vertices;
+        vertices += scene.meshes[object.mesh].positions.size();
     }
-    occludee_orientation_ = closed_occludee_orientations(scene, occludee_positions_, occludee_first_vertex_, kNotGathered);
+    occludee_positions_.resize(3 * vertices);
+    for_each_index(parallel, scene.objects.size(), 16, [&](std::size_t id) {
+        const Object& object = scene.objects[id];
+        if (occludee_first_vertex_[id] != kNotGathered)
+            write_world_positions(object, scene.meshes[object.mesh], occludee_positions_.data() + 3 * occludee_first_vertex_[id], anchor_);
+    });
+    occludee_orientation_ = closed_occludee_orientations(scene, occludee_positions_, occludee_first_vertex_, kNotGathered, parallel);
 }
 
 void detail::SceneCullerState::cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel) {
@@ -351,26 +360,31 @@ void detail::SceneCullerState::reserve_frame_room() {
 // with the flags within each object (own_shared_edges_), right whichever candidates a frame
 // draws, and beside them the flags across objects, for frames that draw every candidate in the
 // frustum (add_candidate_clusters).
-void detail::SceneCullerState::build_clusters() {
+void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
     cluster_neighbour_first_.assign(1, 0);
     const std::vector<std::uint32_t> vertex_candidate = vertex_candidates();
-    std::vector<std::uint32_t> local, local_apexes;  // the candidate's indices and apexes, relative to its first vertex
-    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+    // Each candidate's clusters in a task of its own, then added in the candidates' order.
+    std::vector<OccluderClusters> parts(occluder_ids_.size());
+    for_each_index(parallel, occluder_ids_.size(), 2, [&](std::size_t k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
         // Each object's vertices are together in occluders_.positions: the build sees only
         // those (meshoptimizer's work grows with the vertices it is given).
         const auto begin = occluders_.indices.begin() + std::ptrdiff_t(3 * first), end = begin + std::ptrdiff_t(3 * count);
         const std::uint32_t base = count ? *std::min_element(begin, end) : 0, top = count ? *std::max_element(begin, end) : 0;
-        local.assign(begin, end);
+        std::vector<std::uint32_t> local(begin, end);  // the candidate's indices and apexes, relative to its first vertex
         for (std::uint32_t& v : local) v -= base;
-        local_apexes.assign(own_edge_apexes_.begin() + std::ptrdiff_t(3 * first), own_edge_apexes_.begin() + std::ptrdiff_t(3 * (first + count)));
+        std::vector<std::uint32_t> local_apexes(own_edge_apexes_.begin() + std::ptrdiff_t(3 * first),
+                                                own_edge_apexes_.begin() + std::ptrdiff_t(3 * (first + count)));
         for (std::uint32_t& v : local_apexes) v = v == kNoApex ? kNoApex : v - base;
-        const OccluderClusters part = build_occluder_clusters(occluders_.positions.data() + 3 * std::size_t(base), 3 * sizeof(float),
-                                                              count ? std::size_t(top - base) + 1 : 0, local.data(), count,
-                                                              own_shared_edges_.data() + first, local_apexes.data());
-        add_candidate_clusters(k, part, vertex_candidate);
+        parts[k] = build_occluder_clusters(occluders_.positions.data() + 3 * std::size_t(base), 3 * sizeof(float),
+                                           count ? std::size_t(top - base) + 1 : 0, local.data(), count, own_shared_edges_.data() + first,
+                                           local_apexes.data());
+    });
+    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
+        add_candidate_clusters(k, parts[k], vertex_candidate);
+        parts[k] = {};  // its memory back now: the parts together hold every candidate's triangles again
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
     cluster_neighbour_edges_ = cluster_cross_shared_edges_;

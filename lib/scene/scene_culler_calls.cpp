@@ -4,8 +4,9 @@
 
 namespace homcull {
 
-SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config)
-    : state_(detail::make_hooked<detail::SceneCullerState>(scene, occluders, config)) {}
+SceneCuller::SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
+                         const ParallelFor& parallel)
+    : state_(detail::make_hooked<detail::SceneCullerState>(scene, occluders, config, parallel)) {}
 SceneCuller::~SceneCuller() = default;
 SceneCuller::SceneCuller(SceneCuller&&) noexcept = default;
 SceneCuller& SceneCuller::operator=(SceneCuller&&) noexcept = default;

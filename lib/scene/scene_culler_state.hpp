@@ -16,7 +16,8 @@ namespace homcull::detail {
 class SceneCullerState {
 public:
     // The calls of SceneCuller, with its contracts.
-    SceneCullerState(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config);
+    SceneCullerState(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
+                     const ParallelFor& parallel);
     void cull(const Camera& camera, std::vector<OccludeeAnswer>& answers, const ParallelFor& parallel = {});
     void reset_history() { has_history_ = false; }
     const SceneCullerConfig& config() const { return config_; }
@@ -150,7 +151,7 @@ public:
     void append_occluder(std::uint32_t id, const Frame& frame, EdgeFlags edge_flags);
     bool draws_lod(std::uint32_t id, const Camera& camera) const;
     void gather_lods();
-    void build_clusters();
+    void build_clusters(const ParallelFor& parallel);
     void reserve_frame_room();
     // Triangles appended and not rendered yet (progressive draws every batch of them).
     std::size_t triangles_waiting() const {

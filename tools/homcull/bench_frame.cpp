@@ -78,7 +78,7 @@ void run_frame_bench(const FrameBenchOptions& o) {
     // own preparation (clusters, shared edges, occludee parts, closed meshes, the hierarchy).
     start = now_ns();
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
-    SceneCuller culler(scene, resources.occluders, config);
+    SceneCuller culler(scene, resources.occluders, config, parallel);
     const double setup_ms = elapsed_ms(start);
 
     // One untimed cull per view (the scratch grows to the largest frame), then the timed rounds,

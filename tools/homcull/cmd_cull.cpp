@@ -37,13 +37,13 @@ void run_cull(const CullCommandOptions& o) {
     long long start = now_ns();
     const Scene scene = load_chosen_scene(o.scene);
     const double load_ms = elapsed_ms(start);
+    const ParallelFor parallel = command_job_system(o.threads);
     start = now_ns();
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const std::vector<std::uint32_t>& occluders = resources.occluders;
-    SceneCuller culler(scene, occluders, config);
+    SceneCuller culler(scene, occluders, config, parallel);
     const double setup_ms = elapsed_ms(start);
     std::vector<OccludeeAnswer> answers;
-    const ParallelFor parallel = command_job_system(o.threads);
     // Each repeat forgets the one before it: the temporal strategy would otherwise draw exactly the
     // occluders it found visible in the same view, a frame no walk or cut has.
     SceneCullTimings best;
@@ -166,7 +166,7 @@ void register_cull(CLI::App& app) {
     add_scene_option(*cmd, o->scene);
     add_camera_options(*cmd, o->camera);
     add_cull_options(*cmd, o->cull);
-    cmd->add_option("--threads", o->threads, "Render with this many threads (TBB); 1 = the calling thread")
+    cmd->add_option("--threads", o->threads, "Prepare the culler and cull with this many threads (TBB); 1 = the calling thread")
         ->capture_default_str()->check(CLI::Range(1, 256));
     cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
         ->capture_default_str();

@@ -30,9 +30,9 @@ void run_dump(const DumpCommandOptions& o) {
     prepare_dump_folder(o.out);  // fail on the folder before spending time on the scene
     const Scene scene = load_chosen_scene(o.scene);
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
-    SceneCuller culler(scene, resources.occluders, config);
-    std::vector<OccludeeAnswer> answers;
     const ParallelFor parallel = command_job_system(o.threads);
+    SceneCuller culler(scene, resources.occluders, config, parallel);
+    std::vector<OccludeeAnswer> answers;
     culler.cull(camera, answers, parallel);
     fmt::print("scene      {} ({} objects); depth {}\n", scene.source, scene.objects.size(), o.cull.depth);
     const RayScene rays(scene);
@@ -48,7 +48,7 @@ void register_dump(CLI::App& app) {
     add_camera_options(*cmd, o->camera);
     add_cull_options(*cmd, o->cull);
     cmd->add_option("--out", o->out, "Output folder (created if missing): maps.exr, <part>.png, colormaps.json, overlay.png")->required();
-    cmd->add_option("--threads", o->threads, "Render with this many threads (TBB); 1 = the calling thread")
+    cmd->add_option("--threads", o->threads, "Prepare the culler and cull with this many threads (TBB); 1 = the calling thread")
         ->capture_default_str()->check(CLI::Range(1, 256));
     cmd->callback([o] { run_dump(*o); });
 }

@@ -79,13 +79,13 @@ void run_walk(const WalkCommandOptions& o) {
     const CullResources resources = prepare_cull_resources(o.cull, scene, config);
     const CameraPath path = read_camera_path(o.path);
     if (path.frames.empty()) throw Error("camera path " + o.path + " has no frames");
-    SceneCuller culler(scene, resources.occluders, config);
+    const ParallelFor parallel = command_job_system(o.threads);
+    SceneCuller culler(scene, resources.occluders, config, parallel);
     const bool temporal = config.strategy == CullStrategy::temporal;  // its frames without history are counted
     std::unique_ptr<RayScene> rays;
     if (o.truth == "on") rays = std::make_unique<RayScene>(scene);
     TruthOptions truth_options;
     truth_options.resolution = config.display;
-    const ParallelFor parallel = command_job_system(o.threads);
 
     nlohmann::json frames = nlohmann::json::array();
     std::vector<WalkFrame> measured;
@@ -218,7 +218,7 @@ void register_walk(CLI::App& app) {
     cmd->add_option("--truth", o->truth, "on: cast Embree ground truth per frame (exactly visible, false and missed culls); off: only "
                                          "the culler")
         ->capture_default_str()->check(CLI::IsMember({"on", "off"}));
-    cmd->add_option("--threads", o->threads, "Render with this many threads (TBB); 1 = the calling thread")
+    cmd->add_option("--threads", o->threads, "Prepare the culler and cull with this many threads (TBB); 1 = the calling thread")
         ->capture_default_str()->check(CLI::Range(1, 256));
     cmd->add_option("--isa", o->isa, "Instruction set: best, scalar (the reference path), or one of available_isas()")
         ->capture_default_str();

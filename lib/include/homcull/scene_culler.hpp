@@ -179,8 +179,11 @@ class SceneCuller {
 public:
     // `occluders`: the occluder candidates, object ids (occluder_candidates() gives the usual
     // choices); their triangles are gathered once, here. Throws homcull::Error on an invalid
-    // configuration.
-    SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config);
+    // configuration. With a job system (`parallel`), the preparation's work per object and per
+    // mesh (world positions, coplanar merges, shared edges, clusters, occludee parts, closed
+    // meshes' orientations) runs in its tasks; the culler is the same, bit for bit.
+    SceneCuller(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
+                const ParallelFor& parallel = {});
 
     // answers[id] for every object of the scene (objects without geometry are view-culled).
     // overlap_exit is the deciding box test's (the object's own, or the hidden node's above

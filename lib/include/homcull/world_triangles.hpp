@@ -4,6 +4,7 @@
 // to an anchor: the scene culler's and ground truth's is scene_anchor), and the shared-edge
 // flags of the whole set (edges shared between objects count too).
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/parallel_for.hpp>
 #include <homcull/scene.hpp>
 
 #include <string_view>
@@ -28,13 +29,17 @@ struct WorldTriangles {
 // exactly as ground truth transforms them, in the order of its mesh's positions.
 void append_world_positions(const Scene& scene, const Object& object, std::vector<float>& positions,
                             const glm::dvec3& anchor = glm::dvec3(0.0));
+// The same into `out`, room for 3 x mesh.positions.size() floats (`mesh`: the object's).
+void write_world_positions(const Object& object, const Mesh& mesh, float* out, const glm::dvec3& anchor = glm::dvec3(0.0));
 
 // The triangles of the given objects, relative to `anchor`. With merge_coplanar, each object's
 // exactly coplanar regions are re-triangulated with fewer triangles covering the same points
 // (in world space, as drawn and as ground truth sees them: docs/scene-culling.md, "Coplanar
-// merge"). Allocates: meant for load time or tools.
+// merge"). Allocates: meant for load time or tools. With a job system (`parallel`) the objects'
+// positions and merges run in its tasks; the result is the same bits.
 WorldTriangles gather_world_triangles(const Scene& scene, const std::vector<std::uint32_t>& objects,
-                                      const glm::dvec3& anchor = glm::dvec3(0.0), bool merge_coplanar = false);
+                                      const glm::dvec3& anchor = glm::dvec3(0.0), bool merge_coplanar = false,
+                                      const ParallelFor& parallel = {});
 
 // Ids of the objects whose extra "role" equals `role`, or of every object when role is empty.
 std::vector<std::uint32_t> objects_with_role(const Scene& scene, std::string_view role);
