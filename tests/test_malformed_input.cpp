@@ -5,10 +5,16 @@
 #include <homcull/generate.hpp>
 #include <homcull/io/camera_path.hpp>
 #include <homcull/io/scene_io.hpp>
+#include <homcull/object_hierarchy.hpp>
+#include <homcull/occluder_selection.hpp>
 #include <homcull/occlusion_buffer.hpp>
+#include <homcull/scene_culler.hpp>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -116,6 +122,39 @@ TEST(MalformedInput, NonFiniteVerticesDropTheirTrianglesOnly) {
     for (const Object& o : loaded.objects)
         EXPECT_TRUE(o.world_bounds.empty() || (std::isfinite(o.world_bounds.min.x) && std::isfinite(o.world_bounds.max.y)))
             << o.name;
+}
+
+// Objects whose transform puts them beyond float's range have world boxes with infinite bounds
+// (transform_point rounds to float). The hierarchy's binning converted such a centre to int, an
+// undefined conversion: SceneCuller's constructor crashed. Now they go to an end bin, every
+// object is in the hierarchy once, and a cull answers every object.
+TEST(MalformedInput, ObjectsBeyondFloatRange) {
+    Scene scene = generate_scene("city:blocks=2,cars=0");
+    const std::size_t finite_objects = scene.objects.size();
+    Object stretched = scene.objects[1], moved = scene.objects[2];
+    stretched.world = glm::scale(glm::dmat4(1.0), glm::dvec3(1e39, 1.0, 1.0)) * stretched.world;  // max x = +inf
+    moved.world = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, -1e39)) * moved.world;    // both z bounds -inf
+    scene.objects.push_back(stretched);
+    scene.objects.push_back(moved);
+    scene.finalize();
+    ASSERT_FALSE(std::isfinite(scene.objects[finite_objects].world_bounds.max.x));
+    ASSERT_FALSE(std::isfinite(scene.objects[finite_objects + 1].world_bounds.min.z));
+
+    const ObjectHierarchy h = ObjectHierarchy::build(scene, 2);
+    std::vector<int> seen(scene.objects.size(), 0);
+    for (std::uint32_t id : h.object_ids) ++seen[id];
+    for (std::size_t id = 0; id < scene.objects.size(); ++id)
+        EXPECT_EQ(seen[id], scene.objects[id].world_bounds.empty() ? 0 : 1) << "object " << id;
+
+    SceneCullerConfig config;
+    config.display = {160, 90};
+    SceneCuller culler(scene, occluder_candidates(scene, OccluderFilter::role), config);
+    Camera camera;
+    camera.eye = {-30.0, 2.0, -30.0};
+    camera.target = {0.0, 2.0, 0.0};
+    std::vector<OccludeeAnswer> answers;
+    culler.cull(camera, answers);
+    ASSERT_EQ(answers.size(), scene.objects.size());
 }
 
 // Names are bytes in OBJ files, UTF-8 in glTF and JSON: invalid bytes become U+FFFD at load, so

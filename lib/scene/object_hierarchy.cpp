@@ -19,6 +19,14 @@ double surface_area(const Aabb& b) {
     return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
+// The bin of a centre's coordinate among kBins from lo, `width` wide. A coordinate that is not
+// finite (an object placed so far out that its world box overflowed float) goes to an end bin:
+// a float that is NaN or beyond int's range is not converted, which would be undefined.
+int bin_of(float coordinate, float lo, float width) {
+    const float t = float(kBins) * (coordinate - lo) / width;
+    return t >= 0.0f ? std::min(kBins - 1, int(std::min(t, float(kBins)))) : 0;
+}
+
 struct Builder {
     const Scene& scene;
     int leaf_size;
@@ -46,7 +54,7 @@ struct Builder {
             std::array<std::uint32_t, kBins> count{};
             for (std::uint32_t i = begin; i < end; ++i) {
                 const std::uint32_t id = out.object_ids[i];
-                const int bin = std::min(kBins - 1, int(float(kBins) * (centre[id][axis] - lo) / width));
+                const int bin = bin_of(centre[id][axis], lo, width);
                 box[bin].extend(scene.objects[id].world_bounds);
                 ++count[bin];
             }
@@ -72,7 +80,7 @@ struct Builder {
         if (best_axis < 0) return end;
         const float lo = centres.min[best_axis], width = centres.max[best_axis] - lo;
         const auto middle = std::partition(out.object_ids.begin() + begin, out.object_ids.begin() + end, [&](std::uint32_t id) {
-            return std::min(kBins - 1, int(float(kBins) * (centre[id][best_axis] - lo) / width)) <= best_bin;
+            return bin_of(centre[id][best_axis], lo, width) <= best_bin;
         });
         return std::uint32_t(middle - out.object_ids.begin());
     }

@@ -1,0 +1,123 @@
+// The scene culler's preparation (SceneCuller's constructor) with a job system: its per-object
+// and per-mesh work runs in tasks, each writing only its own results, so that the culler made
+// is the one a single thread makes. Checked through everything a culler shows: answers, the
+// work counts and the buffer's bits, frame after frame, culled on one thread so that only the
+// preparation differs.
+#include "support.hpp"
+
+#include <homcull/camera.hpp>
+#include <homcull/generate.hpp>
+#include <homcull/io/scene_io.hpp>
+#include <homcull/scene_culler.hpp>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace homcull {
+namespace {
+
+// A city with what takes the preparation's less common paths: an object mirrored by its
+// transform (a closed mesh facing in), and one placed so far out that its world positions
+// overflow float (its occludee parts are left out).
+Scene city_with_odd_objects() {
+    CityOptions city;
+    city.blocks = 4;
+    Scene scene = generate_city(city);
+    Object mirrored = scene.objects[1];
+    mirrored.world = glm::scale(mirrored.world, glm::dvec3(-1.0, 1.0, 1.0));
+    scene.objects.push_back(mirrored);
+    Object overflowing = scene.objects[2];
+    overflowing.world = glm::scale(glm::dmat4(1.0), glm::dvec3(1e39, 1.0, 1.0)) * overflowing.world;
+    scene.objects.push_back(overflowing);
+    scene.finalize();
+    return scene;
+}
+
+// Random views from the lower part of the box of the scene's objects placed within float.
+std::vector<Camera> views_over(const Scene& scene, int count, std::uint64_t seed) {
+    Aabb bounds;
+    for (const Object& object : scene.objects)
+        if (std::isfinite(object.world_bounds.min.x + object.world_bounds.max.x)) bounds.extend(object.world_bounds);
+    std::mt19937_64 random(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const auto inside = [&] {
+        glm::dvec3 p;
+        for (int k = 0; k < 3; ++k) p[k] = double(bounds.min[k]) + unit(random) * (double(bounds.max[k]) - double(bounds.min[k]));
+        return p;
+    };
+    std::vector<Camera> cameras;
+    while (int(cameras.size()) < count) {
+        Camera c;
+        c.eye = inside();
+        c.eye.y = double(bounds.min.y) + (0.05 + 0.2 * unit(random)) * (double(bounds.max.y) - double(bounds.min.y));
+        c.target = inside();
+        if (glm::length(c.target - c.eye) < 1.0) continue;
+        c.far_plane = 1e4;
+        cameras.push_back(c);
+    }
+    return cameras;
+}
+
+void expect_same_cullers(const Scene& scene, const std::vector<std::uint32_t>& occluders, const SceneCullerConfig& config,
+                         const std::vector<Camera>& cameras, const std::string& what) {
+    std::mt19937_64 order(5);
+    const ParallelFor shuffled{&test::run_shuffled, &order, 2};
+    SceneCuller serial(scene, occluders, config), threaded(scene, occluders, config, test::thread_jobs(2)),
+        reordered(scene, occluders, config, shuffled);
+    EXPECT_EQ(serial.occluder_triangles(), threaded.occluder_triangles()) << what;
+    EXPECT_EQ(serial.occluder_triangles(), reordered.occluder_triangles()) << what;
+    std::vector<OccludeeAnswer> a, b, c;
+    std::size_t hidden = 0;
+    for (std::size_t v = 0; v < cameras.size(); ++v) {
+        serial.cull(cameras[v], a);
+        threaded.cull(cameras[v], b);
+        reordered.cull(cameras[v], c);
+        for (std::size_t id = 0; id < a.size(); ++id) {
+            ASSERT_EQ(a[id].visibility, b[id].visibility) << what << ", view " << v << ", object " << id;
+            ASSERT_EQ(a[id].level_of_visibility, b[id].level_of_visibility) << what << ", view " << v << ", object " << id;
+            ASSERT_EQ(a[id].visibility, c[id].visibility) << what << ", view " << v << ", object " << id;
+            hidden += a[id].visibility == Visibility::occluded;
+        }
+        for (const SceneCuller* other : {&threaded, &reordered}) {
+            EXPECT_EQ(serial.work().occluder_triangles, other->work().occluder_triangles) << what << ", view " << v;
+            EXPECT_EQ(serial.work().objects_tested, other->work().objects_tested) << what << ", view " << v;
+            EXPECT_EQ(serial.work().occludee_parts_tested, other->work().occludee_parts_tested) << what << ", view " << v;
+            EXPECT_EQ(serial.work().solid_parts_tested, other->work().solid_parts_tested) << what << ", view " << v;
+            EXPECT_TRUE(test::same_subtiles(serial.buffer(), other->buffer())) << what << ", view " << v;
+        }
+    }
+    EXPECT_GT(hidden, 0u) << what << ": no object hidden, the views test nothing";
+}
+
+TEST(CullerPreparation, InTasksMakesTheCullerOfOneThread) {
+    const Scene city = city_with_odd_objects();
+    const std::vector<std::uint32_t> occluders = occluder_candidates(city, OccluderFilter::role);
+    const std::vector<Camera> cameras = views_over(city, 6, 1);
+    for (const bool clusters : {true, false}) {
+        SceneCullerConfig config;
+        config.display = {320, 180};
+        config.occluder_clusters = clusters;
+        expect_same_cullers(city, occluders, config, cameras, clusters ? "city, clusters" : "city, triangles");
+    }
+}
+
+// The castle: coplanar merges, closed meshes, hundreds of meshes split into parts, occluders
+// drawn as clusters; the defaults at 640x360.
+TEST(CullerPreparation, InTasksMakesTheCastleCullerOfOneThread) {
+    const std::string file = test::shared_scene("intel_castle.glb");
+    if (file.empty()) GTEST_SKIP() << "the shared scenes are missing";
+    const Scene castle = load_scene(file);
+    SceneCullerConfig config;
+    config.display = {640, 360};
+    std::vector<Camera> cameras = views_over(castle, 3, 2);
+    cameras.push_back(test::castle_view_c0());
+    expect_same_cullers(castle, occluder_candidates(castle, OccluderFilter::role), config, cameras, "castle");
+}
+
+}  // namespace
+}  // namespace homcull
