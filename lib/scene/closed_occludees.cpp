@@ -5,13 +5,11 @@
 
 #include "common/run_tasks.hpp"
 
-#include <homcull/triangle_input.hpp>
-
 #include <meshoptimizer.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 namespace homcull::detail {
 namespace {
@@ -32,33 +30,50 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t v) {
     return v;
 }
 
+// One pass over the edges, matched by position through the positions' numbers (meshoptimizer's
+// vertex remap on the positions with -0 made +0: equal numbers are equal positions under float
+// ==, as compute_shared_edges matches them). The mesh is closed when every triangle is finite,
+// has three distinct positions, and each of its edges is also met in the opposite direction
+// (compute_shared_edges' flags all set); the triangles across each edge are joined.
 MeshPieces mesh_pieces(const Mesh& mesh) {
     MeshPieces m;
-    const std::size_t triangles = mesh.triangle_count();
-    if (triangles == 0 || mesh.positions.empty()) return m;
-    std::vector<std::uint8_t> shared(triangles);
-    std::vector<std::uint32_t> apexes(3 * triangles);
-    compute_shared_edges(&mesh.positions[0].x, sizeof(glm::vec3), mesh.positions.size(), mesh.indices.data(), triangles, shared.data(),
-                         apexes.data());
-    for (const std::uint8_t s : shared)
-        if (s != 7) return m;
-    // One number per position, by bytes (split normals or texture seams give a position several
-    // vertex numbers; compute_shared_edges matches edges by position bits too): meshoptimizer's
-    // vertex remap, as the occluder LOD build welds (truth/lod_mesh_parts.cpp). Then the
-    // triangles joined across each edge.
-    std::vector<unsigned> point(mesh.positions.size());
-    meshopt_generateVertexRemap(point.data(), nullptr, mesh.positions.size(), mesh.positions.data(), mesh.positions.size(), sizeof(glm::vec3));
+    const std::size_t triangles = mesh.triangle_count(), vertices = mesh.positions.size();
+    if (triangles == 0 || vertices == 0) return m;
+    std::vector<glm::vec3> canonical(vertices);
+    for (std::size_t v = 0; v < vertices; ++v) canonical[v] = mesh.positions[v] + glm::vec3(0.0f);  // -0 + 0 = +0
+    for (const std::uint32_t index : mesh.indices)
+        if (index >= vertices || !std::isfinite(canonical[index].x) || !std::isfinite(canonical[index].y) || !std::isfinite(canonical[index].z))
+            return m;
+    std::vector<unsigned> point(vertices);
+    meshopt_generateVertexRemap(point.data(), nullptr, vertices, canonical.data(), vertices, sizeof(glm::vec3));
+
+    // Open addressing on the edge's two numbers, lower first (never 0: the numbers differ), at
+    // most half full: which directions were met, and the first triangle met.
+    struct Slot {
+        std::uint64_t key = 0;
+        std::uint32_t triangle = 0;
+        std::uint8_t directions = 0;
+    };
+    std::size_t capacity = 16;
+    while (capacity < 6 * triangles) capacity *= 2;
+    std::vector<Slot> table(capacity);
+    const int shift = 64 - __builtin_ctzll(capacity);
     std::vector<std::uint32_t> parent(triangles);
     std::iota(parent.begin(), parent.end(), 0u);
-    std::unordered_map<std::uint64_t, std::uint32_t> edge_owner;
     for (std::uint32_t t = 0; t < triangles; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const std::uint32_t a = point[mesh.indices[3 * std::size_t(t) + std::size_t(k)]];
-            const std::uint32_t b = point[mesh.indices[3 * std::size_t(t) + std::size_t((k + 1) % 3)]];
+        for (std::size_t k = 0; k < 3; ++k) {
+            const std::uint32_t a = point[mesh.indices[3 * std::size_t(t) + k]], b = point[mesh.indices[3 * std::size_t(t) + (k + 1) % 3]];
+            if (a == b) return m;  // a degenerate edge is shared with nothing
             const std::uint64_t key = std::uint64_t(std::min(a, b)) << 32 | std::max(a, b);
-            const auto [it, added] = edge_owner.emplace(key, t);
-            if (!added) parent[find_root(parent, t)] = find_root(parent, it->second);
+            std::size_t slot = std::size_t((key * 0x9E3779B97F4A7C15ull) >> shift);
+            while (table[slot].key != 0 && table[slot].key != key) slot = (slot + 1) & (capacity - 1);
+            Slot& s = table[slot];
+            if (s.key == 0) s.key = key, s.triangle = t;
+            else parent[find_root(parent, t)] = find_root(parent, s.triangle);
+            s.directions |= a < b ? 1 : 2;
         }
+    for (const Slot& s : table)
+        if (s.key != 0 && s.directions != 3) return m;
     std::vector<std::uint32_t> number(triangles, kNoPiece);  // per root triangle
     m.piece.resize(triangles);
     for (std::uint32_t t = 0; t < triangles; ++t) {
