@@ -57,6 +57,8 @@ void OccludeeParts::build(const Scene& scene, int max_parts, std::size_t triangl
     // Each mesh's split in a task of its own, then the meshes' in their order.
     struct MeshSplit {
         std::vector<std::uint32_t> indices, part_begin;
+        // Each part's vertices, once each: part p's are vertices[vertex_begin[p], vertex_begin[p + 1]).
+        std::vector<std::uint32_t> vertices, vertex_begin;
     };
     std::vector<MeshSplit> splits(scene.meshes.size());
     for_each_index(parallel, scene.meshes.size(), 4, [&](std::size_t m) {
@@ -74,6 +76,14 @@ void OccludeeParts::build(const Scene& scene, int max_parts, std::size_t triangl
             out.indices.resize(3 * n);
             std::uint32_t* indices = out.indices.data();
             for (std::uint32_t t : order) indices = std::copy_n(mesh.indices.begin() + 3 * std::ptrdiff_t(t), 3, indices);
+            std::vector<std::uint32_t> last_part(mesh.positions.size(), ~0u);
+            out.vertex_begin.push_back(0);
+            for (std::uint32_t p = 0; p < out.part_begin.size(); ++p) {
+                const std::uint32_t end = p + 1 < out.part_begin.size() ? out.part_begin[p + 1] : std::uint32_t(n);
+                for (std::size_t i = 3 * std::size_t(out.part_begin[p]); i < 3 * std::size_t(end); ++i)
+                    if (last_part[out.indices[i]] != p) last_part[out.indices[i]] = p, out.vertices.push_back(out.indices[i]);
+                out.vertex_begin.push_back(std::uint32_t(out.vertices.size()));
+            }
         }
         out.part_begin.push_back(std::uint32_t(n));  // after the parts' beginnings; alone: no parts
     });
@@ -98,17 +108,15 @@ void OccludeeParts::build(const Scene& scene, int max_parts, std::size_t triangl
         const Mesh& mesh = scene.meshes[object.mesh];
         const std::uint32_t* part_begin = mesh_part_begin_.data() + mesh_first_part_[object.mesh];
         const std::uint32_t parts = object_first_[id + 1] - object_first_[id];
-        const std::uint32_t* indices = mesh_indices_.data() + mesh_first_index_[object.mesh];
         if (parts == 0) return;
         // As Scene::finalize bounds the object: transform_point's floats, then anchored_box's
-        // widening; each vertex transformed once.
-        std::vector<glm::vec3> world(mesh.positions.size());
-        for (std::size_t v = 0; v < world.size(); ++v) world[v] = transform_point(object.world, mesh.positions[v]);
+        // widening; a part's box from its vertices, each once.
+        const MeshSplit& split = splits[object.mesh];
         for (std::uint32_t p = 0; p < parts; ++p) {
             Aabb box;
-            for (std::uint32_t i = 3 * part_begin[p]; i < 3 * part_begin[p + 1]; ++i) {
-                const glm::vec3 w = world[indices[i]];
-                if (!std::isfinite(w.x + w.y + w.z)) finite[id] = 0;
+            for (std::uint32_t i = split.vertex_begin[p]; i < split.vertex_begin[p + 1]; ++i) {
+                const glm::vec3 w = transform_point(object.world, mesh.positions[split.vertices[i]]);
+                if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z)) finite[id] = 0;
                 box.extend(w);
             }
             boxes_[object_first_[id] + p] = anchored_box(box, anchor);
