@@ -108,11 +108,21 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
 
     // The input triangles sorted by their vertices (a repeated triangle: its copies in input
     // order), each handed out once. One sorted array rather than a list per triangle: the
-    // scene culler builds the clusters of every occluder at load time.
+    // scene culler builds the clusters of every occluder at load time. Sorted by first vertex
+    // with a counting sort, then each first vertex's few triangles by the other two, so that a
+    // meshlet triangle is searched for among those alone (a search of the whole array missed
+    // the cache at every step).
+    detail::Vector<std::uint32_t> first_vertex_begin(vertex_count + 1, 0);
+    for (std::size_t t = 0; t < triangle_count; ++t) ++first_vertex_begin[indices[3 * t] + 1];
+    for (std::size_t v = 0; v < vertex_count; ++v) first_vertex_begin[v + 1] += first_vertex_begin[v];
     detail::Vector<NumberedTriangle> by_vertices(triangle_count);
-    for (std::size_t t = 0; t < triangle_count; ++t)
-        by_vertices[t] = {{indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]}, std::uint32_t(t)};
-    std::sort(by_vertices.begin(), by_vertices.end());
+    {
+        detail::Vector<std::uint32_t> fill(first_vertex_begin.begin(), first_vertex_begin.end() - 1);
+        for (std::size_t t = 0; t < triangle_count; ++t)
+            by_vertices[fill[indices[3 * t]]++] = {{indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]}, std::uint32_t(t)};
+    }
+    for (std::size_t v = 0; v < vertex_count; ++v)
+        std::sort(by_vertices.begin() + first_vertex_begin[v], by_vertices.begin() + first_vertex_begin[v + 1]);
     detail::Vector<std::uint32_t> handed_out(triangle_count, 0);  // at a run's first entry: how many of the run are taken
 
     out.indices.reserve(index_count);
@@ -120,6 +130,10 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
     out.source_triangles.reserve(triangle_count);
     out.clusters.reserve(meshlets.size());
     out.edge_apexes.reserve(index_count);
+    // Each input vertex's number in the cluster being appended (kNotInCluster: none; reset after
+    // each cluster), to find an apex among the cluster's vertices at once.
+    constexpr std::uint32_t kNotInCluster = 0xFFFFFFFFu;
+    detail::Vector<std::uint32_t> local_of(vertex_count, kNotInCluster);
     // Appends a cluster of the given input vertices and triangles (vertex numbers local to it;
     // `originals` the input triangles, for their flags), then the apexes its flags need.
     const auto append = [&](detail::Vector<std::uint32_t>& vertices, const detail::Vector<std::uint8_t>& local,
@@ -130,6 +144,7 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         c.first_triangle = std::uint32_t(out.shared_edges.size());
         c.triangle_count = std::uint32_t(originals.size());
         c.bounded = true;
+        for (std::size_t i = 0; i < vertices.size(); ++i) local_of[vertices[i]] = std::uint32_t(i);
         for (const std::uint32_t v : vertices) {
             const float* p = &packed[3 * std::size_t(v)];
             out.positions.insert(out.positions.end(), p, p + 3);
@@ -147,15 +162,18 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
                     continue;
                 }
                 // The cluster's copy of the apex: one of its vertices, or a copy appended after them.
-                const auto found = std::find(vertices.begin(), vertices.end(), apex);
-                out.edge_apexes.push_back(std::uint32_t(found - vertices.begin()));
-                if (found != vertices.end()) continue;
+                if (local_of[apex] != kNotInCluster) {
+                    out.edge_apexes.push_back(local_of[apex]);
+                    continue;
+                }
+                out.edge_apexes.push_back(local_of[apex] = std::uint32_t(vertices.size()));
                 vertices.push_back(apex);
                 const float* p = &packed[3 * std::size_t(apex)];
                 out.positions.insert(out.positions.end(), p, p + 3);
             }
         }
         c.vertex_count = std::uint32_t(vertices.size());
+        for (const std::uint32_t v : vertices) local_of[v] = kNotInCluster;
         out.source_triangles.insert(out.source_triangles.end(), originals.begin(), originals.end());
         out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
         out.clusters.push_back(c);
@@ -168,9 +186,11 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         originals.clear();
         for (unsigned t = 0; t < m.triangle_count; ++t) {
             const NumberedTriangle key{{vertices[local[3 * t]], vertices[local[3 * t + 1]], vertices[local[3 * t + 2]]}, 0};
-            const std::size_t run = std::size_t(std::lower_bound(by_vertices.begin(), by_vertices.end(), key) - by_vertices.begin());
-            const std::size_t next = run + handed_out[run < triangle_count ? run : 0];
-            if (run == triangle_count || next == triangle_count || !by_vertices[next].same_vertices(key))
+            const auto bucket_end = by_vertices.begin() + first_vertex_begin[key.v[0] + 1];
+            const auto found = std::lower_bound(by_vertices.begin() + first_vertex_begin[key.v[0]], bucket_end, key);
+            const std::size_t run = std::size_t(found - by_vertices.begin()), end = std::size_t(bucket_end - by_vertices.begin());
+            const std::size_t next = run + (run < end ? handed_out[run] : 0);
+            if (run == end || next >= end || !by_vertices[next].same_vertices(key))
                 fail("meshoptimizer changed a triangle (internal error)");
             ++handed_out[run];
             originals.push_back(by_vertices[next].number);
