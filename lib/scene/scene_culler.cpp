@@ -384,7 +384,7 @@ void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
     });
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         add_candidate_clusters(k, parts[k], vertex_candidate);
-        parts[k] = {};  // its memory back now: the parts together hold every candidate's triangles again
+        parts[k] = {};  // freed once added: the parts together are a second copy of every candidate's clusters
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
     cluster_neighbour_edges_ = cluster_cross_shared_edges_;

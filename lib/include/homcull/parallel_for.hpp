@@ -4,7 +4,8 @@
 
 namespace homcull {
 
-// The caller's job system, for renders: run(user, count, task, task_data) must call
+// The caller's job system (renders, the scene culler's tests and its preparation):
+// run(user, count, task, task_data) must call
 // task(task_data, i) once for every i in [0, count), in any order, on any threads, and return
 // when all calls have returned. The library creates no threads. Left empty, tasks run in
 // order on the calling thread. Results are the same bits whatever the threads.
