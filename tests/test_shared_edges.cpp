@@ -1,5 +1,6 @@
 // compute_shared_edges against its definition, checked pair by pair: an edge is shared when
 // another edge of the mesh joins the same two positions (float ==) in the opposite direction.
+#include <homcull/detail/memory.hpp>
 #include <homcull/occlusion_buffer.hpp>
 
 #include <gtest/gtest.h>
@@ -9,6 +10,8 @@
 #include <bitset>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -204,6 +207,39 @@ TEST(SharedEdges, ClosedAndOpenMeshes) {
     EXPECT_EQ(soup_apexes[1], 5u);  // across it: the second triangle's vertex 2 (vertex 3 + 2)
     EXPECT_EQ(soup_apexes[3], 0u);  // and the first's vertex 0
     EXPECT_EQ(soup_apexes[0], homcull::kNoApex);
+}
+
+// Indices far apart (two triangles using vertices 0 to 2 and 2,000,000 of a large array): the
+// positions are numbered index by index rather than over the whole range between them, so that
+// the memory follows the triangles (the whole range would take some 70 MB here).
+TEST(SharedEdges, FarApartIndicesTakeMemoryForTheTrianglesOnly) {
+    constexpr std::uint32_t kFar = 2000000;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<Position> positions(kFar + 1, Position{nan, nan, nan});
+    positions[0] = {0, 0, 0}, positions[1] = {1, 0, 0}, positions[2] = {1, 1, 0}, positions[kFar] = {0, 1, 0};
+    const std::vector<std::uint32_t> indices = {0, 1, kFar, kFar, 1, 2};
+    struct Counted {
+        std::size_t bytes = 0;
+    } counted;
+    homcull::detail::MemoryHooks hooks;
+    hooks.user = &counted;
+    hooks.allocate = [](void* user, std::size_t size, std::size_t) -> void* {
+        static_cast<Counted*>(user)->bytes += size;
+        return std::aligned_alloc(64, (size + 63) / 64 * 64);
+    };
+    hooks.deallocate = [](void*, void* memory, std::size_t) { std::free(memory); };
+    std::uint8_t shared[2] = {0xFF, 0xFF};
+    std::uint32_t apexes[6];
+    {
+        const homcull::detail::MemoryScope scope(&hooks);
+        homcull::compute_shared_edges(positions[0].data(), sizeof(Position), positions.size(), indices.data(), 2, shared, apexes);
+    }
+    EXPECT_EQ(shared[0], 2u);  // edge 1 -> far of the first triangle
+    EXPECT_EQ(shared[1], 1u);  // edge far -> 1 of the second
+    EXPECT_EQ(apexes[1], 2u);
+    EXPECT_EQ(apexes[3], 0u);
+    EXPECT_LT(counted.bytes, 4096u);
+    EXPECT_GT(counted.bytes, 0u);  // the hooks were used: the count means something
 }
 
 }  // namespace

@@ -31,10 +31,12 @@ std::uint32_t float_key(float f) {
     return u == 0x80000000u ? 0u : u;
 }
 
-// Numbers for the positions of vertices [first, first + count): equal positions one number,
-// numbers from 0 in the order the positions first appear; kNoNumber where a coordinate is not
-// finite (such triangles are not drawn, and share nothing).
-detail::Vector<std::uint32_t> number_positions(const float* positions, std::size_t stride, std::size_t first, std::size_t count) {
+// Numbers for `count` positions (position(i, p) fills p and returns false when there is none):
+// equal positions one number, numbers from 0 in the order the positions first appear;
+// kNoNumber where there is no position or a coordinate is not finite (such triangles are not
+// drawn, and share nothing). `numbers`: how many.
+template <typename Position>
+detail::Vector<std::uint32_t> number_positions(std::size_t count, const Position& position, std::uint32_t& numbers) {
     struct Slot {
         std::uint32_t key[3];
         std::uint32_t number_plus_one;  // 0: empty
@@ -44,11 +46,10 @@ detail::Vector<std::uint32_t> number_positions(const float* positions, std::size
     while (capacity < 2 * count) capacity *= 2, ++bits;
     detail::Vector<Slot> table(capacity, Slot{{0, 0, 0}, 0});
     detail::Vector<std::uint32_t> number(count, kNoNumber);
-    std::uint32_t next = 0;
+    numbers = 0;
     for (std::size_t i = 0; i < count; ++i) {
         float p[3];
-        std::memcpy(p, reinterpret_cast<const unsigned char*>(positions) + (first + i) * stride, sizeof p);
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
+        if (!position(i, p) || !std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
         const std::uint32_t key[3] = {float_key(p[0]), float_key(p[1]), float_key(p[2])};
         // The slot from the hash's high bits: a float's low bits are often all 0 (whole numbers).
         std::uint64_t h = (std::uint64_t(key[0]) << 32 | key[1]) * 0x9E3779B97F4A7C15ull;
@@ -57,8 +58,8 @@ detail::Vector<std::uint32_t> number_positions(const float* positions, std::size
             Slot& s = table[slot];
             if (s.number_plus_one == 0) {
                 std::memcpy(s.key, key, sizeof key);
-                s.number_plus_one = ++next;
-                number[i] = next - 1;
+                s.number_plus_one = ++numbers;
+                number[i] = numbers - 1;
                 break;
             }
             if (std::memcmp(s.key, key, sizeof key) == 0) {
@@ -82,25 +83,32 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
         throw Error("compute_shared_edges: more than 2^32 / 3 triangles");
     const auto vertex = [&](std::size_t i) -> std::size_t { return indices ? indices[i] : i; };
 
-    // The vertices the triangles use lie within [low, high]: a caller may pass one object's
-    // triangles with a whole scene's positions (the scene culler does), so only those are numbered.
+    // The vertices the triangles use lie within [low, high]. Numbered vertex by vertex when that
+    // range is not much longer than the triangles' indices (a caller may pass one object's
+    // triangles with a whole scene's positions, as the scene culler does: only the object's are
+    // numbered), else index by index, so that memory follows the triangles whatever the indices.
     std::size_t low = vertex_count, high = 0;
     for (std::size_t i = 0; i < 3 * triangle_count; ++i) {
         const std::size_t v = vertex(i);
         if (v < vertex_count) low = std::min(low, v), high = std::max(high, v);
     }
+    const bool by_vertex = low <= high && high - low < 2 * 3 * triangle_count;
+    const auto position_of = [&](std::size_t v, float* p) {
+        if (v >= vertex_count) return false;
+        std::memcpy(p, reinterpret_cast<const unsigned char*>(positions) + v * stride, 3 * sizeof(float));
+        return true;
+    };
+    std::uint32_t numbers = 0;
     const detail::Vector<std::uint32_t> number =
-        low <= high ? number_positions(positions, stride, low, high - low + 1) : detail::Vector<std::uint32_t>();
+        by_vertex ? number_positions(high - low + 1, [&](std::size_t i, float* p) { return position_of(low + i, p); }, numbers)
+                  : number_positions(3 * triangle_count, [&](std::size_t i, float* p) { return position_of(vertex(i), p); }, numbers);
     const auto number_of = [&](std::size_t i) {
         const std::size_t v = vertex(i);
-        return v < vertex_count ? number[v - low] : kNoNumber;
+        return v >= vertex_count ? kNoNumber : by_vertex ? number[v - low] : number[i];
     };
 
     // Each edge of a triangle whose three vertices are numbered, between two different
     // positions, into the bucket of its lower number.
-    std::uint32_t numbers = 0;
-    for (const std::uint32_t n : number)
-        if (n != kNoNumber) numbers = std::max(numbers, n + 1);
     detail::Vector<std::uint32_t> bucket_first(std::size_t(numbers) + 1, 0);
     const auto usable = [&](std::size_t t) {
         return number_of(3 * t) != kNoNumber && number_of(3 * t + 1) != kNoNumber && number_of(3 * t + 2) != kNoNumber;
@@ -133,10 +141,11 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
     }
 
     // Within a bucket, the edges joining the same two positions, in the mesh's order (sorted by
-    // the higher number, then the edge: std::sort allocates nothing, unlike std::stable_sort, and
-    // a bucket holds a handful of edges): such an edge is shared when met in both directions, and its
-    // neighbour is the first triangle met the other way (on a non-manifold edge, any one of them
-    // will do: the render keeps the flag only where that neighbour lies across the edge).
+    // the higher number, then the edge: std::sort allocates nothing, unlike std::stable_sort,
+    // and a bucket holds a handful of edges): such an edge is shared when met in both
+    // directions, and its neighbour is the first triangle met the other way (on a non-manifold
+    // edge, any one of them will do: the render keeps the flag only where that neighbour lies
+    // across the edge).
     for (std::size_t n = 0; n < numbers; ++n) {
         BucketEdge* begin = edges.data() + bucket_first[n];
         BucketEdge* end = edges.data() + bucket_first[n + 1];

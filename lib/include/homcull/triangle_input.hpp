@@ -116,8 +116,8 @@ struct TriangleInput {
 // TriangleInput::shared_edges bits and, for each shared edge, the apex of one neighbour across
 // it (TriangleInput::edge_apexes: 3 per triangle; kNoApex where the edge is not shared).
 // `indices` may be null (vertices 3k, 3k+1, 3k+2). Meant for load time: it allocates 36 bytes per
-// triangle and up to 80 per vertex from the lowest index the triangles use to the highest (a
-// table numbering the positions). Throws homcull::Error when positions
+// triangle, and a table numbering the positions: up to 80 bytes per vertex from the lowest
+// index the triangles use to the highest, or per index when that range is longer. Throws homcull::Error when positions
 // or an output are missing, the stride is below one position (12 bytes), or there are 2^32 / 3
 // triangles or more.
 constexpr std::uint32_t kNoApex = 0xFFFFFFFFu;
