@@ -266,8 +266,8 @@ void register_bench(CLI::App& app) {
     cmd->add_option("--scene", o->scene, "Scene for --workload castle and frame (frame: any scene file or gen:...)")->capture_default_str();
     cmd->add_option("--clusters", o->clusters,
                     "castle: split the occluders into clusters of at most N triangles (a multiple of 4, <= 512) and render those "
-                    "(OccluderClusters); 0 = the triangles as one input. frame: N > 0 draws the occluders as clusters (cull "
-                    "--clusters on, the default there), 0 every triangle (cull --clusters off)")
+                    "(OccluderClusters); 0 (castle's default) = the triangles as one input. frame: without it, clusters (cull's "
+                    "default); N > 0 draws the occluders as clusters (cull --clusters on), 0 every triangle (cull --clusters off)")
         ->capture_default_str()
         ->each([o](const std::string&) { o->clusters_given = true; });
     cmd->add_option("--views", o->views, "Camera path with the views for --workload castle and frame (default data/views/castle.json)");
