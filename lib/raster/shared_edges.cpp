@@ -31,6 +31,11 @@ std::uint32_t float_key(float f) {
     return u == 0x80000000u ? 0u : u;
 }
 
+// A table of its own rather than meshoptimizer's meshopt_generateVertexRemap (which the scene
+// layer uses to weld): the raster layer does not depend on meshoptimizer, whose allocations
+// would also have to be routed to the engine's memory hooks here (homcull_mesh_create runs this
+// inside them), and the remap compares bytes, so -0 and +0 would need a canonical copy first.
+//
 // Numbers for `count` positions (position(i, p) fills p and returns false when there is none):
 // equal positions one number, numbers from 0 in the order the positions first appear;
 // kNoNumber where there is no position or a coordinate is not finite (such triangles are not
