@@ -92,7 +92,11 @@ if [ "${#sources[@]}" -eq 0 ]; then
   exit 1
 fi
 simd_source=raster/rasterize_simd.cpp
-printf '%s\n' "${sources[@]}" | grep -qx "$simd_source" ||
+# Matched in bash, not with "printf ... | grep -q": under pipefail, grep -q leaving at the first
+# match kills printf (which writes line by line) with SIGPIPE now and then, and the check fails.
+listed=0
+for src in "${sources[@]}"; do [ "$src" = "$simd_source" ] && listed=1; done
+[ "$listed" -eq 1 ] ||
   { echo "check-neon: $simd_source is no longer a source of homcull_core; update this script" >&2; exit 1; }
 
 # --- Compile ------------------------------------------------------------------------------
@@ -101,7 +105,7 @@ flags=(-std=c++17 -O3 -DNDEBUG -fPIC -ffp-contract=off
        -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
        -isystem "$tmp/include" -Ilib/include -Ilib "$@")
 hwy_version=$(sed -n 's/^#define HWY_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' /usr/include/hwy/highway.h | paste -sd.)
-echo "check-neon: $("$cxx" --version | head -n 1), Highway headers $hwy_version"
+echo "check-neon: $("$cxx" --version | sed -n 1p), Highway headers $hwy_version"
 failed=()
 for src in "${sources[@]}"; do
   obj="$tmp/obj/${src//\//_}.o"
@@ -135,7 +139,7 @@ done
 [ "$status" -eq 0 ] || exit 1
 
 simd_obj="$tmp/obj/${simd_source//\//_}.o"
-neon_symbol=$("$nm" --defined-only "$simd_obj" | awk '$3 ~ /6N_NEON13RasterizeRows/ {print $3}' | head -n 1)
+neon_symbol=$("$nm" --defined-only "$simd_obj" | awk '!found && $3 ~ /6N_NEON13RasterizeRows/ {print $3; found = 1}')
 if [ -z "$neon_symbol" ]; then
   echo "check-neon: FAILED: no homcull::detail::N_NEON::RasterizeRows in lib/$simd_source's object" >&2
   exit 1

@@ -30,7 +30,7 @@ done
 echo
 echo "== frame 60 in detail"
 "$homcull" truth --scene "$out/city.glb" --path "$out/city_walk.json" --frame 60 --resolution 1280x720 --samples 2 \
-  | head -16
+  | sed -n 1,16p  # not head: under pipefail, head leaving early could kill homcull (SIGPIPE)
 
 echo
 echo "== occlusion culling along the walk: the scene culler's answers for every object"

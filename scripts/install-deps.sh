@@ -32,7 +32,8 @@ arm_packages=(qemu-user-static libhwy1:arm64 libmeshoptimizer2d:arm64)
 sudo_cmd=()
 if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
 
-installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
+# No "| grep -q" under pipefail: grep leaving at its first match can kill the writer (SIGPIPE).
+installed() { [ "$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" = "install ok installed" ]; }
 export DEBIAN_FRONTEND=noninteractive
 
 missing=()
@@ -52,7 +53,7 @@ for p in "${arm_packages[@]}"; do installed "$p" || arm_missing+=("$p"); done
 if [ ${#arm_missing[@]} -ne 0 ]; then
   echo "install-deps: installing ${arm_missing[*]} (optional: the Arm run-time check)" >&2
   added_arm64=0
-  if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+  if [[ " $(dpkg --print-foreign-architectures | paste -sd' ') " != *" arm64 "* ]]; then
     "${sudo_cmd[@]}" dpkg --add-architecture arm64
     added_arm64=1
   fi
