@@ -42,6 +42,23 @@ TEST(ImageModule, OpenImageIOComesWithTheModuleWhenAnImageIsWritten) {
     EXPECT_TRUE(mapped(after, "libOpenImageIO"));
 }
 
+TEST(ImageModule, AFailedLoadIsTriedAgainOnTheNextImage) {
+    if (mapped(mapped_files(), "homcull_oiio.so"))
+        GTEST_SKIP() << "the module is loaded already (another test of this process wrote an image; ctest runs each alone)";
+    const std::string dir = test::temp_dir("image_module_retry");
+    const char* before = std::getenv("HOMCULL_IMAGE_MODULE");
+    const std::string kept = before ? before : "";
+    ASSERT_EQ(setenv("HOMCULL_IMAGE_MODULE", (dir + "/no_such_module.so").c_str(), 1), 0);
+    EXPECT_THROW(write_rgb_image(dir + "/first.png", 2, 1, {255, 0, 0, 0, 0, 255}), Error);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/first.png"));
+    // The variable mended (here: unset, so that the usual places are searched), the next image
+    // is written.
+    if (before) ASSERT_EQ(setenv("HOMCULL_IMAGE_MODULE", kept.c_str(), 1), 0);
+    else ASSERT_EQ(unsetenv("HOMCULL_IMAGE_MODULE"), 0);
+    EXPECT_NO_THROW(write_rgb_image(dir + "/second.png", 2, 1, {255, 0, 0, 0, 0, 255}));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/second.png"));
+}
+
 int run(const std::string& command) {
     const int status = std::system(command.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;

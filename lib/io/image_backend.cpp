@@ -4,8 +4,10 @@
 
 #include <dlfcn.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
 #include <system_error>
 
 // Compiled in by lib/CMakeLists.txt: the module in this build tree, and the library folder
@@ -83,10 +85,19 @@ Loaded load() {
 }  // namespace
 
 const ImageBackend& image_backend() {
-    static const Loaded loaded = load();
-    if (!loaded.backend)
-        throw Error(std::string("homcull's image writer (") + kImageModuleName + ", OpenImageIO) could not be loaded" + loaded.tried);
-    return *loaded.backend;
+    // A module once loaded stays loaded and is returned at once. A failure is not kept: a
+    // program that then sets $HOMCULL_IMAGE_MODULE or installs the module can write images
+    // without restarting (each failed call looks again, one thread at a time).
+    static std::atomic<const ImageBackend*> loaded{nullptr};
+    if (const ImageBackend* backend = loaded.load(std::memory_order_acquire)) return *backend;
+    static std::mutex loading;
+    const std::lock_guard<std::mutex> lock(loading);
+    if (const ImageBackend* backend = loaded.load(std::memory_order_acquire)) return *backend;
+    const Loaded attempt = load();
+    if (!attempt.backend)
+        throw Error(std::string("homcull's image writer (") + kImageModuleName + ", OpenImageIO) could not be loaded" + attempt.tried);
+    loaded.store(attempt.backend, std::memory_order_release);
+    return *attempt.backend;
 }
 
 }  // namespace homcull::detail

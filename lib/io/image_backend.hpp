@@ -60,9 +60,10 @@ struct ImageBackend {
     void (*render_box)(const RgbCanvas& canvas, int x0, int y0, int x1, int y1, const float rgb[3], bool fill);
 };
 
-// The module's table, loaded on the first call (thread-safe). Throws homcull::Error naming
-// every place tried and why each failed when it cannot be loaded. Looks, in order, at
-// $HOMCULL_IMAGE_MODULE alone when it is set; else <the program's folder>/../<libdir>/homcull
+// The module's table, loaded on the first call that succeeds (thread-safe). Throws
+// homcull::Error naming every place tried and why each failed when it cannot be loaded; the next
+// call looks again. Looks, in order, at $HOMCULL_IMAGE_MODULE alone when it is set; else
+// <the program's folder>/../<libdir>/homcull
 // (an installed program), the library search path (the RUNPATH that homcull::io gives the
 // programs linking an installed package, LD_LIBRARY_PATH, ...), and the build tree's module.
 const ImageBackend& image_backend();
