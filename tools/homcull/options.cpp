@@ -15,8 +15,12 @@ namespace homcull::cli {
 
 const CLI::Validator kAtLeastZero(
     [](const std::string& text) {
-        double v = 0.0;
-        if (!CLI::detail::lexical_cast(text, v) || !(v >= 0.0)) return "must be a number at least 0 (inf allowed), got " + text;
+        // The whole text a number as CLI11 then reads it into a double (strtod's syntax: "inf"
+        // included), without CLI11's internal CLI::detail, which is no part of its interface.
+        char* end = nullptr;
+        const double v = text.empty() ? 0.0 : std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size() || !(v >= 0.0))
+            return "must be a number at least 0 (inf allowed), got " + text;
         return std::string();
     },
     "NUMBER >= 0");
