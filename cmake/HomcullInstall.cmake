@@ -47,11 +47,34 @@ install(FILES "${PROJECT_BINARY_DIR}/homcullConfig.cmake"
               "${PROJECT_BINARY_DIR}/homcullConfigVersion.cmake"
         DESTINATION ${HOMCULL_CMAKE_DIR})
 
-# homcull.pc: the C interface's shared library for pkg-config. Relocatable: the prefix is
-# found from the file's own place (${pcfiledir}), so an install with --prefix works as is.
+# homcull.pc: the C interface's shared library for pkg-config. With the usual relative folders
+# it is relocatable: the prefix is found from the file's own place (${pcfiledir}), so an install
+# with --prefix works as is. GNUInstallDirs also allows absolute folders
+# (-DCMAKE_INSTALL_LIBDIR=/opt/lib64): those are written as they are, and with an absolute
+# libdir the prefix (for a relative includedir) is the one installed to, written at install time.
 if(TARGET homcull_shared)
-  file(RELATIVE_PATH HOMCULL_PC_TO_PREFIX "/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/")
-  string(REGEX REPLACE "/$" "" HOMCULL_PC_TO_PREFIX "${HOMCULL_PC_TO_PREFIX}")
-  configure_file(cmake/homcull.pc.in "${PROJECT_BINARY_DIR}/homcull.pc" @ONLY)
+  foreach(dir IN ITEMS LIBDIR INCLUDEDIR)
+    if(IS_ABSOLUTE "${CMAKE_INSTALL_${dir}}")
+      set(HOMCULL_PC_${dir} "${CMAKE_INSTALL_${dir}}")
+    else()
+      set(HOMCULL_PC_${dir} "\${prefix}/${CMAKE_INSTALL_${dir}}")
+    endif()
+  endforeach()
+  if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+    # Bracket arguments: the values (a relative includedir is "${prefix}/include") are written
+    # into the install script as they are, not expanded when it runs.
+    install(CODE "
+      set(HOMCULL_PC_PREFIX \"\${CMAKE_INSTALL_PREFIX}\")
+      set(HOMCULL_PC_LIBDIR [==[${HOMCULL_PC_LIBDIR}]==])
+      set(HOMCULL_PC_INCLUDEDIR [==[${HOMCULL_PC_INCLUDEDIR}]==])
+      set(PROJECT_DESCRIPTION [==[${PROJECT_DESCRIPTION}]==])
+      set(PROJECT_VERSION [==[${PROJECT_VERSION}]==])
+      configure_file([==[${PROJECT_SOURCE_DIR}/cmake/homcull.pc.in]==] [==[${PROJECT_BINARY_DIR}/homcull.pc]==] @ONLY)")
+  else()
+    file(RELATIVE_PATH HOMCULL_PC_TO_PREFIX "/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/")
+    string(REGEX REPLACE "/$" "" HOMCULL_PC_TO_PREFIX "${HOMCULL_PC_TO_PREFIX}")
+    set(HOMCULL_PC_PREFIX "\${pcfiledir}/${HOMCULL_PC_TO_PREFIX}")
+    configure_file(cmake/homcull.pc.in "${PROJECT_BINARY_DIR}/homcull.pc" @ONLY)
+  endif()
   install(FILES "${PROJECT_BINARY_DIR}/homcull.pc" DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 endif()
