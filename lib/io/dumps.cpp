@@ -272,13 +272,7 @@ ColormapPng write_colormap_png(const DumpPart& part, const std::string& path) {
     } else {
         r.note = font.reason;
     }
-    detail::ImagePart image;
-    image.width = r.width;
-    image.height = r.height;
-    image.channels = 3;
-    image.pixels = pixels;
-    const std::string why = images.write(path, &image, 1, "png");
-    if (!why.empty()) throw Error(path + ": " + why);
+    detail::write_rgb_pixels(path, r.width, r.height, pixels, "png");
     return r;
 }
 

@@ -22,13 +22,7 @@ std::uint32_t id_color(std::uint32_t id) {
 void write_rgb_image(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
     if (width < 1 || height < 1 || rgb.size() != 3 * std::size_t(width) * std::size_t(height))
         throw Error(path + ": pixel buffer does not match the image size");
-    detail::ImagePart image;
-    image.width = width;
-    image.height = height;
-    image.channels = 3;
-    image.pixels = rgb.data();
-    const std::string why = detail::image_backend().write(path, &image, 1, "");
-    if (!why.empty()) throw Error(path + ": " + why);
+    detail::write_rgb_pixels(path, width, height, rgb.data(), "");
 }
 
 void write_id_image(const std::string& path, int width, int height, const std::vector<std::uint32_t>& ids) {

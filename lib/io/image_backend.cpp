@@ -100,4 +100,14 @@ const ImageBackend& image_backend() {
     return *attempt.backend;
 }
 
+void write_rgb_pixels(const std::string& path, int width, int height, const std::uint8_t* rgb, const char* format) {
+    ImagePart image;
+    image.width = width;
+    image.height = height;
+    image.channels = 3;
+    image.pixels = rgb;
+    const std::string why = image_backend().write(path, &image, 1, format);
+    if (!why.empty()) throw Error(path + ": " + why);
+}
+
 }  // namespace homcull::detail

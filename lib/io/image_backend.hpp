@@ -68,4 +68,9 @@ struct ImageBackend {
 // programs linking an installed package, LD_LIBRARY_PATH, ...), and the build tree's module.
 const ImageBackend& image_backend();
 
+// Writes one 8-bit RGB image of width x height pixels (rows top first) through the module, in
+// `format` (an OpenImageIO format name) or, given "", the one the file's extension names.
+// Throws homcull::Error naming the file and why when it cannot.
+void write_rgb_pixels(const std::string& path, int width, int height, const std::uint8_t* rgb, const char* format);
+
 }  // namespace homcull::detail
