@@ -125,6 +125,12 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         std::sort(by_vertices.begin() + first_vertex_begin[v], by_vertices.begin() + first_vertex_begin[v + 1]);
     detail::Vector<std::uint32_t> handed_out(triangle_count, 0);  // at a run's first entry: how many of the run are taken
 
+    // Positions: each meshlet's vertices, and up to one copy per shared edge of an apex from
+    // another cluster (reserved, so that the array is not copied at every doubling).
+    std::size_t cluster_vertices = 0;
+    for (const meshopt_Meshlet& m : meshlets) cluster_vertices += m.vertex_count;
+    for (std::size_t t = 0; t < triangle_count && shared_edges; ++t) cluster_vertices += std::size_t(__builtin_popcount(shared_edges[t] & 7u));
+    out.positions.reserve(3 * cluster_vertices);
     out.indices.reserve(index_count);
     out.shared_edges.reserve(triangle_count);
     out.source_triangles.reserve(triangle_count);

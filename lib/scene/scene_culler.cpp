@@ -382,6 +382,29 @@ void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
                                            count ? std::size_t(top - base) + 1 : 0, local.data(), count, own_shared_edges_.data() + first,
                                            local_apexes.data());
     });
+    // Room for every candidate's clusters at once: appended in growing vectors, the castle's
+    // copied their contents again at every doubling and wrote twice the pages. A cluster's
+    // vertex count can still grow by the copies of apexes in other objects: up to three a
+    // triangle, reserved too (address space; the pages of room left unused are never written).
+    std::size_t clusters = 0, triangles = 0, positions = 0, neighbour_flags = 0;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        clusters += parts[k].clusters.size();
+        triangles += parts[k].shared_edges.size();
+        positions += parts[k].positions.size();
+        for (std::size_t t = first_triangle_[k]; t < first_triangle_[k + 1]; ++t)
+            neighbour_flags += std::size_t(__builtin_popcount(occluders_.shared_edges[t] & 7u));
+    }
+    clusters_.clusters.reserve(clusters);
+    clusters_.positions.reserve(positions + 3 * neighbour_flags);
+    clusters_.indices.reserve(3 * triangles);
+    clusters_.shared_edges.reserve(triangles);
+    clusters_.edge_apexes.reserve(3 * triangles);
+    clusters_.source_triangles.reserve(triangles);
+    cluster_cross_shared_edges_.reserve(triangles);
+    cluster_cross_edge_apexes_.reserve(3 * triangles);
+    cluster_neighbours_.reserve(neighbour_flags);
+    cluster_neighbour_first_.reserve(clusters + 1);
+    cluster_first_.reserve(occluder_ids_.size() + 1);
     for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
         add_candidate_clusters(k, parts[k], vertex_candidate);
         parts[k] = {};  // freed once added: the parts together are a second copy of every candidate's clusters
