@@ -1,11 +1,15 @@
-// Import: glTF node order, hierarchy, shared meshes, extras, primitive modes; OBJ groups; PLY.
+// Import: glTF node order, hierarchy, shared meshes, extras, primitive modes; OBJ groups; PLY;
+// the objects' world bounds.
 #include "support.hpp"
 
 #include <homcull/io/scene_io.hpp>
+#include <homcull/scene.hpp>
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <random>
 #include <vector>
 
 namespace homcull {
@@ -136,6 +140,49 @@ TEST(SceneImport, PlyThroughAssimp) {
     ASSERT_EQ(scene.objects.size(), 1u);
     EXPECT_EQ(scene.triangle_count(scene.objects[0]), 2u);
     EXPECT_EQ(scene.objects[0].world_bounds.max, glm::vec3(1, 1, 0));
+}
+
+}  // namespace
+}  // namespace homcull
+
+namespace homcull {
+namespace {
+
+// Scene::finalize bounds an object from each vertex its indices name, once: the same floats as
+// extending the box at every index in turn, signed zeros and NaN included (glm::min and max keep
+// the first of equal values and never take a NaN, so repeats and the order of first naming are
+// all that could matter).
+TEST(SceneBounds, FromEachVertexOnceAreTheBoundsFromEveryIndex) {
+    std::mt19937 random(11);
+    const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, std::nanf(""), 3.0f, -2.5f};
+    for (int round = 0; round < 400; ++round) {
+        Scene scene;
+        Mesh mesh;
+        const int vertices = 1 + int(random() % 12);
+        for (int v = 0; v < vertices; ++v)
+            mesh.positions.emplace_back(values[random() % 8], values[random() % 8], values[random() % 8]);
+        const int triangles = 1 + int(random() % 10);
+        for (int i = 0; i < 3 * triangles; ++i) mesh.indices.push_back(std::uint32_t(random() % std::uint32_t(vertices)));
+        scene.meshes.push_back(mesh);
+        for (int o = 0; o < 3; ++o) {
+            Object object;
+            object.mesh = 0;
+            // Scales of either sign and zero (which makes -0 and +0 of the same vertex), and shifts.
+            for (int c = 0; c < 3; ++c) {
+                object.world[c][c] = double(values[random() % 8]);
+                if (object.world[c][c] != object.world[c][c]) object.world[c][c] = 0.0;
+                object.world[3][c] = double(values[random() % 8]);  // NaN: the whole object is not finite
+            }
+            scene.objects.push_back(object);
+        }
+        scene.finalize();
+        for (const Object& object : scene.objects) {
+            Aabb expected;
+            for (const std::uint32_t index : mesh.indices) expected.extend(transform_point(object.world, mesh.positions[index]));
+            ASSERT_EQ(std::memcmp(&expected.min, &object.world_bounds.min, sizeof(glm::vec3)), 0) << "round " << round;
+            ASSERT_EQ(std::memcmp(&expected.max, &object.world_bounds.max, sizeof(glm::vec3)), 0) << "round " << round;
+        }
+    }
 }
 
 }  // namespace

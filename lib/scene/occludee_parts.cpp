@@ -3,6 +3,7 @@
 #include "scene/occludee_parts.hpp"
 
 #include "common/run_tasks.hpp"
+#include "scene/world_point.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -117,7 +118,7 @@ void OccludeeParts::build(const Scene& scene, int max_parts, std::size_t triangl
         for (std::uint32_t p = 0; p < parts; ++p) {
             Aabb box;
             for (std::uint32_t i = split.vertex_begin[p]; i < split.vertex_begin[p + 1]; ++i) {
-                const glm::vec3 w = transform_point(object.world, mesh.positions[split.vertices[i]]);
+                const glm::vec3 w = world_point(object.world, mesh.positions[split.vertices[i]]);
                 if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z)) finite[id] = 0;
                 box.extend(w);
             }

@@ -2,9 +2,12 @@
 #include <homcull/scene.hpp>
 
 #include "common/float_round.hpp"  // float_down, float_up
+#include "scene/world_point.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace homcull {
 
@@ -32,10 +35,7 @@ Aabb Scene::bounds() const {
     return b;
 }
 
-glm::vec3 transform_point(const glm::dmat4& world, const glm::vec3& p) {
-    // glTF node transforms are affine; the fourth row is not used.
-    return glm::vec3(glm::dvec3(world * glm::dvec4(glm::dvec3(p), 1.0)));
-}
+glm::vec3 transform_point(const glm::dmat4& world, const glm::vec3& p) { return detail::world_point(world, p); }
 
 Scene translated_scene(const Scene& scene, const glm::dvec3& offset) {
     Scene moved = scene;
@@ -55,7 +55,7 @@ glm::dvec3 scene_anchor(const Scene& scene) {
 }
 
 glm::vec3 transform_point_from(const glm::dmat4& world, const glm::vec3& p, const glm::dvec3& anchor) {
-    return glm::vec3(glm::dvec3(world * glm::dvec4(glm::dvec3(p), 1.0)) - anchor);
+    return detail::world_point_from(world, p, anchor);
 }
 
 Aabb anchored_box(const Aabb& world_box, const glm::dvec3& anchor) {
@@ -112,17 +112,26 @@ void Scene::finalize() {
         object.name = valid_utf8(object.name);
         for (auto& [key, value] : object.extras) key = valid_utf8(key), value = valid_utf8(value);
     }
+    // Each mesh's vertices in the order its indices first name them, each once. An object's
+    // bounds from those are its bounds from every index (glm::min and glm::max keep the first
+    // of equal values, -0 and +0 alike, and never take a NaN), for a fraction of the transforms
+    // of a scene that places its meshes many times.
+    std::vector<std::vector<std::uint32_t>> named_vertices(meshes.size());
+    std::vector<std::uint8_t> named;
     for (std::size_t m = 0; m < meshes.size(); ++m) {
         const Mesh& mesh = meshes[m];
         if (mesh.indices.size() % 3 != 0)
             throw Error(source + ": mesh " + std::to_string(m) + " ('" + mesh.name +
                         "') has " + std::to_string(mesh.indices.size()) +
                         " indices, not a multiple of 3");
-        for (std::uint32_t index : mesh.indices)
+        named.assign(mesh.positions.size(), 0);
+        for (std::uint32_t index : mesh.indices) {
             if (index >= mesh.positions.size())
                 throw Error(source + ": mesh " + std::to_string(m) + " ('" + mesh.name +
                             "') uses vertex " + std::to_string(index) + " but has only " +
                             std::to_string(mesh.positions.size()) + " vertices");
+            if (!named[index]) named[index] = 1, named_vertices[m].push_back(index);
+        }
     }
     for (std::size_t i = 0; i < objects.size(); ++i) {
         Object& object = objects[i];
@@ -131,8 +140,8 @@ void Scene::finalize() {
                         "') names mesh " + std::to_string(object.mesh) + " but there are " +
                         std::to_string(meshes.size()));
         object.world_bounds = Aabb{};
-        for (std::uint32_t index : meshes[object.mesh].indices)
-            object.world_bounds.extend(transform_point(object.world, meshes[object.mesh].positions[index]));
+        for (std::uint32_t index : named_vertices[object.mesh])
+            object.world_bounds.extend(detail::world_point(object.world, meshes[object.mesh].positions[index]));
     }
 }
 

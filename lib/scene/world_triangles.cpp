@@ -3,6 +3,7 @@
 #include "common/float_mode.hpp"
 #include "common/run_tasks.hpp"
 #include "scene/coplanar_merge.hpp"
+#include "scene/world_point.hpp"
 
 #include <meshoptimizer.h>
 
@@ -23,7 +24,7 @@ TriangleInput WorldTriangles::input(const std::array<float, 16>& clip_from_world
 
 void write_world_positions(const Object& object, const Mesh& mesh, float* out, const glm::dvec3& anchor) {
     for (const glm::vec3& p : mesh.positions) {
-        const glm::vec3 w = transform_point_from(object.world, p, anchor);
+        const glm::vec3 w = detail::world_point_from(object.world, p, anchor);
         *out++ = w.x, *out++ = w.y, *out++ = w.z;
     }
 }
