@@ -8,6 +8,7 @@
 #include <meshoptimizer.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -68,33 +69,36 @@ void check_cluster_limits(const ClusterLimits& limits, const char* caller) {
         throw Error(std::string(caller) + ": max_triangles must be a multiple of 4 in [4, 512]");
 }
 
-OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
-                                         const std::uint32_t* indices, std::size_t triangle_count, const std::uint8_t* shared_edges,
-                                         const std::uint32_t* edge_apexes, const ClusterLimits& limits) {
+namespace {
+
+// plan_occluder_clusters, its errors naming `caller`.
+OccluderClusterPlan plan_clusters(const char* caller, const float* positions, std::size_t position_stride, std::size_t vertex_count,
+                                  const std::uint32_t* indices, std::size_t triangle_count, const ClusterLimits& limits) {
     const detail::StandardFloatMode mode;  // float_mode.hpp
-    const auto fail = [](const std::string& why) { throw Error("build_occluder_clusters: " + why); };
-    check_cluster_limits(limits);
-    OccluderClusters out;
-    if (triangle_count == 0) return out;
+    const auto fail = [&](const std::string& why) { throw Error(std::string(caller) + ": " + why); };
+    check_cluster_limits(limits, caller);
+    OccluderClusterPlan plan;
+    plan.vertex_count = vertex_count;
+    plan.triangle_count = triangle_count;
+    plan.vertex_begin.push_back(0);
+    plan.triangle_begin.push_back(0);
+    if (triangle_count == 0) return plan;
     if (!positions || !indices) fail("positions or indices missing");
     if (position_stride < 3 * sizeof(float)) fail("position stride smaller than one position (12 bytes)");
-    if (shared_edges && !edge_apexes) fail("shared_edges without edge_apexes (compute_shared_edges writes both)");
     for (std::size_t i = 0; i < 3 * triangle_count; ++i)
         if (indices[i] >= vertex_count)
             fail("index " + std::to_string(indices[i]) + " of triangle " + std::to_string(i / 3) + " is not below vertex_count " +
                  std::to_string(vertex_count));
 
-    // meshopt_buildMeshlets reads packed x, y, z (it takes a stride, but this keeps the
-    // positions it sees and the ones copied below the same by construction).
-    detail::Vector<float> packed(3 * vertex_count);
-    for (std::size_t v = 0; v < vertex_count; ++v)
-        std::memcpy(&packed[3 * v], reinterpret_cast<const unsigned char*>(positions) + v * position_stride, 3 * sizeof(float));
-
-    // meshoptimizer sorts positions spatially: it sees non-finite ones as the origin (the
-    // clusters keep them as they are, and their boxes say so).
-    detail::Vector<float> finite(packed);
-    for (float& x : finite)
-        if (!std::isfinite(x)) x = 0.0f;
+    // meshopt_buildMeshlets reads packed x, y, z. meshoptimizer sorts positions spatially: it
+    // sees non-finite ones as the origin (the clusters keep them as they are, and their boxes
+    // say so).
+    detail::Vector<float> finite(3 * vertex_count);
+    for (std::size_t v = 0; v < vertex_count; ++v) {
+        std::memcpy(&finite[3 * v], reinterpret_cast<const unsigned char*>(positions) + v * position_stride, 3 * sizeof(float));
+        for (std::size_t k = 0; k < 3; ++k)
+            if (!std::isfinite(finite[3 * v + k])) finite[3 * v + k] = 0.0f;
+    }
 
     const std::size_t index_count = 3 * triangle_count;
     detail::Vector<meshopt_Meshlet> meshlets(meshopt_buildMeshletsBound(index_count, limits.max_vertices, limits.max_triangles));
@@ -125,71 +129,19 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
         std::sort(by_vertices.begin() + first_vertex_begin[v], by_vertices.begin() + first_vertex_begin[v + 1]);
     detail::Vector<std::uint32_t> handed_out(triangle_count, 0);  // at a run's first entry: how many of the run are taken
 
-    // Positions: each meshlet's vertices, and up to one copy per shared edge of an apex from
-    // another cluster (reserved, so that the array is not copied at every doubling).
     std::size_t cluster_vertices = 0;
     for (const meshopt_Meshlet& m : meshlets) cluster_vertices += m.vertex_count;
-    for (std::size_t t = 0; t < triangle_count && shared_edges; ++t) cluster_vertices += std::size_t(__builtin_popcount(shared_edges[t] & 7u));
-    out.positions.reserve(3 * cluster_vertices);
-    out.indices.reserve(index_count);
-    out.shared_edges.reserve(triangle_count);
-    out.source_triangles.reserve(triangle_count);
-    out.clusters.reserve(meshlets.size());
-    out.edge_apexes.reserve(index_count);
-    // Each input vertex's number in the cluster being appended (kNotInCluster: none; reset after
-    // each cluster), to find an apex among the cluster's vertices at once.
-    constexpr std::uint32_t kNotInCluster = 0xFFFFFFFFu;
-    detail::Vector<std::uint32_t> local_of(vertex_count, kNotInCluster);
-    // Appends a cluster of the given input vertices and triangles (vertex numbers local to it;
-    // `originals` the input triangles, for their flags), then the apexes its flags need.
-    const auto append = [&](detail::Vector<std::uint32_t>& vertices, const detail::Vector<std::uint8_t>& local,
-                            const detail::Vector<std::uint32_t>& originals) {
-        OccluderCluster c;
-        c.first_vertex = std::uint32_t(out.positions.size() / 3);
-        c.vertex_count = std::uint32_t(vertices.size());
-        c.first_triangle = std::uint32_t(out.shared_edges.size());
-        c.triangle_count = std::uint32_t(originals.size());
-        c.bounded = true;
-        for (std::size_t i = 0; i < vertices.size(); ++i) local_of[vertices[i]] = std::uint32_t(i);
-        for (const std::uint32_t v : vertices) {
-            const float* p = &packed[3 * std::size_t(v)];
-            out.positions.insert(out.positions.end(), p, p + 3);
-            c.bounded = c.bounded && std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
-            c.bounds.extend(glm::vec3(p[0], p[1], p[2]));
-        }
-        out.indices.insert(out.indices.end(), local.begin(), local.end());
-        for (const std::uint32_t t : originals) {
-            const std::uint8_t flags = shared_edges ? shared_edges[t] : 0;
-            out.shared_edges.push_back(flags);
-            for (int k = 0; k < 3; ++k) {
-                const std::uint32_t apex = (flags >> k) & 1u ? edge_apexes[3 * std::size_t(t) + std::size_t(k)] : kNoApex;
-                if (apex >= vertex_count) {  // none, or out of range: the render drops the flag
-                    out.edge_apexes.push_back(kNoApex);
-                    continue;
-                }
-                // The cluster's copy of the apex: one of its vertices, or a copy appended after them.
-                if (local_of[apex] != kNotInCluster) {
-                    out.edge_apexes.push_back(local_of[apex]);
-                    continue;
-                }
-                out.edge_apexes.push_back(local_of[apex] = std::uint32_t(vertices.size()));
-                vertices.push_back(apex);
-                const float* p = &packed[3 * std::size_t(apex)];
-                out.positions.insert(out.positions.end(), p, p + 3);
-            }
-        }
-        c.vertex_count = std::uint32_t(vertices.size());
-        for (const std::uint32_t v : vertices) local_of[v] = kNotInCluster;
-        out.source_triangles.insert(out.source_triangles.end(), originals.begin(), originals.end());
-        out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
-        out.clusters.push_back(c);
-    };
-    detail::Vector<std::uint32_t> vertices, originals;
-    detail::Vector<std::uint8_t> local;
+    plan.vertices.reserve(cluster_vertices);
+    plan.vertex_begin.reserve(meshlets.size() + 1);
+    plan.local_indices.reserve(index_count);
+    plan.source_triangles.reserve(triangle_count);
+    plan.triangle_begin.reserve(meshlets.size() + 1);
     for (const meshopt_Meshlet& m : meshlets) {
-        vertices.assign(meshlet_vertices.begin() + m.vertex_offset, meshlet_vertices.begin() + m.vertex_offset + m.vertex_count);
-        local.assign(meshlet_triangles.begin() + m.triangle_offset, meshlet_triangles.begin() + m.triangle_offset + 3 * m.triangle_count);
-        originals.clear();
+        const unsigned int* vertices = meshlet_vertices.data() + m.vertex_offset;
+        const unsigned char* local = meshlet_triangles.data() + m.triangle_offset;
+        plan.vertices.insert(plan.vertices.end(), vertices, vertices + m.vertex_count);
+        plan.vertex_begin.push_back(std::uint32_t(plan.vertices.size()));
+        plan.local_indices.insert(plan.local_indices.end(), local, local + 3 * m.triangle_count);
         for (unsigned t = 0; t < m.triangle_count; ++t) {
             const NumberedTriangle key{{vertices[local[3 * t]], vertices[local[3 * t + 1]], vertices[local[3 * t + 2]]}, 0};
             const auto bucket_end = by_vertices.begin() + first_vertex_begin[key.v[0] + 1];
@@ -199,13 +151,114 @@ OccluderClusters build_occluder_clusters(const float* positions, std::size_t pos
             if (run == end || next >= end || !by_vertices[next].same_vertices(key))
                 fail("meshoptimizer changed a triangle (internal error)");
             ++handed_out[run];
-            originals.push_back(by_vertices[next].number);
+            plan.source_triangles.push_back(by_vertices[next].number);
         }
-        append(vertices, local, originals);
+        plan.triangle_begin.push_back(std::uint32_t(plan.source_triangles.size()));
     }
-    if (out.shared_edges.size() != triangle_count)
-        fail("meshoptimizer left out " + std::to_string(triangle_count - out.shared_edges.size()) + " triangles (internal error)");
+    if (plan.source_triangles.size() != triangle_count)
+        fail("meshoptimizer left out " + std::to_string(triangle_count - plan.source_triangles.size()) + " triangles (internal error)");
+    return plan;
+}
+
+}  // namespace
+
+OccluderClusterPlan plan_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
+                                           const std::uint32_t* indices, std::size_t triangle_count, const ClusterLimits& limits) {
+    return plan_clusters("plan_occluder_clusters", positions, position_stride, vertex_count, indices, triangle_count, limits);
+}
+
+OccluderClusters build_occluder_clusters(const OccluderClusterPlan& plan, const float* positions, std::size_t position_stride,
+                                         const std::uint8_t* shared_edges, const std::uint32_t* edge_apexes) {
+    const detail::StandardFloatMode mode;  // float_mode.hpp
+    const auto fail = [](const std::string& why) { throw Error("build_occluder_clusters: " + why); };
+    OccluderClusters out;
+    if (plan.triangle_count == 0) return out;
+    if (!positions) fail("positions missing");
+    if (position_stride < 3 * sizeof(float)) fail("position stride smaller than one position (12 bytes)");
+    if (shared_edges && !edge_apexes) fail("shared_edges without edge_apexes (compute_shared_edges writes both)");
+    const std::size_t vertex_count = plan.vertex_count, clusters = plan.vertex_begin.size() - 1;
+    const auto position = [&](std::uint32_t v) {  // copied: a stride need not keep floats aligned
+        std::array<float, 3> p;
+        std::memcpy(p.data(), reinterpret_cast<const unsigned char*>(positions) + std::size_t(v) * position_stride, sizeof p);
+        return p;
+    };
+
+    // Positions: each cluster's vertices, and up to one copy per shared edge of an apex from
+    // another cluster (reserved, so that the array is not copied at every doubling).
+    std::size_t cluster_vertices = plan.vertices.size();
+    for (std::size_t t = 0; t < plan.triangle_count && shared_edges; ++t) cluster_vertices += std::size_t(__builtin_popcount(shared_edges[t] & 7u));
+    out.positions.reserve(3 * cluster_vertices);
+    out.indices.reserve(3 * plan.triangle_count);
+    out.shared_edges.reserve(plan.triangle_count);
+    out.source_triangles.reserve(plan.triangle_count);
+    out.clusters.reserve(clusters);
+    out.edge_apexes.reserve(3 * plan.triangle_count);
+    // Each input vertex's number in the cluster being appended (kNotInCluster: none; reset after
+    // each cluster), to find an apex among the cluster's vertices at once.
+    constexpr std::uint32_t kNotInCluster = 0xFFFFFFFFu;
+    detail::Vector<std::uint32_t> local_of(vertex_count, kNotInCluster);
+    detail::Vector<std::uint32_t> vertices;  // the cluster's input vertices, then its apex copies
+    for (std::size_t cluster = 0; cluster < clusters; ++cluster) {
+        vertices.assign(plan.vertices.begin() + plan.vertex_begin[cluster], plan.vertices.begin() + plan.vertex_begin[cluster + 1]);
+        const std::uint32_t first_triangle = plan.triangle_begin[cluster], end_triangle = plan.triangle_begin[cluster + 1];
+        OccluderCluster c;
+        c.first_vertex = std::uint32_t(out.positions.size() / 3);
+        c.first_triangle = std::uint32_t(out.shared_edges.size());
+        c.triangle_count = end_triangle - first_triangle;
+        c.bounded = true;
+        for (std::size_t i = 0; i < vertices.size(); ++i) local_of[vertices[i]] = std::uint32_t(i);
+        for (const std::uint32_t v : vertices) {
+            const std::array<float, 3> p = position(v);
+            out.positions.insert(out.positions.end(), p.begin(), p.end());
+            c.bounded = c.bounded && std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+            c.bounds.extend(glm::vec3(p[0], p[1], p[2]));
+        }
+        out.indices.insert(out.indices.end(), plan.local_indices.begin() + 3 * std::ptrdiff_t(first_triangle),
+                           plan.local_indices.begin() + 3 * std::ptrdiff_t(end_triangle));
+        // The triangles' flags, then the apexes they need: one of the cluster's vertices, or a
+        // copy appended after them.
+        for (std::uint32_t i = first_triangle; i < end_triangle; ++i) {
+            const std::uint32_t t = plan.source_triangles[i];
+            const std::uint8_t flags = shared_edges ? shared_edges[t] : 0;
+            out.shared_edges.push_back(flags);
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t apex = (flags >> k) & 1u ? edge_apexes[3 * std::size_t(t) + std::size_t(k)] : kNoApex;
+                if (apex >= vertex_count) {  // none, or out of range: the render drops the flag
+                    out.edge_apexes.push_back(kNoApex);
+                    continue;
+                }
+                if (local_of[apex] != kNotInCluster) {
+                    out.edge_apexes.push_back(local_of[apex]);
+                    continue;
+                }
+                out.edge_apexes.push_back(local_of[apex] = std::uint32_t(vertices.size()));
+                vertices.push_back(apex);
+                const std::array<float, 3> p = position(apex);
+                out.positions.insert(out.positions.end(), p.begin(), p.end());
+            }
+        }
+        c.vertex_count = std::uint32_t(vertices.size());
+        for (const std::uint32_t v : vertices) local_of[v] = kNotInCluster;
+        out.source_triangles.insert(out.source_triangles.end(), plan.source_triangles.begin() + first_triangle,
+                                    plan.source_triangles.begin() + end_triangle);
+        out.max_cluster_vertices = std::max(out.max_cluster_vertices, c.vertex_count);
+        out.clusters.push_back(c);
+    }
     return out;
+}
+
+OccluderClusters build_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
+                                         const std::uint32_t* indices, std::size_t triangle_count, const std::uint8_t* shared_edges,
+                                         const std::uint32_t* edge_apexes, const ClusterLimits& limits) {
+    // The checks in the order they always ran: the limits, then the mesh, then the flags.
+    check_cluster_limits(limits);
+    if (triangle_count == 0) return {};
+    if (!positions || !indices) throw Error("build_occluder_clusters: positions or indices missing");
+    if (position_stride < 3 * sizeof(float)) throw Error("build_occluder_clusters: position stride smaller than one position (12 bytes)");
+    if (shared_edges && !edge_apexes) throw Error("build_occluder_clusters: shared_edges without edge_apexes (compute_shared_edges writes both)");
+    const OccluderClusterPlan plan =
+        plan_clusters("build_occluder_clusters", positions, position_stride, vertex_count, indices, triangle_count, limits);
+    return build_occluder_clusters(plan, positions, position_stride, shared_edges, edge_apexes);
 }
 
 }  // namespace homcull

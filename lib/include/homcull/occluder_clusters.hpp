@@ -53,6 +53,33 @@ struct ClusterLimits {
 // (build_occluder_clusters' own check, for callers that want it before loading a mesh).
 void check_cluster_limits(const ClusterLimits& limits, const char* caller = "build_occluder_clusters");
 
+// How a mesh splits into clusters, apart from where its vertices are: each cluster's input
+// vertices and input triangles, in order. plan_occluder_clusters makes it (meshoptimizer's
+// meshlets: most of the work of a build); build_occluder_clusters(plan, ...) makes the clusters
+// from it and any positions of the mesh's vertices, so that a mesh placed many times is split
+// once. Its arrays come from the memory hooks current where it was made.
+struct OccluderClusterPlan {
+    std::size_t vertex_count = 0, triangle_count = 0;  // of the mesh planned
+    detail::Vector<std::uint32_t> vertices;            // each cluster's input vertices, cluster by cluster
+    detail::Vector<std::uint32_t> vertex_begin;        // cluster c's are [vertex_begin[c], vertex_begin[c + 1])
+    detail::Vector<std::uint8_t> local_indices;        // 3 per cluster triangle, into its cluster's vertices
+    detail::Vector<std::uint32_t> source_triangles;    // per cluster triangle, its input triangle
+    detail::Vector<std::uint32_t> triangle_begin;      // cluster c's are [triangle_begin[c], triangle_begin[c + 1])
+};
+
+// The plan of build_occluder_clusters(positions, ...) below; the same checks and errors (the
+// shared edges are not needed yet).
+OccluderClusterPlan plan_occluder_clusters(const float* positions, std::size_t position_stride, std::size_t vertex_count,
+                                           const std::uint32_t* indices, std::size_t triangle_count, const ClusterLimits& limits = {});
+
+// The clusters of a plan, with these positions of the planned mesh's vertex_count vertices and
+// these shared-edge bits and apexes of its triangles (as below). A plan made from the same
+// positions gives build_occluder_clusters(positions, ...)'s clusters, bit for bit; other
+// positions keep the plan's clusters (whose boxes are then these positions'). Throws
+// homcull::Error on a stride smaller than a position, or flags without apexes.
+OccluderClusters build_occluder_clusters(const OccluderClusterPlan& plan, const float* positions, std::size_t position_stride,
+                                         const std::uint8_t* shared_edges, const std::uint32_t* edge_apexes);
+
 // Splits an indexed triangle mesh (x, y, z floats every position_stride bytes; 32-bit indices)
 // into clusters. Each triangle keeps its vertices in order and its shared-edge bits and their
 // apexes (compute_shared_edges'; both null: none shared); triangles and vertices are reordered
