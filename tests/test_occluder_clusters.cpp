@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <tuple>
@@ -131,6 +132,87 @@ TEST(OccluderClusters, RepeatedTrianglesAreEachKeptOnce) {
     EXPECT_EQ(sources, (std::vector<std::uint32_t>{0, 1, 2, 3, 4}));
     for (std::size_t t = 0; t < clusters.source_triangles.size(); ++t)
         EXPECT_EQ(clusters.shared_edges[t], flags[clusters.source_triangles[t]]);
+}
+
+// A plan (plan_occluder_clusters) then the clusters from it are the one-step build, bit for
+// bit; the same plan with a placement's positions (a mesh placed elsewhere, turned, with other
+// shared edges) gives the plan's clusters at those positions, each with that placement's flags
+// and apexes and its own box.
+TEST(OccluderClusters, APlanGivesTheBuildsClustersAndServesAnyPlacement) {
+    Scene scene;
+    for (int k = 0; k < 12; ++k)
+        test::add_box(scene, "box", glm::vec3(float(k % 4) * 3.0f, 0.0f, float(k / 4) * -3.0f),
+                      glm::vec3(float(k % 4) * 3.0f + 2.0f, 1.0f + float(k % 3), float(k / 4) * -3.0f + 2.0f));
+    scene.finalize();
+    const WorldTriangles world = gather_world_triangles(scene, objects_with_role(scene, ""));
+    const std::size_t vertices = world.positions.size() / 3, triangles = world.triangle_count();
+    const ClusterLimits limits{16, 8};
+    const OccluderClusterPlan plan = plan_occluder_clusters(world.positions.data(), 12, vertices, world.indices.data(), triangles, limits);
+    EXPECT_EQ(plan.vertex_count, vertices);
+    EXPECT_EQ(plan.triangle_count, triangles);
+    const OccluderClusters direct = build_occluder_clusters(world.positions.data(), 12, vertices, world.indices.data(), triangles,
+                                                            world.shared_edges.data(), world.edge_apexes.data(), limits);
+    const OccluderClusters planned = build_occluder_clusters(plan, world.positions.data(), 12, world.shared_edges.data(), world.edge_apexes.data());
+    ASSERT_GT(direct.clusters.size(), 1u);
+    const auto same_bits = [](const auto& a, const auto& b) {
+        return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+    };
+    EXPECT_TRUE(same_bits(direct.positions, planned.positions));
+    EXPECT_TRUE(same_bits(direct.indices, planned.indices));
+    EXPECT_TRUE(same_bits(direct.shared_edges, planned.shared_edges));
+    EXPECT_TRUE(same_bits(direct.edge_apexes, planned.edge_apexes));
+    EXPECT_TRUE(same_bits(direct.source_triangles, planned.source_triangles));
+    ASSERT_EQ(direct.clusters.size(), planned.clusters.size());
+    for (std::size_t c = 0; c < direct.clusters.size(); ++c) {
+        EXPECT_EQ(direct.clusters[c].first_vertex, planned.clusters[c].first_vertex);
+        EXPECT_EQ(direct.clusters[c].vertex_count, planned.clusters[c].vertex_count);
+        EXPECT_EQ(direct.clusters[c].triangle_count, planned.clusters[c].triangle_count);
+        EXPECT_EQ(std::memcmp(&direct.clusters[c].bounds, &planned.clusters[c].bounds, sizeof(Aabb)), 0);
+    }
+    EXPECT_EQ(direct.max_cluster_vertices, planned.max_cluster_vertices);
+
+    // Another placement: positions turned a quarter about y and moved, in a wider stride, and
+    // only every other triangle's flags kept.
+    std::vector<float> moved(4 * vertices);
+    for (std::size_t v = 0; v < vertices; ++v) {
+        const float* p = &world.positions[3 * v];
+        moved[4 * v] = p[2] + 100.0f, moved[4 * v + 1] = p[1] - 7.0f, moved[4 * v + 2] = -p[0], moved[4 * v + 3] = 1.0f;
+    }
+    std::vector<std::uint8_t> flags(world.shared_edges.begin(), world.shared_edges.end());
+    for (std::size_t t = 1; t < triangles; t += 2) flags[t] = 0;
+    const OccluderClusters placed = build_occluder_clusters(plan, moved.data(), 16, flags.data(), world.edge_apexes.data());
+    ASSERT_EQ(placed.clusters.size(), direct.clusters.size());
+    EXPECT_TRUE(same_bits(direct.source_triangles, placed.source_triangles));  // the plan's triangles, in its order
+    EXPECT_TRUE(same_bits(direct.indices, placed.indices));
+    for (const OccluderCluster& c : placed.clusters) {
+        Aabb box;
+        for (std::uint32_t t = c.first_triangle; t < c.first_triangle + c.triangle_count; ++t) {
+            const std::uint32_t source = placed.source_triangles[t];
+            EXPECT_EQ(placed.shared_edges[t], flags[source]);
+            for (int k = 0; k < 3; ++k) {
+                // Each corner is the placement's position of the source triangle's vertex.
+                const float* at = &placed.positions[3 * (std::size_t(c.first_vertex) + placed.indices[3 * t + std::size_t(k)])];
+                const float* expected = &moved[4 * std::size_t(world.indices[3 * source + std::size_t(k)])];
+                EXPECT_TRUE(std::equal(at, at + 3, expected));
+                box.extend(glm::vec3(at[0], at[1], at[2]));
+                if (!((flags[source] >> k) & 1u)) continue;
+                const float* apex = &placed.positions[3 * (std::size_t(c.first_vertex) + placed.edge_apexes[3 * t + std::size_t(k)])];
+                const float* apex_expected = &moved[4 * std::size_t(world.edge_apexes[3 * source + std::size_t(k)])];
+                EXPECT_TRUE(std::equal(apex, apex + 3, apex_expected));
+            }
+        }
+        EXPECT_EQ(std::memcmp(&box, &c.bounds, sizeof(Aabb)), 0);
+    }
+    // A plan's own checks, named after it.
+    try {
+        plan_occluder_clusters(world.positions.data(), 12, 3, world.indices.data(), triangles, limits);
+        ADD_FAILURE() << "an index out of range was planned";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("plan_occluder_clusters: index"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(build_occluder_clusters(plan, world.positions.data(), 8, nullptr, nullptr), Error);
+    EXPECT_THROW(build_occluder_clusters(plan, world.positions.data(), 12, flags.data(), nullptr), Error);
+    EXPECT_TRUE(build_occluder_clusters(OccluderClusterPlan{}, nullptr, 12, nullptr, nullptr).clusters.empty());
 }
 
 TEST(OccluderClusters, BadInputIsAnErrorOrADefinedResult) {

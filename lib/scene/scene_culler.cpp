@@ -365,23 +365,60 @@ void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
     cluster_first_.assign(1, 0);
     cluster_neighbour_first_.assign(1, 0);
     const std::vector<std::uint32_t> vertex_candidate = vertex_candidates();
-    // Each candidate's clusters in a task of its own, then added in the candidates' order.
-    std::vector<OccluderClusters> parts(occluder_ids_.size());
-    for_each_index(parallel, occluder_ids_.size(), 2, [&](std::size_t k) {
+    // Each candidate's triangles relative to its first vertex: each object's vertices are
+    // together in occluders_.positions, and a build sees only those (meshoptimizer's work grows
+    // with the vertices it is given).
+    const std::size_t candidates = occluder_ids_.size();
+    struct LocalMesh {
+        std::uint32_t base = 0;
+        std::size_t vertices = 0;
+        std::vector<std::uint32_t> indices;
+    };
+    std::vector<LocalMesh> local(candidates);
+    for_each_index(parallel, candidates, 8, [&](std::size_t k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
-        // Each object's vertices are together in occluders_.positions: the build sees only
-        // those (meshoptimizer's work grows with the vertices it is given).
         const auto begin = occluders_.indices.begin() + std::ptrdiff_t(3 * first), end = begin + std::ptrdiff_t(3 * count);
-        const std::uint32_t base = count ? *std::min_element(begin, end) : 0, top = count ? *std::max_element(begin, end) : 0;
-        std::vector<std::uint32_t> local(begin, end);  // the candidate's indices and apexes, relative to its first vertex
-        for (std::uint32_t& v : local) v -= base;
+        LocalMesh& m = local[k];
+        m.base = count ? *std::min_element(begin, end) : 0;
+        m.vertices = count ? std::size_t(*std::max_element(begin, end) - m.base) + 1 : 0;
+        m.indices.assign(begin, end);
+        for (std::uint32_t& v : m.indices) v -= m.base;
+    });
+    // Candidates that place the same mesh with the same triangles share one plan (which
+    // triangles and vertices each cluster takes: meshoptimizer's meshlets, most of the build),
+    // made from the first of them; each then gets its clusters from its own positions and flags.
+    // The castle's 115 role occluders place 16 meshes. (A merge of coplanar triangles can give
+    // two placements different triangles: then each has its own plan.)
+    std::vector<std::uint32_t> plan_of(candidates);
+    {
+        std::vector<std::vector<std::uint32_t>> planned_of_mesh(scene_->meshes.size());
+        for (std::size_t k = 0; k < candidates; ++k) {
+            std::vector<std::uint32_t>& planned = planned_of_mesh[scene_->objects[occluder_ids_[k]].mesh];
+            const auto same = std::find_if(planned.begin(), planned.end(), [&](std::uint32_t r) {
+                return local[r].vertices == local[k].vertices && local[r].indices == local[k].indices;
+            });
+            plan_of[k] = same != planned.end() ? *same : std::uint32_t(k);
+            if (same == planned.end()) planned.push_back(std::uint32_t(k));
+        }
+    }
+    const auto positions_of = [&](std::size_t k) { return occluders_.positions.data() + 3 * std::size_t(local[k].base); };
+    std::vector<OccluderClusterPlan> plans(candidates);
+    for_each_index(parallel, candidates, 2, [&](std::size_t k) {
+        if (plan_of[k] == k)
+            plans[k] = plan_occluder_clusters(positions_of(k), 3 * sizeof(float), local[k].vertices, local[k].indices.data(),
+                                              local[k].indices.size() / 3);
+    });
+    // Each candidate's clusters in a task of its own, then added in the candidates' order.
+    std::vector<OccluderClusters> parts(candidates);
+    for_each_index(parallel, candidates, 4, [&](std::size_t k) {
+        const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
         std::vector<std::uint32_t> local_apexes(own_edge_apexes_.begin() + std::ptrdiff_t(3 * first),
                                                 own_edge_apexes_.begin() + std::ptrdiff_t(3 * (first + count)));
-        for (std::uint32_t& v : local_apexes) v = v == kNoApex ? kNoApex : v - base;
-        parts[k] = build_occluder_clusters(occluders_.positions.data() + 3 * std::size_t(base), 3 * sizeof(float),
-                                           count ? std::size_t(top - base) + 1 : 0, local.data(), count, own_shared_edges_.data() + first,
+        for (std::uint32_t& v : local_apexes) v = v == kNoApex ? kNoApex : v - local[k].base;
+        parts[k] = build_occluder_clusters(plans[plan_of[k]], positions_of(k), 3 * sizeof(float), own_shared_edges_.data() + first,
                                            local_apexes.data());
     });
+    local = {}, plans = {};
     // Room for every candidate's clusters at once: appended in growing vectors, the castle's
     // copied their contents again at every doubling and wrote twice the pages. A cluster's
     // vertex count can still grow by the copies of apexes in other objects: up to three a
