@@ -61,13 +61,19 @@ TriangleRecord record(const float* p0, const float* p1, const float* p2, std::ui
     return {p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], p2[0], p2[1], p2[2], float(flags)};
 }
 
-TEST(OccluderClusters, KeepEveryTriangleWithItsVerticesAndFlags) {
+// The world triangles of `count` boxes of three heights in rows of `row`, 3 apart, their shared
+// edges found.
+WorldTriangles box_grid(int count, int row) {
     Scene scene;
-    for (int k = 0; k < 40; ++k)
-        test::add_box(scene, "box", glm::vec3(float(k % 8) * 3.0f, 0.0f, float(k / 8) * -3.0f),
-                      glm::vec3(float(k % 8) * 3.0f + 2.0f, 1.0f + float(k % 3), float(k / 8) * -3.0f + 2.0f));
+    for (int k = 0; k < count; ++k)
+        test::add_box(scene, "box", glm::vec3(float(k % row) * 3.0f, 0.0f, float(k / row) * -3.0f),
+                      glm::vec3(float(k % row) * 3.0f + 2.0f, 1.0f + float(k % 3), float(k / row) * -3.0f + 2.0f));
     scene.finalize();
-    const WorldTriangles world = gather_world_triangles(scene, objects_with_role(scene, ""));
+    return gather_world_triangles(scene, objects_with_role(scene, ""));
+}
+
+TEST(OccluderClusters, KeepEveryTriangleWithItsVerticesAndFlags) {
+    const WorldTriangles world = box_grid(40, 8);
     ASSERT_EQ(world.triangle_count(), 480u);
     for (const std::size_t max_triangles : {std::size_t(4), std::size_t(64), std::size_t(512)}) {
         ClusterLimits limits;
@@ -139,12 +145,7 @@ TEST(OccluderClusters, RepeatedTrianglesAreEachKeptOnce) {
 // shared edges) gives the plan's clusters at those positions, each with that placement's flags
 // and apexes and its own box.
 TEST(OccluderClusters, APlanGivesTheBuildsClustersAndServesAnyPlacement) {
-    Scene scene;
-    for (int k = 0; k < 12; ++k)
-        test::add_box(scene, "box", glm::vec3(float(k % 4) * 3.0f, 0.0f, float(k / 4) * -3.0f),
-                      glm::vec3(float(k % 4) * 3.0f + 2.0f, 1.0f + float(k % 3), float(k / 4) * -3.0f + 2.0f));
-    scene.finalize();
-    const WorldTriangles world = gather_world_triangles(scene, objects_with_role(scene, ""));
+    const WorldTriangles world = box_grid(12, 4);
     const std::size_t vertices = world.positions.size() / 3, triangles = world.triangle_count();
     const ClusterLimits limits{16, 8};
     const OccluderClusterPlan plan = plan_occluder_clusters(world.positions.data(), 12, vertices, world.indices.data(), triangles, limits);
