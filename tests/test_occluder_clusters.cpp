@@ -214,6 +214,16 @@ TEST(OccluderClusters, APlanGivesTheBuildsClustersAndServesAnyPlacement) {
     EXPECT_THROW(build_occluder_clusters(plan, world.positions.data(), 8, nullptr, nullptr), Error);
     EXPECT_THROW(build_occluder_clusters(plan, world.positions.data(), 12, flags.data(), nullptr), Error);
     EXPECT_TRUE(build_occluder_clusters(OccluderClusterPlan{}, nullptr, 12, nullptr, nullptr).clusters.empty());
+    // A plan filled by hand that does not hold together is refused, whatever is wrong with it.
+    for (int broken = 0; broken < 5; ++broken) {
+        OccluderClusterPlan bad = plan;
+        if (broken == 0) bad.vertex_begin.pop_back();
+        if (broken == 1) bad.vertices[3] = std::uint32_t(vertices);
+        if (broken == 2) bad.source_triangles[5] = std::uint32_t(triangles);
+        if (broken == 3) bad.local_indices[7] = 200;
+        if (broken == 4) bad.triangle_count += 1;
+        EXPECT_THROW(build_occluder_clusters(bad, world.positions.data(), 12, nullptr, nullptr), Error) << "broken plan " << broken;
+    }
 }
 
 TEST(OccluderClusters, BadInputIsAnErrorOrADefinedResult) {

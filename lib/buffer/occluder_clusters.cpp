@@ -176,7 +176,27 @@ OccluderClusters build_occluder_clusters(const OccluderClusterPlan& plan, const 
     if (!positions) fail("positions missing");
     if (position_stride < 3 * sizeof(float)) fail("position stride smaller than one position (12 bytes)");
     if (shared_edges && !edge_apexes) fail("shared_edges without edge_apexes (compute_shared_edges writes both)");
-    const std::size_t vertex_count = plan.vertex_count, clusters = plan.vertex_begin.size() - 1;
+    // A plan is a struct anyone can fill: one that does not hold together is refused before
+    // anything is read through it.
+    const std::size_t vertex_count = plan.vertex_count;
+    if (plan.vertex_begin.empty() || plan.vertex_begin.size() != plan.triangle_begin.size() || plan.vertex_begin.front() != 0 ||
+        plan.triangle_begin.front() != 0 || plan.vertex_begin.back() != plan.vertices.size() ||
+        plan.triangle_begin.back() != plan.source_triangles.size() || plan.source_triangles.size() != plan.triangle_count ||
+        plan.local_indices.size() != 3 * plan.triangle_count)
+        fail("the plan's arrays do not fit together (plan_occluder_clusters makes them)");
+    const std::size_t clusters = plan.vertex_begin.size() - 1;
+    for (std::size_t c = 0; c < clusters; ++c) {
+        if (plan.vertex_begin[c] > plan.vertex_begin[c + 1] || plan.triangle_begin[c] > plan.triangle_begin[c + 1] ||
+            plan.vertex_begin[c + 1] - plan.vertex_begin[c] > 255)
+            fail("cluster " + std::to_string(c) + " of the plan has its ranges out of order or more than 255 vertices");
+        for (std::uint32_t i = 3 * plan.triangle_begin[c]; i < 3 * plan.triangle_begin[c + 1]; ++i)
+            if (plan.local_indices[i] >= plan.vertex_begin[c + 1] - plan.vertex_begin[c])
+                fail("cluster " + std::to_string(c) + " of the plan has a triangle corner past its vertices");
+    }
+    for (const std::uint32_t v : plan.vertices)
+        if (v >= vertex_count) fail("the plan names vertex " + std::to_string(v) + " of " + std::to_string(vertex_count));
+    for (const std::uint32_t t : plan.source_triangles)
+        if (t >= plan.triangle_count) fail("the plan names triangle " + std::to_string(t) + " of " + std::to_string(plan.triangle_count));
     const auto position = [&](std::uint32_t v) {  // copied: a stride need not keep floats aligned
         std::array<float, 3> p;
         std::memcpy(p.data(), reinterpret_cast<const unsigned char*>(positions) + std::size_t(v) * position_stride, sizeof p);

@@ -76,7 +76,8 @@ OccluderClusterPlan plan_occluder_clusters(const float* positions, std::size_t p
 // these shared-edge bits and apexes of its triangles (as below). A plan made from the same
 // positions gives build_occluder_clusters(positions, ...)'s clusters, bit for bit; other
 // positions keep the plan's clusters (whose boxes are then these positions'). Throws
-// homcull::Error on a stride smaller than a position, or flags without apexes.
+// homcull::Error on a stride smaller than a position, flags without apexes, or a plan whose
+// arrays do not fit together or name vertices or triangles it does not have.
 OccluderClusters build_occluder_clusters(const OccluderClusterPlan& plan, const float* positions, std::size_t position_stride,
                                          const std::uint8_t* shared_edges, const std::uint32_t* edge_apexes);
 
