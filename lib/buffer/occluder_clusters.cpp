@@ -189,7 +189,7 @@ OccluderClusters build_occluder_clusters(const OccluderClusterPlan& plan, const 
         if (plan.vertex_begin[c] > plan.vertex_begin[c + 1] || plan.triangle_begin[c] > plan.triangle_begin[c + 1] ||
             plan.vertex_begin[c + 1] - plan.vertex_begin[c] > 255)
             fail("cluster " + std::to_string(c) + " of the plan has its ranges out of order or more than 255 vertices");
-        for (std::uint32_t i = 3 * plan.triangle_begin[c]; i < 3 * plan.triangle_begin[c + 1]; ++i)
+        for (std::size_t i = 3 * std::size_t(plan.triangle_begin[c]); i < 3 * std::size_t(plan.triangle_begin[c + 1]); ++i)
             if (plan.local_indices[i] >= plan.vertex_begin[c + 1] - plan.vertex_begin[c])
                 fail("cluster " + std::to_string(c) + " of the plan has a triangle corner past its vertices");
     }
