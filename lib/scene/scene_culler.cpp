@@ -359,7 +359,7 @@ void detail::SceneCullerState::reserve_frame_room() {
 // that a frame draws the clusters of the candidates it picks), one after the other in clusters_,
 // with the flags within each object (own_shared_edges_), right whichever candidates a frame
 // draws, and beside them the flags across objects, for frames that draw every candidate in the
-// frustum (add_candidate_clusters).
+// frustum (candidate_clusters).
 void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
     if (!config_.occluder_clusters) return;
     cluster_first_.assign(1, 0);
@@ -408,42 +408,42 @@ void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
             plans[k] = plan_occluder_clusters(positions_of(k), 3 * sizeof(float), local[k].vertices, local[k].indices.data(),
                                               local[k].indices.size() / 3);
     });
-    // Each candidate's clusters in a task of its own, then added in the candidates' order.
-    std::vector<OccluderClusters> parts(candidates);
+    // Each candidate's clusters, with the flags across objects, in a task of its own; then
+    // appended in the candidates' order.
+    std::vector<CandidateClusters> parts(candidates);
     for_each_index(parallel, candidates, 4, [&](std::size_t k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
         std::vector<std::uint32_t> local_apexes(own_edge_apexes_.begin() + std::ptrdiff_t(3 * first),
                                                 own_edge_apexes_.begin() + std::ptrdiff_t(3 * (first + count)));
         for (std::uint32_t& v : local_apexes) v = v == kNoApex ? kNoApex : v - local[k].base;
-        parts[k] = build_occluder_clusters(plans[plan_of[k]], positions_of(k), 3 * sizeof(float), own_shared_edges_.data() + first,
-                                           local_apexes.data());
+        parts[k] = candidate_clusters(k,
+                                      build_occluder_clusters(plans[plan_of[k]], positions_of(k), 3 * sizeof(float),
+                                                              own_shared_edges_.data() + first, local_apexes.data()),
+                                      vertex_candidate);
     });
     local = {}, plans = {};
-    // Room for every candidate's clusters at once: appended in growing vectors, the castle's
-    // copied their contents again at every doubling and wrote twice the pages. A cluster's
-    // vertex count can still grow by the copies of apexes in other objects: up to three a
-    // triangle, reserved too (address space; the pages of room left unused are never written).
-    std::size_t clusters = 0, triangles = 0, positions = 0, neighbour_flags = 0;
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-        clusters += parts[k].clusters.size();
-        triangles += parts[k].shared_edges.size();
-        positions += parts[k].positions.size();
-        for (std::size_t t = first_triangle_[k]; t < first_triangle_[k + 1]; ++t)
-            neighbour_flags += std::size_t(__builtin_popcount(occluders_.shared_edges[t] & 7u));
+    // Room for every candidate's clusters at once (appended in growing vectors, the castle's
+    // copied their contents again at every doubling and wrote twice the pages).
+    std::size_t clusters = 0, triangles = 0, positions = 0, neighbours = 0;
+    for (const CandidateClusters& part : parts) {
+        clusters += part.clusters.clusters.size();
+        triangles += part.clusters.triangle_count();
+        positions += part.clusters.positions.size();
+        neighbours += part.neighbours.size();
     }
     clusters_.clusters.reserve(clusters);
-    clusters_.positions.reserve(positions + 3 * neighbour_flags);
+    clusters_.positions.reserve(positions);
     clusters_.indices.reserve(3 * triangles);
     clusters_.shared_edges.reserve(triangles);
     clusters_.edge_apexes.reserve(3 * triangles);
     clusters_.source_triangles.reserve(triangles);
     cluster_cross_shared_edges_.reserve(triangles);
     cluster_cross_edge_apexes_.reserve(3 * triangles);
-    cluster_neighbours_.reserve(neighbour_flags);
+    cluster_neighbours_.reserve(neighbours);
     cluster_neighbour_first_.reserve(clusters + 1);
-    cluster_first_.reserve(occluder_ids_.size() + 1);
-    for (std::size_t k = 0; k < occluder_ids_.size(); ++k) {
-        add_candidate_clusters(k, parts[k], vertex_candidate);
+    cluster_first_.reserve(candidates + 1);
+    for (std::size_t k = 0; k < candidates; ++k) {
+        append_candidate_clusters(k, parts[k]);
         parts[k] = {};  // freed once added: the parts together are a second copy of every candidate's clusters
         cluster_first_.push_back(std::uint32_t(clusters_.clusters.size()));
     }
@@ -461,7 +461,7 @@ std::vector<std::uint32_t> detail::SceneCullerState::vertex_candidates() const {
 }
 
 // Occluders drawn as triangles: each candidate's edges whose cross-object flag names an apex in
-// another candidate (for EdgeFlags::drawn_neighbours, as add_candidate_clusters lists them for
+// another candidate (for EdgeFlags::drawn_neighbours, as candidate_clusters lists them for
 // clusters, an apex in no candidate listed with kNone, never drawn).
 void detail::SceneCullerState::find_triangle_neighbours() {
     triangle_neighbour_first_.assign(1, 0);
@@ -480,55 +480,87 @@ void detail::SceneCullerState::find_triangle_neighbours() {
     detail::reserve_written(frame_neighbours_, triangle_neighbours_.size());
 }
 
-// Candidate k's clusters (built with its own flags) appended to clusters_, each with the
-// cross-object flags of its triangles beside them. An apex the own flags already name keeps its
-// cluster vertex; an apex in another object becomes a vertex of the cluster (found among its
-// vertices by position, or a copy appended), so that either set of flags names apexes among
-// the cluster's own vertices, as the render requires.
-void detail::SceneCullerState::add_candidate_clusters(std::size_t k, const OccluderClusters& part, const std::vector<std::uint32_t>& vertex_candidate) {
+// Candidate k's clusters (built with its own flags), each with the cross-object flags of its
+// triangles beside them. An apex the own flags already name keeps its cluster vertex; an apex in
+// another object becomes a vertex of the cluster (found among its vertices by position, or a
+// copy appended), so that either set of flags names apexes among the cluster's own vertices, as
+// the render requires. Reads the culler's arrays only: candidates are made in tasks.
+detail::SceneCullerState::CandidateClusters detail::SceneCullerState::candidate_clusters(std::size_t k, OccluderClusters&& part,
+                                                                                        const std::vector<std::uint32_t>& vertex_candidate) const {
     const std::size_t first = first_triangle_[k];
-    const auto triangle_base = std::uint32_t(clusters_.shared_edges.size());
     const std::size_t occluder_vertices = occluders_.positions.size() / 3;
+    CandidateClusters out;
+    OccluderClusters& made = out.clusters;
+    made.clusters.reserve(part.clusters.size());
+    made.positions.reserve(part.positions.size());
+    out.cross_shared_edges.reserve(part.triangle_count());
+    out.cross_edge_apexes.reserve(3 * part.triangle_count());
+    out.neighbour_end.reserve(part.clusters.size());
     for (OccluderCluster c : part.clusters) {
         const std::uint32_t part_first_vertex = c.first_vertex;
-        c.first_vertex = std::uint32_t(clusters_.positions.size() / 3);
-        c.first_triangle += triangle_base;
+        c.first_vertex = std::uint32_t(made.positions.size() / 3);
         const auto own_positions = part.positions.begin() + 3 * std::ptrdiff_t(part_first_vertex);
-        clusters_.positions.insert(clusters_.positions.end(), own_positions, own_positions + 3 * std::ptrdiff_t(c.vertex_count));
+        made.positions.insert(made.positions.end(), own_positions, own_positions + 3 * std::ptrdiff_t(c.vertex_count));
         for (std::uint32_t i = 0; i < c.triangle_count; ++i) {
-            const std::size_t local = std::size_t(c.first_triangle - triangle_base) + i;  // within part
+            const std::size_t local = std::size_t(c.first_triangle) + i;  // within part
             const std::size_t source = first + part.source_triangles[local];
             const std::uint8_t flags = occluders_.shared_edges[source];
-            cluster_cross_shared_edges_.push_back(flags);
+            out.cross_shared_edges.push_back(flags);
             for (std::size_t e = 0; e < 3; ++e) {
                 const std::uint32_t apex = (flags >> e) & 1u ? occluders_.edge_apexes[3 * source + e] : kNoApex;
                 if (apex < occluder_vertices && vertex_candidate[apex] != k)
-                    cluster_neighbours_.push_back({c.first_triangle + i, vertex_candidate[apex], std::uint8_t(1u << e)});
+                    out.neighbours.push_back({std::uint32_t(local), vertex_candidate[apex], std::uint8_t(1u << e)});
                 if (apex >= occluder_vertices) {  // none (the render drops a flag without an apex)
-                    cluster_cross_edge_apexes_.push_back(kNoApex);
+                    out.cross_edge_apexes.push_back(kNoApex);
                 } else if ((own_shared_edges_[source] >> e) & 1u && own_edge_apexes_[3 * source + e] == apex &&
                            part.edge_apexes[3 * local + e] != kNoApex) {
-                    cluster_cross_edge_apexes_.push_back(part.edge_apexes[3 * local + e]);
+                    out.cross_edge_apexes.push_back(part.edge_apexes[3 * local + e]);
                 } else {
                     const float* p = occluders_.positions.data() + 3 * std::size_t(apex);
-                    const std::size_t begin = 3 * std::size_t(c.first_vertex), end = clusters_.positions.size();
+                    const std::size_t begin = 3 * std::size_t(c.first_vertex), end = made.positions.size();
                     std::size_t at = begin;
-                    while (at < end && !(clusters_.positions[at] == p[0] && clusters_.positions[at + 1] == p[1] && clusters_.positions[at + 2] == p[2]))
+                    while (at < end && !(made.positions[at] == p[0] && made.positions[at + 1] == p[1] && made.positions[at + 2] == p[2]))
                         at += 3;
-                    if (at == end) clusters_.positions.insert(clusters_.positions.end(), p, p + 3);
-                    cluster_cross_edge_apexes_.push_back(std::uint32_t((at - begin) / 3));
+                    if (at == end) made.positions.insert(made.positions.end(), p, p + 3);
+                    out.cross_edge_apexes.push_back(std::uint32_t((at - begin) / 3));
                 }
             }
         }
-        c.vertex_count = std::uint32_t(clusters_.positions.size() / 3 - c.first_vertex);
-        clusters_.max_cluster_vertices = std::max(clusters_.max_cluster_vertices, c.vertex_count);
-        clusters_.clusters.push_back(c);
-        cluster_neighbour_first_.push_back(std::uint32_t(cluster_neighbours_.size()));
+        c.vertex_count = std::uint32_t(made.positions.size() / 3 - c.first_vertex);
+        made.max_cluster_vertices = std::max(made.max_cluster_vertices, c.vertex_count);
+        made.clusters.push_back(c);
+        out.neighbour_end.push_back(std::uint32_t(out.neighbours.size()));
     }
-    clusters_.indices.insert(clusters_.indices.end(), part.indices.begin(), part.indices.end());
-    clusters_.shared_edges.insert(clusters_.shared_edges.end(), part.shared_edges.begin(), part.shared_edges.end());
-    clusters_.edge_apexes.insert(clusters_.edge_apexes.end(), part.edge_apexes.begin(), part.edge_apexes.end());
-    for (const std::uint32_t t : part.source_triangles) clusters_.source_triangles.push_back(std::uint32_t(first) + t);
+    made.indices = std::move(part.indices);
+    made.shared_edges = std::move(part.shared_edges);
+    made.edge_apexes = std::move(part.edge_apexes);
+    made.source_triangles = std::move(part.source_triangles);
+    return out;
+}
+
+// Candidate k's clusters appended to clusters_ and the cross-object arrays, renumbered.
+void detail::SceneCullerState::append_candidate_clusters(std::size_t k, const CandidateClusters& candidate) {
+    const std::size_t first = first_triangle_[k];
+    const OccluderClusters& made = candidate.clusters;
+    const auto vertex_base = std::uint32_t(clusters_.positions.size() / 3), triangle_base = std::uint32_t(clusters_.shared_edges.size());
+    const auto neighbour_base = std::uint32_t(cluster_neighbours_.size());
+    for (OccluderCluster c : made.clusters) {
+        c.first_vertex += vertex_base;
+        c.first_triangle += triangle_base;
+        clusters_.clusters.push_back(c);
+    }
+    clusters_.max_cluster_vertices = std::max(clusters_.max_cluster_vertices, made.max_cluster_vertices);
+    clusters_.positions.insert(clusters_.positions.end(), made.positions.begin(), made.positions.end());
+    clusters_.indices.insert(clusters_.indices.end(), made.indices.begin(), made.indices.end());
+    clusters_.shared_edges.insert(clusters_.shared_edges.end(), made.shared_edges.begin(), made.shared_edges.end());
+    clusters_.edge_apexes.insert(clusters_.edge_apexes.end(), made.edge_apexes.begin(), made.edge_apexes.end());
+    for (const std::uint32_t t : made.source_triangles) clusters_.source_triangles.push_back(std::uint32_t(first) + t);
+    cluster_cross_shared_edges_.insert(cluster_cross_shared_edges_.end(), candidate.cross_shared_edges.begin(),
+                                       candidate.cross_shared_edges.end());
+    cluster_cross_edge_apexes_.insert(cluster_cross_edge_apexes_.end(), candidate.cross_edge_apexes.begin(),
+                                      candidate.cross_edge_apexes.end());
+    for (const NeighbourEdge& n : candidate.neighbours) cluster_neighbours_.push_back({n.triangle + triangle_base, n.candidate, n.edge_bit});
+    for (const std::uint32_t end : candidate.neighbour_end) cluster_neighbour_first_.push_back(neighbour_base + end);
 }
 
 // A candidate is closed when every edge of its triangles is shared within the object, in

@@ -100,7 +100,18 @@ public:
     // Which candidate each vertex of occluders_ belongs to (each object's vertices are its own).
     std::vector<std::uint32_t> vertex_candidates() const;
     void find_triangle_neighbours();
-    void add_candidate_clusters(std::size_t k, const OccluderClusters& part, const std::vector<std::uint32_t>& vertex_candidate);
+    // One candidate's clusters with the flags across objects beside them, numbered from its own
+    // first vertex, triangle and neighbour edge: made in a task (candidate_clusters), then
+    // appended in the candidates' order (append_candidate_clusters).
+    struct CandidateClusters {
+        OccluderClusters clusters;  // each cluster's positions, then its copies of apexes in other objects
+        std::vector<std::uint8_t> cross_shared_edges;
+        std::vector<std::uint32_t> cross_edge_apexes;
+        std::vector<NeighbourEdge> neighbours;     // triangle: into clusters' triangles
+        std::vector<std::uint32_t> neighbour_end;  // per cluster: where its neighbour edges end
+    };
+    CandidateClusters candidate_clusters(std::size_t k, OccluderClusters&& part, const std::vector<std::uint32_t>& vertex_candidate) const;
+    void append_candidate_clusters(std::size_t k, const CandidateClusters& candidate);
     void keep_drawn_neighbours(std::size_t first_cluster, std::size_t end_cluster);
     void clear_undrawn_neighbours();
     ObjectHierarchy hierarchy_;
