@@ -5,7 +5,10 @@
 // preparation differs.
 #include "support.hpp"
 
+#include "scene/shared_plans.hpp"
+
 #include <homcull/camera.hpp>
+#include <homcull/error.hpp>
 #include <homcull/generate.hpp>
 #include <homcull/io/scene_io.hpp>
 #include <homcull/scene_culler.hpp>
@@ -117,6 +120,37 @@ TEST(CullerPreparation, InTasksMakesTheCastleCullerOfOneThread) {
     std::vector<Camera> cameras = views_over(castle, 3, 2);
     cameras.push_back(test::castle_view_c0());
     expect_same_cullers(castle, occluder_candidates(castle, OccluderFilter::role), config, cameras, "castle");
+}
+
+
+// The plans' sharing: a candidate shares the plan of the first one placing the same mesh with
+// the same local triangles, and plans itself when its triangles differ in any way (an index,
+// their count, the vertex count) or its mesh does, wherever its vertices begin.
+TEST(CullerPreparation, PlacementsShareAPlanOnlyWithTheSameMeshAndTriangles) {
+    using detail::LocalTriangles;
+    const LocalTriangles quad{0, 4, {0, 1, 2, 0, 2, 3}};
+    LocalTriangles other_split = quad;
+    other_split.indices = {0, 1, 3, 1, 2, 3};  // the quad cut along its other diagonal
+    LocalTriangles one_more_vertex = quad;
+    one_more_vertex.vertices = 5;
+    LocalTriangles placed_elsewhere = quad;
+    placed_elsewhere.base = 40;  // the same triangles from another first vertex: shared
+    const LocalTriangles fewer{0, 4, {0, 1, 2}};
+    const std::vector<LocalTriangles> local = {quad, other_split, placed_elsewhere, quad, one_more_vertex, fewer, other_split, quad};
+    const std::vector<std::uint32_t> mesh_of = {0, 0, 0, 1, 0, 0, 0, 1};
+    const std::vector<std::uint32_t> expected = {0, 1, 0, 3, 4, 5, 1, 3};
+    EXPECT_EQ(detail::first_with_same_triangles(mesh_of, local), expected);
+    EXPECT_TRUE(detail::first_with_same_triangles({}, {}).empty());
+    EXPECT_THROW(detail::first_with_same_triangles({0}, local), Error);
+
+    // Many placements of one mesh, every one with triangles of its own but the last, which
+    // repeats the first: each plans for itself, the last shares the first's.
+    std::vector<LocalTriangles> many;
+    for (std::uint32_t k = 0; k < 5000; ++k) many.push_back({0, 3, {0, 1, 2, k % 3, (k + 1) % 3, k}});
+    many.push_back(many.front());
+    const std::vector<std::uint32_t> plan = detail::first_with_same_triangles(std::vector<std::uint32_t>(many.size(), 7), many);
+    for (std::size_t k = 0; k + 1 < many.size(); ++k) ASSERT_EQ(plan[k], k);
+    EXPECT_EQ(plan.back(), 0u);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "common/run_tasks.hpp"
 #include "scene/closed_occludees.hpp"
 #include "scene/scene_culler_frame.hpp"
+#include "scene/shared_plans.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -369,16 +370,13 @@ void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
     // together in occluders_.positions, and a build sees only those (meshoptimizer's work grows
     // with the vertices it is given).
     const std::size_t candidates = occluder_ids_.size();
-    struct LocalMesh {
-        std::uint32_t base = 0;
-        std::size_t vertices = 0;
-        std::vector<std::uint32_t> indices;
-    };
-    std::vector<LocalMesh> local(candidates);
+    std::vector<LocalTriangles> local(candidates);
+    std::vector<std::uint32_t> mesh_of(candidates);
     for_each_index(parallel, candidates, 8, [&](std::size_t k) {
         const std::size_t first = first_triangle_[k], count = first_triangle_[k + 1] - first;
         const auto begin = occluders_.indices.begin() + std::ptrdiff_t(3 * first), end = begin + std::ptrdiff_t(3 * count);
-        LocalMesh& m = local[k];
+        mesh_of[k] = scene_->objects[occluder_ids_[k]].mesh;
+        LocalTriangles& m = local[k];
         m.base = count ? *std::min_element(begin, end) : 0;
         m.vertices = count ? std::size_t(*std::max_element(begin, end) - m.base) + 1 : 0;
         m.indices.assign(begin, end);
@@ -389,18 +387,7 @@ void detail::SceneCullerState::build_clusters(const ParallelFor& parallel) {
     // made from the first of them; each then gets its clusters from its own positions and flags.
     // The castle's 115 role occluders place 16 meshes. (A merge of coplanar triangles can give
     // two placements different triangles: then each has its own plan.)
-    std::vector<std::uint32_t> plan_of(candidates);
-    {
-        std::vector<std::vector<std::uint32_t>> planned_of_mesh(scene_->meshes.size());
-        for (std::size_t k = 0; k < candidates; ++k) {
-            std::vector<std::uint32_t>& planned = planned_of_mesh[scene_->objects[occluder_ids_[k]].mesh];
-            const auto same = std::find_if(planned.begin(), planned.end(), [&](std::uint32_t r) {
-                return local[r].vertices == local[k].vertices && local[r].indices == local[k].indices;
-            });
-            plan_of[k] = same != planned.end() ? *same : std::uint32_t(k);
-            if (same == planned.end()) planned.push_back(std::uint32_t(k));
-        }
-    }
+    const std::vector<std::uint32_t> plan_of = first_with_same_triangles(mesh_of, local);
     const auto positions_of = [&](std::size_t k) { return occluders_.positions.data() + 3 * std::size_t(local[k].base); };
     std::vector<OccluderClusterPlan> plans(candidates);
     for_each_index(parallel, candidates, 2, [&](std::size_t k) {
