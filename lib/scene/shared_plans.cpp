@@ -7,17 +7,21 @@
 namespace homcull::detail {
 namespace {
 
-// FNV-1a over the mesh, the vertex count and the indices, 64 bits: only a grouping key (equal
-// keys are compared in full), so its quality only has to keep groups small.
+// A key of the mesh, the vertex count and the indices: a multiply per index, in four
+// independent chains (one chain waits on its multiplies: 115 placements of 1,270 indices, the
+// castle's role occluders, took 0.30 ms so, 0.09 in four). Only a grouping key, since equal
+// keys are compared in full, so it only has to keep groups small.
 std::uint64_t triangles_key(std::uint32_t mesh, const LocalTriangles& t) {
-    std::uint64_t h = 14695981039346656037ull;
-    const auto mix = [&h](std::uint64_t v) {
-        for (int byte = 0; byte < 8; ++byte, v >>= 8) h = (h ^ (v & 0xffu)) * 1099511628211ull;
-    };
-    mix(mesh);
-    mix(t.vertices);
-    for (const std::uint32_t i : t.indices) mix(i);
-    return h;
+    constexpr std::uint64_t kOdd = 0x9E3779B97F4A7C15ull;
+    std::uint64_t h[4] = {mesh, t.vertices, t.indices.size(), 0};
+    const std::size_t n = t.indices.size();
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (int c = 0; c < 4; ++c) h[c] = (h[c] ^ t.indices[i + std::size_t(c)]) * kOdd;
+    for (; i < n; ++i) h[3] = (h[3] ^ t.indices[i]) * kOdd;
+    std::uint64_t key = 0;
+    for (const std::uint64_t c : h) key = (key ^ c ^ (c >> 29)) * kOdd;
+    return key;
 }
 
 }  // namespace
