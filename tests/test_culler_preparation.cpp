@@ -122,7 +122,6 @@ TEST(CullerPreparation, InTasksMakesTheCastleCullerOfOneThread) {
     expect_same_cullers(castle, occluder_candidates(castle, OccluderFilter::role), config, cameras, "castle");
 }
 
-
 // The plans' sharing: a candidate shares the plan of the first one placing the same mesh with
 // the same local triangles, and plans itself when its triangles differ in any way (an index,
 // their count, the vertex count) or its mesh does, wherever its vertices begin.
@@ -146,7 +145,7 @@ TEST(CullerPreparation, PlacementsShareAPlanOnlyWithTheSameMeshAndTriangles) {
     // Many placements of one mesh, every one with triangles of its own but the last, which
     // repeats the first: each plans for itself, the last shares the first's.
     std::vector<LocalTriangles> many;
-    for (std::uint32_t k = 0; k < 5000; ++k) many.push_back({0, 3, {0, 1, 2, k % 3, (k + 1) % 3, k}});
+    for (std::uint32_t k = 0; k < 5000; ++k) many.push_back({0, 5000, {0, 1, 2, k % 3, (k + 1) % 3, k}});
     many.push_back(many.front());
     const std::vector<std::uint32_t> plan = detail::first_with_same_triangles(std::vector<std::uint32_t>(many.size(), 7), many);
     for (std::size_t k = 0; k + 1 < many.size(); ++k) ASSERT_EQ(plan[k], k);
