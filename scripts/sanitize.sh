@@ -16,8 +16,8 @@ case "$kind" in
     flags="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer"
     # intercept_tls_get_addr=0: the runtime's __tls_get_addr interceptor (gcc 12's, as clang
     # 14's) takes a dynamic TLS block that malloc placed 16 bytes past a page boundary for one of
-    # glibc 2.18 or older, reads the allocator's chunk header before it as that block's address
-    # and size, and LeakSanitizer's tracer then dies scanning that range at exit ("Tracer caught
+    # glibc 2.19 to 2.24, which wrote a header there, reads the allocator's chunk header before it
+    # as that block's address and size, and LeakSanitizer's tracer then dies scanning that range at exit ("Tracer caught
     # signal 11", "LeakSanitizer has encountered a fatal error"), with no leak found. A program
     # that loads the image module (OpenImageIO's libraries, dlopen'ed: their thread-locals are
     # such blocks) failed so, now and then, depending on where its blocks landed. Without the

@@ -1,8 +1,9 @@
 // The leak check at exit with a dynamic TLS block 16 bytes past a page boundary, for
 // scripts/sanitize.sh's intercept_tls_get_addr=0 (the comment there says why): run under the
 // AddressSanitizer suite's options, it must end with 0 and no report. Without that option, gcc
-// 12's runtime takes such a block for one of glibc 2.18, reads the allocator's chunk header
-// before it as the block's address and size, and LeakSanitizer's tracer dies at exit.
+// 12's runtime takes such a block for one of glibc 2.19 to 2.24 (which wrote a header before
+// it), reads the allocator's chunk header there as the block's address and size, and
+// LeakSanitizer's tracer dies at exit.
 //
 // A thread allocates blocks of the size class glibc's allocation of the module's block falls
 // in (8 bytes) until the allocator's next one is at page + 16 (it hands a thread's blocks of a
