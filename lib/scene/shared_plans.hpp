@@ -20,8 +20,8 @@ struct LocalTriangles {
 // For each candidate k, the first candidate with the same mesh (mesh_of) and the same local
 // triangles (vertex count and index list), k itself when none comes before it: the candidates
 // whose entry is themselves make the plans. Depends only on the candidates' order. Candidates
-// are grouped by a key hashed from their triangles and compared in full only within a group, so that
-// many placements of one mesh with differing triangles cost linear time, not quadratic.
+// are grouped by a key hashed from their triangles and compared in full only within a group,
+// so that many placements of one mesh with differing triangles cost linear time, not quadratic.
 std::vector<std::uint32_t> first_with_same_triangles(const std::vector<std::uint32_t>& mesh_of, const std::vector<LocalTriangles>& local);
 
 }  // namespace homcull::detail
