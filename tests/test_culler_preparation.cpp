@@ -141,15 +141,30 @@ TEST(CullerPreparation, PlacementsShareAPlanOnlyWithTheSameMeshAndTriangles) {
     EXPECT_EQ(detail::first_with_same_triangles(mesh_of, local), expected);
     EXPECT_TRUE(detail::first_with_same_triangles({}, {}).empty());
     EXPECT_THROW(detail::first_with_same_triangles({0}, local), Error);
+    // The same under a key that puts every candidate in one group, as a collision of the real
+    // key would put two: the full comparison alone tells them apart.
+    const detail::TrianglesKey one_group = [](std::uint32_t, const LocalTriangles&) -> std::uint64_t { return 42; };
+    EXPECT_EQ(detail::first_with_same_triangles(mesh_of, local, one_group), expected);
 
     // Many placements of one mesh, every one with triangles of its own but the last, which
-    // repeats the first: each plans for itself, the last shares the first's.
-    std::vector<LocalTriangles> many;
-    for (std::uint32_t k = 0; k < 5000; ++k) many.push_back({0, 5000, {0, 1, 2, k % 3, (k + 1) % 3, k}});
-    many.push_back(many.front());
-    const std::vector<std::uint32_t> plan = detail::first_with_same_triangles(std::vector<std::uint32_t>(many.size(), 7), many);
-    for (std::size_t k = 0; k + 1 < many.size(); ++k) ASSERT_EQ(plan[k], k);
-    EXPECT_EQ(plan.back(), 0u);
+    // repeats the first: each plans for itself, the last shares the first's; under the real key
+    // (linear) and in one group (quadratic: fewer placements).
+    for (const std::uint32_t count : {5000u, 400u}) {
+        std::vector<LocalTriangles> many;
+        for (std::uint32_t k = 0; k < count; ++k) many.push_back({0, count, {0, 1, 2, k % 3, (k + 1) % 3, k}});
+        many.push_back(many.front());
+        const std::vector<std::uint32_t> plan = detail::first_with_same_triangles(std::vector<std::uint32_t>(many.size(), 7), many,
+                                                                                 count == 400 ? one_group : &detail::triangles_key);
+        for (std::size_t k = 0; k + 1 < many.size(); ++k) ASSERT_EQ(plan[k], k);
+        EXPECT_EQ(plan.back(), 0u);
+    }
+    // The real key tells the test's differing triangles apart (else the cases above would not
+    // reach the grouping they are meant to test).
+    for (std::size_t a = 0; a < local.size(); ++a)
+        for (std::size_t b = 0; b < local.size(); ++b) {
+            if (expected[a] == expected[b]) continue;
+            EXPECT_NE(detail::triangles_key(mesh_of[a], local[a]), detail::triangles_key(mesh_of[b], local[b])) << a << " " << b;
+        }
 }
 
 }  // namespace

@@ -6,7 +6,6 @@
 #include <unordered_map>
 
 namespace homcull::detail {
-namespace {
 
 // A key of the mesh, the vertex count and the indices: a multiply per index, in four
 // independent chains (one chain waits on its multiplies: 115 placements of 1,270 indices, the
@@ -25,9 +24,8 @@ std::uint64_t triangles_key(std::uint32_t mesh, const LocalTriangles& t) {
     return key;
 }
 
-}  // namespace
-
-std::vector<std::uint32_t> first_with_same_triangles(const std::vector<std::uint32_t>& mesh_of, const std::vector<LocalTriangles>& local) {
+std::vector<std::uint32_t> first_with_same_triangles(const std::vector<std::uint32_t>& mesh_of, const std::vector<LocalTriangles>& local,
+                                                     TrianglesKey key) {
     if (mesh_of.size() != local.size())
         throw Error("first_with_same_triangles: " + std::to_string(mesh_of.size()) + " meshes for " + std::to_string(local.size()) +
                     " candidates");
@@ -36,7 +34,7 @@ std::vector<std::uint32_t> first_with_same_triangles(const std::vector<std::uint
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> planning;
     planning.reserve(local.size());
     for (std::size_t k = 0; k < local.size(); ++k) {
-        std::vector<std::uint32_t>& group = planning[triangles_key(mesh_of[k], local[k])];
+        std::vector<std::uint32_t>& group = planning[key(mesh_of[k], local[k])];
         first[k] = std::uint32_t(k);
         for (const std::uint32_t r : group)
             if (mesh_of[r] == mesh_of[k] && local[r].vertices == local[k].vertices && local[r].indices == local[k].indices) {

@@ -17,11 +17,18 @@ struct LocalTriangles {
     std::vector<std::uint32_t> indices;
 };
 
+// The grouping key of a candidate's mesh and local triangles: equal for equal ones, and rarely
+// equal otherwise.
+using TrianglesKey = std::uint64_t (*)(std::uint32_t mesh, const LocalTriangles& triangles);
+std::uint64_t triangles_key(std::uint32_t mesh, const LocalTriangles& triangles);
+
 // For each candidate k, the first candidate with the same mesh (mesh_of) and the same local
 // triangles (vertex count and index list), k itself when none comes before it: the candidates
 // whose entry is themselves make the plans. Depends only on the candidates' order. Candidates
-// are grouped by a key hashed from their triangles and compared in full only within a group,
-// so that many placements of one mesh with differing triangles cost linear time, not quadratic.
-std::vector<std::uint32_t> first_with_same_triangles(const std::vector<std::uint32_t>& mesh_of, const std::vector<LocalTriangles>& local);
+// are grouped by `key` and compared in full only within a group, so that many placements of one
+// mesh with differing triangles cost linear time, not quadratic. (The tests pass a key that
+// groups everything, to reach the full comparison that equal keys of differing triangles need.)
+std::vector<std::uint32_t> first_with_same_triangles(const std::vector<std::uint32_t>& mesh_of, const std::vector<LocalTriangles>& local,
+                                                     TrianglesKey key = &triangles_key);
 
 }  // namespace homcull::detail
