@@ -107,23 +107,28 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
     const detail::Vector<std::uint32_t> number =
         by_vertex ? number_positions(high - low + 1, [&](std::size_t i, float* p) { return position_of(low + i, p); }, numbers)
                   : number_positions(3 * triangle_count, [&](std::size_t i, float* p) { return position_of(vertex(i), p); }, numbers);
-    const auto number_of = [&](std::size_t i) {
-        const std::size_t v = vertex(i);
-        return v >= vertex_count ? kNoNumber : by_vertex ? number[v - low] : number[i];
-    };
+    // Each corner's position number, once for both passes below: kNoNumber at every corner of a
+    // triangle with a corner unnumbered (such a triangle has no edge).
+    detail::Vector<std::uint32_t> corner_number(3 * triangle_count);
+    for (std::size_t t = 0; t < triangle_count; ++t) {
+        std::uint32_t n[3];
+        for (std::size_t k = 0; k < 3; ++k) {
+            const std::size_t i = 3 * t + k, v = vertex(i);
+            n[k] = v >= vertex_count ? kNoNumber : by_vertex ? number[v - low] : number[i];
+        }
+        const bool usable = n[0] != kNoNumber && n[1] != kNoNumber && n[2] != kNoNumber;
+        for (std::size_t k = 0; k < 3; ++k) corner_number[3 * t + k] = usable ? n[k] : kNoNumber;
+    }
 
     // Each edge of a triangle whose three vertices are numbered, between two different
     // positions, into the bucket of its lower number.
     detail::Vector<std::uint32_t> bucket_first(std::size_t(numbers) + 1, 0);
-    const auto usable = [&](std::size_t t) {
-        return number_of(3 * t) != kNoNumber && number_of(3 * t + 1) != kNoNumber && number_of(3 * t + 2) != kNoNumber;
-    };
     for (std::size_t t = 0; t < triangle_count; ++t) {
         shared_edges[t] = 0;
         for (std::size_t k = 0; k < 3; ++k) edge_apexes[3 * t + k] = kNoApex;
-        if (!usable(t)) continue;
+        if (corner_number[3 * t] == kNoNumber) continue;
         for (std::size_t k = 0; k < 3; ++k) {
-            const std::uint32_t a = number_of(3 * t + k), b = number_of(3 * t + (k + 1) % 3);
+            const std::uint32_t a = corner_number[3 * t + k], b = corner_number[3 * t + (k + 1) % 3];
             if (a != b) ++bucket_first[std::min(a, b) + 1];
         }
     }
@@ -137,9 +142,9 @@ void compute_shared_edges(const float* positions, std::size_t stride, std::size_
     {
         detail::Vector<std::uint32_t> fill(bucket_first.begin(), bucket_first.end() - 1);
         for (std::size_t t = 0; t < triangle_count; ++t) {
-            if (!usable(t)) continue;
+            if (corner_number[3 * t] == kNoNumber) continue;
             for (std::size_t k = 0; k < 3; ++k) {
-                const std::uint32_t a = number_of(3 * t + k), b = number_of(3 * t + (k + 1) % 3);
+                const std::uint32_t a = corner_number[3 * t + k], b = corner_number[3 * t + (k + 1) % 3];
                 if (a != b) edges[fill[std::min(a, b)]++] = {std::max(a, b), std::uint32_t(3 * t + k), a < b ? 1u : 0u};
             }
         }
