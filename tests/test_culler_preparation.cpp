@@ -19,6 +19,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace homcull {
@@ -141,6 +142,7 @@ TEST(CullerPreparation, PlacementsShareAPlanOnlyWithTheSameMeshAndTriangles) {
     EXPECT_EQ(detail::first_with_same_triangles(mesh_of, local), expected);
     EXPECT_TRUE(detail::first_with_same_triangles({}, {}).empty());
     EXPECT_THROW(detail::first_with_same_triangles({0}, local), Error);
+    EXPECT_THROW(detail::first_with_same_triangles(mesh_of, local, nullptr), Error);
     // The same under a key that puts every candidate in one group, as a collision of the real
     // key would put two: the full comparison alone tells them apart.
     const detail::TrianglesKey one_group = [](std::uint32_t, const LocalTriangles&) -> std::uint64_t { return 42; };
@@ -149,12 +151,12 @@ TEST(CullerPreparation, PlacementsShareAPlanOnlyWithTheSameMeshAndTriangles) {
     // Many placements of one mesh, every one with triangles of its own but the last, which
     // repeats the first: each plans for itself, the last shares the first's; under the real key
     // (linear) and in one group (quadratic: fewer placements).
-    for (const std::uint32_t count : {5000u, 400u}) {
+    const std::pair<std::uint32_t, detail::TrianglesKey> runs[] = {{5000u, &detail::triangles_key}, {400u, one_group}};
+    for (const auto& [count, key] : runs) {
         std::vector<LocalTriangles> many;
         for (std::uint32_t k = 0; k < count; ++k) many.push_back({0, count, {0, 1, 2, k % 3, (k + 1) % 3, k}});
         many.push_back(many.front());
-        const std::vector<std::uint32_t> plan = detail::first_with_same_triangles(std::vector<std::uint32_t>(many.size(), 7), many,
-                                                                                 count == 400 ? one_group : &detail::triangles_key);
+        const std::vector<std::uint32_t> plan = detail::first_with_same_triangles(std::vector<std::uint32_t>(many.size(), 7), many, key);
         for (std::size_t k = 0; k + 1 < many.size(); ++k) ASSERT_EQ(plan[k], k);
         EXPECT_EQ(plan.back(), 0u);
     }

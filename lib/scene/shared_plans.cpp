@@ -26,6 +26,7 @@ std::uint64_t triangles_key(std::uint32_t mesh, const LocalTriangles& t) {
 
 std::vector<std::uint32_t> first_with_same_triangles(const std::vector<std::uint32_t>& mesh_of, const std::vector<LocalTriangles>& local,
                                                      TrianglesKey key) {
+    if (!key) throw Error("first_with_same_triangles: no key function");
     if (mesh_of.size() != local.size())
         throw Error("first_with_same_triangles: " + std::to_string(mesh_of.size()) + " meshes for " + std::to_string(local.size()) +
                     " candidates");
