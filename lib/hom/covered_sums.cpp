@@ -68,16 +68,28 @@ std::uint64_t detail::MapsState::uncovered_by_sums(int i0, int i1, int j0, int j
         return std::uint32_t(((std::uint64_t(1) << (8 * (r1 - r0 + 1))) - 1u) << (8 * r0));
     };
     const int tx0 = i0 / kW, tx1 = i1 / kW;
+    const auto masks_of = [&](int ty) { return state.covered_.data() + state.at(0, ty); };
     for (int ty = j0 / kH; ty <= j1 / kH; ++ty) {
-        const std::uint32_t rows = row_bits(ty);
-        const std::uint32_t* masks = state.covered_.data() + state.at(0, ty);
-        for (int tx = tx0; tx <= tx1; ++tx) {
-            if (interior && ty >= iy0 && ty <= iy1 && tx >= ix0 && tx <= ix1) {  // counted above
-                tx = ix1;
-                continue;
-            }
-            covered += detail::bit_count(column_bits(tx) & rows & masks[tx]);
+        if (interior && ty == iy0) {
+            // The interior's rows hold all their subtiles' rows: only the border subtile left
+            // of the interior and the one right of it (when the rectangle cuts them) remain,
+            // each with the same columns on every row.
+            const std::uint32_t left = ix0 > tx0 ? column_bits(tx0) : 0u, right = ix1 < tx1 ? column_bits(tx1) : 0u;
+            if (left | right)
+                for (int row = iy0; row <= iy1; ++row) {
+                    const std::uint32_t* masks = masks_of(row);
+                    covered += detail::bit_count(left & masks[tx0]) + detail::bit_count(right & masks[tx1]);
+                }
+            ty = iy1;
+            continue;
         }
+        // A row the rectangle cuts (or any, without an interior): every subtile between the
+        // first and the last holds all its columns.
+        const std::uint32_t rows = row_bits(ty);
+        const std::uint32_t* masks = masks_of(ty);
+        covered += detail::bit_count(column_bits(tx0) & rows & masks[tx0]);
+        if (tx1 > tx0) covered += detail::bit_count(column_bits(tx1) & rows & masks[tx1]);
+        for (int tx = tx0 + 1; tx < tx1; ++tx) covered += detail::bit_count(rows & masks[tx]);
     }
     return std::uint64_t(i1 - i0 + 1) * std::uint64_t(j1 - j0 + 1) - covered;
 }
