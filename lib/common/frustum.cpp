@@ -87,9 +87,13 @@ bool separated(const FrustumAxes& axes, const Aabb& box) {
         const double c = glm::dot(a, centre);
         const double r = glm::dot(abs_a, half);
         const double f_lo = axes.lo[std::size_t(k)], f_hi = axes.hi[std::size_t(k)];
-        // The box's terms without their cancellation (|a| |centre|, not |a . centre|).
-        const double margin = axes.relative_margin * (glm::dot(abs_a, glm::abs(centre)) + r + axes.extent_magnitude[std::size_t(k)]);
-        if (f_hi + margin < c - r || c + r + margin < f_lo) return true;
+        // Apart by more than the margin only where apart at all (the margin is not negative):
+        // the margin is worked out for the few axes that get that far.
+        if (f_hi < c - r || c + r < f_lo) {
+            // The box's terms without their cancellation (|a| |centre|, not |a . centre|).
+            const double margin = axes.relative_margin * (glm::dot(abs_a, glm::abs(centre)) + r + axes.extent_magnitude[std::size_t(k)]);
+            if (f_hi + margin < c - r || c + r + margin < f_lo) return true;
+        }
         // A box whose centre lies within every plane's extent (inside the frustum) meets it:
         // most boxes tested are in view, and end here without the 21 other axes.
         centre_inside = centre_inside && f_lo <= c && c <= f_hi;
