@@ -15,6 +15,7 @@ packages=(
   libmeshoptimizer-dev            # occluder simplification
   libcli11-dev nlohmann-json3-dev libfmt-dev
   jq                              # scripts/walk-results.sh reads the walk JSON
+  valgrind                        # scripts/count-instructions.sh (callgrind: work counted without the host's noise)
   libtinygltf-dev                 # glTF/GLB import and export (keeps node order and extras)
   assimp-testmodels               # test data: the IFC source of fzk_haus.glb, for the IFC import test
   libgtest-dev libgmock-dev libbenchmark-dev
