@@ -16,32 +16,28 @@ namespace {
 
 constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtileHeight;
 
-// The scalar choice's CoveredCountsKernel.
-void covered_counts_reference(const std::uint32_t* masks, int count, std::uint32_t* counts) {
-    for (int k = 0; k < count; ++k) counts[k] = detail::bit_count(masks[k]);
+// The scalar choice's CoveredSumsRowKernel.
+void covered_sums_row_reference(const std::uint32_t* masks, int count, const std::uint32_t* above, std::uint32_t* row) {
+    std::uint32_t run = 0;  // the covered samples left of k + 1
+    for (int k = 0; k < count; ++k) {
+        run += detail::bit_count(masks[k]);
+        row[k + 1] = above[k + 1] + run;
+    }
 }
 
 }  // namespace
 
 // One pass over the subtiles' coverage masks: a fortieth of the pyramids' work at one sample
-// per pixel (one 32-bit mask a subtile against a count, and depths, per pixel). A row's counts
-// come from the instruction set's kernel (map_kernels.hpp), then are summed along the row.
+// per pixel (one 32-bit mask a subtile against a count, and depths, per pixel), a row at a time
+// by the instruction set's kernel (map_kernels.hpp).
 void detail::MapsState::sum_covered_samples() {
     const detail::BufferState& state = built_->state();
     const int tiles_x = sums_width_ - 1, tiles_y = int(covered_sums_.size() / std::size_t(sums_width_)) - 1;
-    const detail::CoveredCountsKernel count_row = built_with_->covered_counts ? built_with_->covered_counts : &covered_counts_reference;
+    const detail::CoveredSumsRowKernel sum_row = built_with_->covered_sums_row ? built_with_->covered_sums_row : &covered_sums_row_reference;
     std::uint32_t* sums = covered_sums_.data();
-    std::uint32_t* counts = row_counts_.data();
-    for (int ty = 0; ty < tiles_y; ++ty) {
-        const std::uint32_t* above = sums + std::size_t(ty) * std::size_t(sums_width_);
-        std::uint32_t* row = sums + std::size_t(ty + 1) * std::size_t(sums_width_);
-        count_row(state.covered_.data() + state.at(0, ty), tiles_x, counts);
-        std::uint32_t run = 0;  // this row's covered samples left of tx + 1
-        for (int tx = 0; tx < tiles_x; ++tx) {
-            run += counts[tx];
-            row[tx + 1] = above[tx + 1] + run;
-        }
-    }
+    for (int ty = 0; ty < tiles_y; ++ty)
+        sum_row(state.covered_.data() + state.at(0, ty), tiles_x, sums + std::size_t(ty) * std::size_t(sums_width_),
+                sums + std::size_t(ty + 1) * std::size_t(sums_width_));
 }
 
 // Uncovered samples of [i0, i1] x [j0, j1] (inside the buffer): the subtiles wholly inside from

@@ -6,7 +6,7 @@ namespace {
 
 MapKernels resolve_all(const IsaChoice& choice) {
     MapKernels kernels = resolve_map_kernels(choice);
-    resolve_covered_counts_kernel(choice, kernels);
+    resolve_covered_sums_kernel(choice, kernels);
     return kernels;
 }
 

@@ -8,21 +8,21 @@
 
 namespace homcull::detail {
 
-// counts[k] = the set bits of masks[k] for k < count; may read and write a whole vector past
-// count (rows and counts padded for kMaxSimdLanes).
-using CoveredCountsKernel = void (*)(const std::uint32_t* masks, int count, std::uint32_t* counts);
+// A row of the summed-area table of covered samples: row[k + 1] = above[k + 1] + the set bits
+// of masks[0..k], for k < count (row[0] is left alone). Reads and writes nothing past them.
+using CoveredSumsRowKernel = void (*)(const std::uint32_t* masks, int count, const std::uint32_t* above, std::uint32_t* row);
 
 struct MapKernels {
     // Null for the scalar choice: the reference paths then do every cell.
     Level0Kernel level0 = nullptr;
     PyramidRowKernel reduce_row = nullptr;
-    CoveredCountsKernel covered_counts = nullptr;  // covered_counts_simd.cpp
+    CoveredSumsRowKernel covered_sums_row = nullptr;  // covered_sums_simd.cpp
 };
 
 const MapKernels& map_kernels(const IsaChoice& choice);
 
 // Each SIMD translation unit's part of the table (they hold the HWY_EXPORTs).
 MapKernels resolve_map_kernels(const IsaChoice& choice);  // opacity_pyramid_simd.cpp
-void resolve_covered_counts_kernel(const IsaChoice& choice, MapKernels& kernels);
+void resolve_covered_sums_kernel(const IsaChoice& choice, MapKernels& kernels);
 
 }  // namespace homcull::detail

@@ -55,7 +55,6 @@ public:
     // Covered samples summed over subtiles [0, tx) x [0, ty), at ty * (subtiles_x + 1) + tx.
     std::vector<std::uint32_t> covered_sums_;
     int sums_width_ = 0;
-    std::vector<std::uint32_t> row_counts_;  // one row's covered samples per subtile, padded for a vector
     const MapKernels* built_with_ = nullptr;     // the kernels it ran: its buffer's instruction set's
     int width_ = 0, height_ = 0, samples_ = 1;  // buffer pixels and samples per axis
     float near_w_ = 0.1f;

@@ -81,7 +81,6 @@ detail::MapsState::MapsState(const OcclusionBuffer& buffer, const OcclusionMapsC
     if (buffer_decides_) {
         sums_width_ = buffer.subtiles_x() + 1;
         covered_sums_.assign(std::size_t(sums_width_) * std::size_t(buffer.subtiles_y() + 1), 0u);
-        row_counts_.assign(std::size_t(buffer.subtiles_x()) + detail::kMaxSimdLanes, 0u);
     }
 
     // Display pixels per buffer pixel (m0 x m0) and samples per display pixel (area).
