@@ -18,11 +18,7 @@ constexpr int kW = OcclusionBuffer::kSubtileWidth, kH = OcclusionBuffer::kSubtil
 
 // The scalar choice's CoveredSumsRowKernel.
 void covered_sums_row_reference(const std::uint32_t* masks, int count, const std::uint32_t* above, std::uint32_t* row) {
-    std::uint32_t run = 0;  // the covered samples left of k + 1
-    for (int k = 0; k < count; ++k) {
-        run += detail::bit_count(masks[k]);
-        row[k + 1] = above[k + 1] + run;
-    }
+    detail::covered_sums_row_from(masks, 0, count, above, row, 0u);
 }
 
 }  // namespace

@@ -11,7 +11,6 @@
 #include <hwy/highway.h>
 
 #include "hom/map_kernels.hpp"
-#include "raster/rasterize.hpp"
 
 #include <cstdint>
 
@@ -38,10 +37,7 @@ void CoveredSumsRow(const std::uint32_t* masks, int count, const std::uint32_t* 
     }
     run = hn::GetLane(carry);
 #endif
-    for (; k < count; ++k) {
-        run += bit_count(masks[k]);
-        row[k + 1] = above[k + 1] + run;
-    }
+    covered_sums_row_from(masks, k, count, above, row, run);
 }
 
 }  // namespace homcull::detail::HWY_NAMESPACE
