@@ -22,11 +22,12 @@ binaries=()
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do binaries+=("$1"); shift; done
 [ "${1:-}" = "--" ] && shift
 walk_options=("$@")
+[ ${#binaries[@]} -gt 0 ] || { echo "count-instructions: no homcull program given" >&2; sed -n 8,10p "$0" >&2; exit 2; }
 command -v valgrind >/dev/null || { echo "count-instructions: valgrind is missing (bash scripts/install-deps.sh)" >&2; exit 2; }
 file=$scene
 [ -f "$file" ] || file=../shared/scenes/$scene.glb
 [ -f "$file" ] || { echo "count-instructions: no scene $scene (nor $file)" >&2; exit 2; }
-for b in "${binaries[@]}"; do [ -x "$b" ] || { echo "count-instructions: $b is not a program" >&2; exit 2; }; done
+for b in "${binaries[@]}"; do [ -f "$b" ] && [ -x "$b" ] || { echo "count-instructions: $b is not a program" >&2; exit 2; }; done
 out=${OUT:-$(mktemp -d)}
 mkdir -p "$out"
 path=$out/path.json
@@ -39,7 +40,9 @@ for k in "${!binaries[@]}"; do
     "${binaries[$k]}" walk --scene "$file" --path "$path" --truth off --quiet "${walk_options[@]}" > "$out/walk.$k.txt" 2> "$out/valgrind.$k.log" ||
     { echo "count-instructions: ${binaries[$k]} failed under valgrind ($out/valgrind.$k.log)" >&2; exit 1; }
   total=$(awk '/^(summary|totals):/ {print $2; exit}' "$cg")
-  [ -n "$total" ] && [ "$total" -gt 0 ] || { echo "count-instructions: nothing counted in SceneCullerState::cull ($cg)" >&2; exit 1; }
+  # A wrapper script around homcull counts nothing: valgrind runs the shell, not what it starts.
+  [ -n "$total" ] && [ "$total" -gt 0 ] ||
+    { echo "count-instructions: nothing counted in SceneCullerState::cull ($cg; give the homcull program itself, not a wrapper)" >&2; exit 1; }
   totals+=("$total")
 done
 echo "instructions in SceneCuller::cull, $(basename "$file"), ${FRAMES:-120}-frame walk ${walk_options[*]}"
