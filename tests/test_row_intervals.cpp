@@ -1,6 +1,7 @@
 // The float row rule (prepare_float_row_edges, float_sample_row_interval) against the double
 // rule it stands in for: on every row, the float interval lies inside the double interval
-// (so it inherits its conservative coverage) and loses at most one sample at each end.
+// (so it inherits its conservative coverage) and loses at most one sample at each end. And the
+// rows the row loop passes over (rows_reaching_columns) against both rules.
 #include "raster/rasterize.hpp"
 #include "support.hpp"
 
@@ -108,6 +109,63 @@ TEST(FloatRowRule, SharedHorizontalAndFarEdgesKeepTheDoubleRule) {
     ScreenTriangle far = tri;
     far.p[2] = {-60000.0, 5.0};  // an edge starts far beyond the screen: float would round too coarsely
     EXPECT_FALSE(setup(far));
+}
+
+// rows_reaching_columns, which the SIMD row loop uses to pass over the rows of a large triangle
+// that hold no sample in its columns: outside the rows it gives, every row's interval is empty
+// by the rule the triangle takes (double with its shared edges, or float), for triangles of
+// every size placed anywhere around the view, with nearly horizontal or vertical edges, shared
+// edges and vertices far beyond the screen. It must also pass over a good share of the rows of
+// the large triangles partly beside the view, or the row loop would gain nothing.
+TEST(RowsReachingColumns, NoRowOutsideHoldsASample) {
+    std::mt19937_64 rng(11);
+    const int width = 1283, height = 721;
+    long rows = 0, rows_outside = 0, large_rows = 0, large_rows_outside = 0, triangles_in_float = 0, triangles = 0;
+    for (double size : {3.0, 40.0, 500.0, 5000.0, 200000.0}) {
+        std::uniform_real_distribution<double> centre_x(-0.5 * width, 1.5 * width), centre_y(-0.5 * height, 1.5 * height);
+        std::uniform_real_distribution<double> offset(-size, size);
+        std::uniform_int_distribution<int> shared_bits(0, 7);
+        for (int trial = 0; trial < 3000; ++trial) {
+            ScreenTriangle tri;
+            const double cx = centre_x(rng), cy = centre_y(rng);
+            for (int k = 0; k < 3; ++k) {
+                tri.p[k] = {cx + offset(rng), cy + offset(rng)};
+                tri.d[k] = 1.0;
+            }
+            if (trial % 5 == 0) tri.p[1].y = tri.p[0].y + offset(rng) * 1e-5;  // nearly horizontal edges
+            if (trial % 7 == 1) tri.p[2].x = tri.p[0].x + offset(rng) * 1e-5;  // nearly vertical ones
+            if (trial % 3 == 2) tri.shared = std::uint8_t(shared_bits(rng));
+            RasterTriangle raster;
+            if (!setup_raster_triangle(tri, 1.0 / 1024.0, width, height, raster)) continue;
+            ++triangles;
+            triangles_in_float += raster.plane.float_rows;
+            int row_lo = 0, row_hi = -1;
+            const bool any = rows_reaching_columns(raster, row_lo, row_hi);
+            if (any) {
+                ASSERT_LE(raster.j0, row_lo);
+                ASSERT_LE(row_lo, row_hi);
+                ASSERT_LE(row_hi, raster.j1);
+            }
+            for (int row = raster.j0; row <= raster.j1; ++row) {
+                const bool outside = !any || row < row_lo || row > row_hi;
+                ++rows;
+                rows_outside += outside;
+                if (size >= 500.0) ++large_rows, large_rows_outside += outside;
+                if (!outside) continue;
+                std::int32_t first = 0, last = -1;
+                if (raster.plane.float_rows) float_sample_row_interval(raster.float_edges, row, raster.i0, raster.i1, first, last);
+                else sample_row_interval(raster.edges, row, raster.i0, raster.i1, first, last);
+                ASSERT_GT(first, last) << "row " << row << " holds samples [" << first << ", " << last << "] outside rows [" << row_lo
+                                       << ", " << row_hi << "] (size " << size << ", trial " << trial << ", float " << raster.plane.float_rows
+                                       << ")";
+            }
+        }
+    }
+    std::printf("[ rows     ] %ld triangles (%ld by the float rule): %ld of %ld rows passed over, %ld of %ld of those 500 samples "
+                "across and more\n",
+                triangles, triangles_in_float, rows_outside, rows, large_rows_outside, large_rows);
+    EXPECT_GT(triangles_in_float, triangles / 4);
+    EXPECT_GT(large_rows_outside, large_rows / 10);
 }
 
 // The float rule on a real scene against Embree: fzk_haus's triangles drawn without their

@@ -216,6 +216,17 @@ struct RasterTriangle {
 };
 static_assert(sizeof(RasterTriangle) == 192, "the two-thread render copies every binned triangle");
 
+// The sample rows [row_lo, row_hi] within the triangle's [j0, j1] outside which no row holds a
+// sample in its columns [i0, i1] (false: none does). The row rule (sample_row_interval, or
+// float_sample_row_interval for float_rows) bounds a row's samples by each edge's boundary x_k,
+// a linear function of the row: a lower edge's first sample is past x_k - 1/2 and an upper
+// edge's last before it, so a row where a lower edge's boundary lies right of i1 + 1/2 or an
+// upper one's left of i0 + 1/2 has none, whatever the other edges. Solved for the rows in
+// double with a margin of a sample beyond the rules' roundings, then widened by a row on each
+// side. A large triangle partly beside the view spans rows its part in it does not reach: the
+// row loop skips them before computing their intervals. Rows inside may still be empty.
+bool rows_reaching_columns(const RasterTriangle& triangle, int& row_lo, int& row_hi);
+
 // The coverage threshold of an edge with sign-normalized normal (sa, sb): an inner margin of
 // edge_margin samples (times the normal's L1 length) on a silhouette edge, none on a shared one.
 inline double edge_threshold(bool shared, double edge_margin, double sa, double sb) {
