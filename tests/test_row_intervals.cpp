@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <tuple>
 #include <cstdio>
@@ -111,9 +112,10 @@ TEST(FloatRowRule, SharedHorizontalAndFarEdgesKeepTheDoubleRule) {
     EXPECT_FALSE(setup(far));
 }
 
-// rows_reaching_columns, which the SIMD row loop uses to pass over the rows of a large triangle
-// that hold no sample in its columns: outside the rows it gives, every row's interval is empty
-// by the rule the triangle takes (double with its shared edges, or float), for triangles of
+// rows_reaching_columns, which the SIMD row loop and the occludee tests use to pass over the rows
+// of a large triangle that hold no sample in its columns: outside the rows it gives, every row's
+// interval is empty by the rule the triangle takes (double with its shared edges, or float, or
+// the occludee tests' outer edges pushed out by a pad), for triangles of
 // every size placed anywhere around the view, with nearly horizontal or vertical edges, shared
 // edges and vertices far beyond the screen. It must also pass over a good share of the rows of
 // the large triangles partly beside the view, or the row loop would gain nothing.
@@ -121,6 +123,8 @@ TEST(RowsReachingColumns, NoRowOutsideHoldsASample) {
     std::mt19937_64 rng(11);
     const int width = 1283, height = 721;
     long rows = 0, rows_outside = 0, large_rows = 0, large_rows_outside = 0, triangles_in_float = 0, triangles = 0;
+    long outer_rows = 0, outer_rows_outside = 0;
+    std::uniform_real_distribution<double> pad_samples(0.0, 3.0);
     for (double size : {3.0, 40.0, 500.0, 5000.0, 200000.0}) {
         std::uniform_real_distribution<double> centre_x(-0.5 * width, 1.5 * width), centre_y(-0.5 * height, 1.5 * height);
         std::uniform_real_distribution<double> offset(-size, size);
@@ -135,6 +139,31 @@ TEST(RowsReachingColumns, NoRowOutsideHoldsASample) {
             if (trial % 5 == 0) tri.p[1].y = tri.p[0].y + offset(rng) * 1e-5;  // nearly horizontal edges
             if (trial % 7 == 1) tri.p[2].x = tri.p[0].x + offset(rng) * 1e-5;  // nearly vertical ones
             if (trial % 3 == 2) tri.shared = std::uint8_t(shared_bits(rng));
+            // The occludee tests' outer edges: pushed out by a pad's support, over the padded box.
+            OrientedTriangle oriented;
+            if (orient_triangle(tri, oriented)) {
+                TriangleEdges outer = edge_functions(oriented);
+                const double pad = pad_samples(rng);
+                for (int k = 0; k < 3; ++k) {
+                    outer.shared[k] = false;
+                    outer.threshold[k] = -(std::abs(outer.sa[k]) + std::abs(outer.sb[k])) * pad;
+                }
+                const glm::dvec2* v = oriented.v;
+                int i0, i1, j0, j1;
+                sample_span(std::min({v[0].x, v[1].x, v[2].x}) - pad, std::max({v[0].x, v[1].x, v[2].x}) + pad, width, i0, i1);
+                sample_span(std::min({v[0].y, v[1].y, v[2].y}) - pad, std::max({v[0].y, v[1].y, v[2].y}) + pad, height, j0, j1);
+                int row_lo = 0, row_hi = -1;
+                const bool any = rows_reaching_columns(outer, i0, i1, j0, j1, row_lo, row_hi);
+                for (int row = j0; row <= j1 && i0 <= i1; ++row) {
+                    const bool outside = !any || row < row_lo || row > row_hi;
+                    outer_rows += 1, outer_rows_outside += outside;
+                    if (!outside) continue;
+                    std::int32_t first = 0, last = -1;
+                    sample_row_interval(outer, row, i0, i1, first, last);
+                    ASSERT_GT(first, last) << "outer edges: row " << row << " holds samples [" << first << ", " << last << "] outside rows ["
+                                           << row_lo << ", " << row_hi << "] (size " << size << ", trial " << trial << ")";
+                }
+            }
             RasterTriangle raster;
             if (!setup_raster_triangle(tri, 1.0 / 1024.0, width, height, raster)) continue;
             ++triangles;
@@ -162,10 +191,11 @@ TEST(RowsReachingColumns, NoRowOutsideHoldsASample) {
         }
     }
     std::printf("[ rows     ] %ld triangles (%ld by the float rule): %ld of %ld rows passed over, %ld of %ld of those 500 samples "
-                "across and more\n",
-                triangles, triangles_in_float, rows_outside, rows, large_rows_outside, large_rows);
+                "across and more; outer edges %ld of %ld\n",
+                triangles, triangles_in_float, rows_outside, rows, large_rows_outside, large_rows, outer_rows_outside, outer_rows);
     EXPECT_GT(triangles_in_float, triangles / 4);
     EXPECT_GT(large_rows_outside, large_rows / 10);
+    EXPECT_GT(outer_rows_outside, outer_rows / 10);
 }
 
 // The float rule on a real scene against Embree: fzk_haus's triangles drawn without their

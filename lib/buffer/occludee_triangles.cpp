@@ -266,10 +266,17 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
     const detail::RowIntervalsKernel row_intervals = has_area ? kernels.raster.row_intervals : nullptr;
     constexpr int kChunkRows = detail::kChunkSubtileRows * kH;
     std::int32_t chunk_first[kChunkRows + detail::kMaxSimdLanes], chunk_last[kChunkRows + detail::kMaxSimdLanes];
-    for (int ty = j0 / kH, chunk_ty = ty; ty <= j1 / kH; ++ty) {
-        if (row_intervals && (ty == j0 / kH || ty - chunk_ty == detail::kChunkSubtileRows)) {
+    // A triangle whose columns the view's edge cuts: only the rows that can hold a sample in them
+    // (rows_reaching_columns, the row loop's bound, for the outer edges here). The rows it leaves
+    // out hold no sample: their intervals are empty, and they would add nothing to the counts.
+    int row_lo = j0, row_hi = j1;
+    if (has_area && (i0 == 0 || i1 == sample_width - 1) && j1 - j0 >= 4 * kH &&
+        !detail::rows_reaching_columns(edges, i0, i1, j0, j1, row_lo, row_hi))
+        return;
+    for (int ty = row_lo / kH, chunk_ty = ty; ty <= row_hi / kH; ++ty) {
+        if (row_intervals && (ty == row_lo / kH || ty - chunk_ty == detail::kChunkSubtileRows)) {
             chunk_ty = ty;
-            const int chunk_rows = std::min(detail::kChunkSubtileRows, j1 / kH - ty + 1) * kH;
+            const int chunk_rows = std::min(detail::kChunkSubtileRows, row_hi / kH - ty + 1) * kH;
             row_intervals(edges, i0, i1, j0, j1, ty * kH, chunk_rows, chunk_first, chunk_last);
         }
         std::int32_t row_first[kH], row_last[kH];

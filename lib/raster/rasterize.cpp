@@ -207,55 +207,68 @@ void float_sample_row_interval(const FloatRowEdges& e, int row, int i0, int i1, 
     last = std::int32_t(hi);
 }
 
-bool rows_reaching_columns(const RasterTriangle& triangle, int& row_lo, int& row_hi) {
-    const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
-    row_lo = j0, row_hi = j1;
-    if (j0 > j1 || i0 > i1) return false;
-    double lo = double(j0), hi = double(j1);
-    // Boundary value(row) = alpha + beta row, needed at most `limit` (a lower edge) or at
-    // least (an upper one) for the row to hold a sample. `magnitude` bounds the terms the rule
-    // rounds; `relative` is its rounding per term, so margin covers the rule's value and ours.
-    const auto constrain = [&](double alpha, double beta, double limit, bool at_most, double magnitude, double relative) {
+namespace {
+
+// Narrows the rows [lo, hi] to those where a boundary value(row) = alpha + beta row is at most
+// `limit` (a lower edge's) or at least (an upper edge's), as a row with a sample needs: by a
+// margin of a sample plus `relative` times the magnitude of the terms the rules round.
+struct RowBounds {
+    double lo, hi;
+    void constrain(double alpha, double beta, double limit, bool at_most, double magnitude, double relative) {
         const double margin = 1.0 + relative * (magnitude + std::abs(limit));
-        // As b row <= r.
-        const double b = at_most ? beta : -beta;
+        const double b = at_most ? beta : -beta;  // as b row <= r
         const double r = at_most ? limit + margin - alpha : alpha - limit + margin;
         if (!(std::isfinite(b) && std::isfinite(r))) return;
         if (b > 0x1.0p-20) hi = std::min(hi, r / b);
         else if (b < -0x1.0p-20) lo = std::max(lo, r / b);
         // A nearly vertical boundary bounds no rows here (its rows' columns hardly move).
-    };
-    if (triangle.plane.float_rows) {
-        const FloatRowEdges& e = triangle.float_edges;
-        for (int k = 0; k < 3; ++k) {
-            // v = base - slope ((row - row_origin) - y_offset), in float; a lower edge's first
-            // sample is floor(v) + 1 + ox_int, an upper one's last ceil(v) - 1 + ox_int.
-            const double slope = double(e.slope[k]), origin = double(e.row_origin[k]) + double(e.y_offset[k]);
-            const double alpha = double(e.base[k]) + slope * origin, beta = -slope;
-            const double reach = std::max(std::abs(double(j0) - origin), std::abs(double(j1) - origin)) + 1.0;
-            const double magnitude = std::abs(double(e.base[k])) + std::abs(slope) * reach;
-            const double ox_int = e.lower[k] ? double(e.column_shift[k]) - 1.0 : double(e.column_shift[k]) + 1.0;
-            if (e.lower[k]) constrain(alpha, beta, double(i1) - ox_int, true, magnitude, 0x1.0p-20);
-            else constrain(alpha, beta, double(i0) - ox_int, false, magnitude, 0x1.0p-20);
-        }
-    } else {
-        const TriangleEdges& e = triangle.edges;
-        for (int k = 0; k < 3; ++k) {
-            if (!(e.sa[k] != 0.0)) continue;  // horizontal: bounds rows, which [j0, j1] does
-            // x = ox + (threshold - sb (row + 1/2 - oy)) / sa; first > x - 1/2 on a lower edge
-            // (sa > 0), last < x - 1/2 on an upper one.
-            const double slope = e.sb[k] * e.inverse_sa[k];
-            const double alpha = e.ox[k] + (e.threshold[k] - e.sb[k] * (0.5 - e.oy[k])) * e.inverse_sa[k] - 0.5, beta = -slope;
-            const double reach = std::max(std::abs(double(j0)), std::abs(double(j1))) + std::abs(e.oy[k]) + 1.0;
-            const double magnitude = std::abs(e.ox[k]) + std::abs(e.threshold[k] * e.inverse_sa[k]) + std::abs(slope) * reach + 1.0;
-            constrain(alpha, beta, e.sa[k] > 0.0 ? double(i1) : double(i0), e.sa[k] > 0.0, magnitude, 0x1.0p-40);
-        }
     }
-    if (!(lo <= hi)) return false;  // no row (NaN bounds were passed over above)
-    // Whole rows, widened by one on each side; within [j0, j1] (so the conversions are exact).
-    row_lo = int(std::max(double(j0), std::floor(lo) - 1.0));
-    row_hi = int(std::min(double(j1), std::ceil(hi) + 1.0));
-    return row_lo <= row_hi;
+    // Whole rows, widened by one on each side, within [j0, j1] (so the conversions are exact).
+    bool rows(int j0, int j1, int& row_lo, int& row_hi) const {
+        if (!(lo <= hi)) return false;  // no row (NaN bounds were passed over)
+        row_lo = int(std::max(double(j0), std::floor(lo) - 1.0));
+        row_hi = int(std::min(double(j1), std::ceil(hi) + 1.0));
+        return row_lo <= row_hi;
+    }
+};
+
+}  // namespace
+
+bool rows_reaching_columns(const TriangleEdges& e, int i0, int i1, int j0, int j1, int& row_lo, int& row_hi) {
+    row_lo = j0, row_hi = j1;
+    if (j0 > j1 || i0 > i1) return false;
+    RowBounds bounds{double(j0), double(j1)};
+    for (int k = 0; k < 3; ++k) {
+        if (!(e.sa[k] != 0.0)) continue;  // horizontal: bounds rows, which [j0, j1] does
+        // x = ox + (threshold - sb (row + 1/2 - oy)) / sa; first > x - 1/2 on a lower edge
+        // (sa > 0), last < x - 1/2 on an upper one.
+        const double slope = e.sb[k] * e.inverse_sa[k];
+        const double alpha = e.ox[k] + (e.threshold[k] - e.sb[k] * (0.5 - e.oy[k])) * e.inverse_sa[k] - 0.5;
+        const double reach = std::max(std::abs(double(j0)), std::abs(double(j1))) + std::abs(e.oy[k]) + 1.0;
+        const double magnitude = std::abs(e.ox[k]) + std::abs(e.threshold[k] * e.inverse_sa[k]) + std::abs(slope) * reach + 1.0;
+        bounds.constrain(alpha, -slope, e.sa[k] > 0.0 ? double(i1) : double(i0), e.sa[k] > 0.0, magnitude, 0x1.0p-40);
+    }
+    return bounds.rows(j0, j1, row_lo, row_hi);
+}
+
+bool rows_reaching_columns(const RasterTriangle& triangle, int& row_lo, int& row_hi) {
+    const int i0 = triangle.i0, i1 = triangle.i1, j0 = triangle.j0, j1 = triangle.j1;
+    if (!triangle.plane.float_rows) return rows_reaching_columns(triangle.edges, i0, i1, j0, j1, row_lo, row_hi);
+    row_lo = j0, row_hi = j1;
+    if (j0 > j1 || i0 > i1) return false;
+    RowBounds bounds{double(j0), double(j1)};
+    const FloatRowEdges& e = triangle.float_edges;
+    for (int k = 0; k < 3; ++k) {
+        // v = base - slope ((row - row_origin) - y_offset), in float; a lower edge's first
+        // sample is floor(v) + 1 + ox_int, an upper one's last ceil(v) - 1 + ox_int.
+        const double slope = double(e.slope[k]), origin = double(e.row_origin[k]) + double(e.y_offset[k]);
+        const double alpha = double(e.base[k]) + slope * origin;
+        const double reach = std::max(std::abs(double(j0) - origin), std::abs(double(j1) - origin)) + 1.0;
+        const double magnitude = std::abs(double(e.base[k])) + std::abs(slope) * reach;
+        const double ox_int = e.lower[k] ? double(e.column_shift[k]) - 1.0 : double(e.column_shift[k]) + 1.0;
+        bounds.constrain(alpha, -slope, (e.lower[k] ? double(i1) : double(i0)) - ox_int, e.lower[k], magnitude, 0x1.0p-20);
+    }
+    return bounds.rows(j0, j1, row_lo, row_hi);
 }
 
 bool hidden_behind_reference_layer(const SubtilePlanes& planes, int tx0, int tx1, int ty0, int ty1, float nearest) {

@@ -226,6 +226,9 @@ static_assert(sizeof(RasterTriangle) == 192, "the two-thread render copies every
 // side. A large triangle partly beside the view spans rows its part in it does not reach: the
 // row loop skips them before computing their intervals. Rows inside may still be empty.
 bool rows_reaching_columns(const RasterTriangle& triangle, int& row_lo, int& row_hi);
+// The same for the double rule's edges (any thresholds: the occludee tests' outer ones too) over
+// columns [i0, i1] and rows [j0, j1].
+bool rows_reaching_columns(const TriangleEdges& edges, int i0, int i1, int j0, int j1, int& row_lo, int& row_hi);
 
 // The coverage threshold of an edge with sign-normalized normal (sa, sb): an inner margin of
 // edge_margin samples (times the normal's L1 length) on a silhouette edge, none on a shared one.
