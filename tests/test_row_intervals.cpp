@@ -58,6 +58,28 @@ void compare_rules(const ScreenTriangle& tri, int width, int height, RuleCompari
     }
 }
 
+// Random triangles: three vertices within `offset` of a centre drawn from centre_x and
+// centre_y; trials with trial % horizontal_every == 0 get a nearly horizontal edge (its
+// endpoints' y apart by flatness times an offset), those with trial % vertical_every == 1 a
+// nearly vertical one.
+struct Flatness {
+    int horizontal_every, vertical_every;
+    double flatness;
+};
+ScreenTriangle random_triangle(std::mt19937_64& rng, std::uniform_real_distribution<double>& centre_x,
+                               std::uniform_real_distribution<double>& centre_y, std::uniform_real_distribution<double>& offset, int trial,
+                               const Flatness& f) {
+    ScreenTriangle tri;
+    const double cx = centre_x(rng), cy = centre_y(rng);
+    for (int k = 0; k < 3; ++k) {
+        tri.p[k] = {cx + offset(rng), cy + offset(rng)};
+        tri.d[k] = 1.0;
+    }
+    if (trial % f.horizontal_every == 0) tri.p[1].y = tri.p[0].y + offset(rng) * f.flatness;
+    if (trial % f.vertical_every == 1) tri.p[2].x = tri.p[0].x + offset(rng) * f.flatness;
+    return tri;
+}
+
 TEST(FloatRowRule, LiesInsideTheDoubleRuleOnRandomTriangles) {
     std::mt19937_64 rng(7);
     const int width = 1920, height = 1080;
@@ -68,14 +90,7 @@ TEST(FloatRowRule, LiesInsideTheDoubleRuleOnRandomTriangles) {
         std::uniform_real_distribution<double> centre_x(-0.2 * width, 1.2 * width), centre_y(-0.2 * height, 1.2 * height);
         std::uniform_real_distribution<double> offset(-size, size);
         for (int trial = 0; trial < 4000; ++trial) {
-            ScreenTriangle tri;
-            const double cx = centre_x(rng), cy = centre_y(rng);
-            for (int k = 0; k < 3; ++k) {
-                tri.p[k] = {cx + offset(rng), cy + offset(rng)};
-                tri.d[k] = 1.0;
-            }
-            if (trial % 4 == 0) tri.p[1].y = tri.p[0].y + offset(rng) * 1e-4;  // nearly horizontal edges
-            if (trial % 8 == 1) tri.p[2].x = tri.p[0].x + offset(rng) * 1e-4;  // nearly vertical ones
+            const ScreenTriangle tri = random_triangle(rng, centre_x, centre_y, offset, trial, {4, 8, 1e-4});
             compare_rules(tri, width, height, trial % 4 == 0 ? flat : size <= 300.0 ? on_screen : c);
             if (HasFatalFailure()) return;
         }
@@ -130,14 +145,7 @@ TEST(RowsReachingColumns, NoRowOutsideHoldsASample) {
         std::uniform_real_distribution<double> offset(-size, size);
         std::uniform_int_distribution<int> shared_bits(0, 7);
         for (int trial = 0; trial < 3000; ++trial) {
-            ScreenTriangle tri;
-            const double cx = centre_x(rng), cy = centre_y(rng);
-            for (int k = 0; k < 3; ++k) {
-                tri.p[k] = {cx + offset(rng), cy + offset(rng)};
-                tri.d[k] = 1.0;
-            }
-            if (trial % 5 == 0) tri.p[1].y = tri.p[0].y + offset(rng) * 1e-5;  // nearly horizontal edges
-            if (trial % 7 == 1) tri.p[2].x = tri.p[0].x + offset(rng) * 1e-5;  // nearly vertical ones
+            ScreenTriangle tri = random_triangle(rng, centre_x, centre_y, offset, trial, {5, 7, 1e-5});
             if (trial % 3 == 2) tri.shared = std::uint8_t(shared_bits(rng));
             // The occludee tests' outer edges: pushed out by a pad's support, over the padded box.
             OrientedTriangle oriented;
