@@ -328,6 +328,29 @@ void barycentrics(const long double sx[3], const long double sy[3], long double 
     l2 = 1 - l0 - l1;
 }
 
+// An occludee given as one triangle of a Soup, on a sample grid of sw x sh: its corners in
+// samples and their w, in long double from the floats given, and its w at a sample's centre.
+struct ScreenOccludee {
+    long double sx[3], sy[3], w[3], area;
+    ScreenOccludee(const Soup& occludee, int sw, int sh) {
+        const std::vector<float>& v = occludee.xyw;
+        for (int k = 0; k < 3; ++k) {
+            w[k] = v[std::size_t(3 * k + 2)];
+            sx[k] = ((long double)v[std::size_t(3 * k)] / w[k] + 1) * 0.5L * sw;
+            sy[k] = (1 - (long double)v[std::size_t(3 * k + 1)] / w[k]) * 0.5L * sh;
+        }
+        area = edge(sx[0], sy[0], sx[1], sy[1], sx[2], sy[2]);
+    }
+    // Whether sample (i, j)'s centre lies inside (area != 0), and the occludee's w there.
+    bool w_at(int i, int j, long double& occludee_w) const {
+        long double l0, l1, l2;
+        barycentrics(sx, sy, area, i + 0.5L, j + 0.5L, l0, l1, l2);
+        if (l0 < 0 || l1 < 0 || l2 < 0) return false;
+        occludee_w = 1 / (l0 / w[0] + l1 / w[1] + l2 / w[2]);
+        return true;
+    }
+};
+
 // Random occluders and random occludee triangles: whenever the occludee is at or in front of
 // the buffer's conservative depth at a sample centre inside it (exact, in long double, from the
 // floats given), test_triangles must not hide it. And it should hide most of those the buffer
@@ -354,32 +377,25 @@ TEST(OccludeeTriangles, NeverHidesATriangleSeenAtASample) {
                 occludee.add(cx + r * (pos(rng) / 1.3f), cy + r * (pos(rng) / 1.3f), far_depth(rng) + 10.0f, cx + r * (pos(rng) / 1.3f),
                              cy + r * (pos(rng) / 1.3f), far_depth(rng) + 10.0f, cx + r * (pos(rng) / 1.3f), cy + r * (pos(rng) / 1.3f),
                              far_depth(rng) + 10.0f);
-                const std::vector<float>& v = occludee.xyw;
-                long double sx[3], sy[3], w[3];
-                for (int k = 0; k < 3; ++k) {
-                    w[k] = v[std::size_t(3 * k + 2)];
-                    sx[k] = ((long double)v[std::size_t(3 * k)] / w[k] + 1) * 0.5L * sw;
-                    sy[k] = (1 - (long double)v[std::size_t(3 * k + 1)] / w[k]) * 0.5L * sh;
-                }
-                const long double area = edge(sx[0], sy[0], sx[1], sy[1], sx[2], sy[2]);
-                if (area == 0) continue;
+                const ScreenOccludee o(occludee, sw, sh);
+                const long double* sx = o.sx;
+                const long double* sy = o.sy;
+                if (o.area == 0) continue;
                 // Room: within a sample of its bounding box, every sample has an occluder 1 %
                 // nearer than the triangle's nearest vertex.
-                const long double nearest_w = std::min({w[0], w[1], w[2]});
+                const long double nearest_w = std::min({o.w[0], o.w[1], o.w[2]});
                 const long double box_x0 = std::min({sx[0], sx[1], sx[2]}) - 1, box_x1 = std::max({sx[0], sx[1], sx[2]}) + 1;
                 const long double box_y0 = std::min({sy[0], sy[1], sy[2]}) - 1, box_y1 = std::max({sy[0], sy[1], sy[2]}) + 1;
                 bool seen = false, hidden_with_room = true, any_sample = false;
                 for (int j = 0; j < sh; ++j)
                     for (int i = 0; i < sw; ++i) {
                         const long double px = i + 0.5L, py = j + 0.5L;
-                        long double l0, l1, l2;
-                        barycentrics(sx, sy, area, px, py, l0, l1, l2);
                         const long double occluder_w = bound_w[std::size_t(j) * std::size_t(sw) + std::size_t(i)];
                         if (px >= box_x0 && px <= box_x1 && py >= box_y0 && py <= box_y1)
                             hidden_with_room = hidden_with_room && occluder_w * 1.01L < nearest_w;
-                        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
+                        long double occludee_w;
+                        if (!o.w_at(i, j, occludee_w)) continue;
                         any_sample = true;
-                        const long double occludee_w = 1 / (l0 / w[0] + l1 / w[1] + l2 / w[2]);
                         seen = seen || !(occluder_w < occludee_w);
                     }
                 const Visibility v_test = buffer.test_triangles(occludee.input()).visibility;
@@ -399,6 +415,51 @@ TEST(OccludeeTriangles, NeverHidesATriangleSeenAtASample) {
                 hidden_by_buffer, hidden_by_test);
     ASSERT_GT(hidden_by_buffer, 50);
     EXPECT_EQ(hidden_by_test, hidden_by_buffer);
+}
+
+// Large occludee triangles reaching far beyond a side of the view, whose part in it spans fewer
+// rows than their box (the occludee tests then pass over the rest: rows_reaching_columns), among
+// random occluders: whenever one is seen at a sample, test_triangles answers visible.
+TEST(OccludeeTriangles, NeverHidesALargeTriangleReachingBeyondTheView) {
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<float> pos(-1.3f, 1.3f), far_pos(-8.0f, 8.0f), beyond(1.5f, 9.0f), depth(2.0f, 40.0f);
+    int seen_count = 0, trials = 0;
+    for (bool sample_depth : {false, true}) {
+        OcclusionBuffer buffer = make_buffer(61, 47, 1, sample_depth);
+        const int sw = buffer.sample_width(), sh = buffer.sample_height();
+        for (int scene = 0; scene < 20; ++scene) {
+            buffer.clear();
+            Soup occluders;
+            for (int k = 0; k < 6; ++k)
+                occluders.add(pos(rng) * 2, pos(rng) * 2, depth(rng), pos(rng) * 2, pos(rng) * 2, depth(rng), pos(rng) * 2, pos(rng) * 2,
+                              depth(rng));
+            buffer.render(occluders.input());
+            std::vector<float> bound_w;
+            buffer.read_depth(bound_w);
+            for (int t = 0; t < 60; ++t) {
+                // Two corners beyond the left or the right side, one in the view.
+                const float side = (rng() & 1u) ? 1.0f : -1.0f;
+                Soup occludee;
+                occludee.add(side * beyond(rng), far_pos(rng), depth(rng) + 10.0f, side * beyond(rng), far_pos(rng), depth(rng) + 10.0f,
+                             pos(rng), pos(rng), depth(rng) + 10.0f);
+                const ScreenOccludee o(occludee, sw, sh);
+                if (o.area == 0) continue;
+                bool seen = false;
+                for (int j = 0; j < sh && !seen; ++j)
+                    for (int i = 0; i < sw && !seen; ++i) {
+                        long double occludee_w;
+                        seen = o.w_at(i, j, occludee_w) && !(bound_w[std::size_t(j) * std::size_t(sw) + std::size_t(i)] < occludee_w);
+                    }
+                ++trials;
+                if (!seen) continue;
+                ++seen_count;
+                ASSERT_EQ(buffer.test_triangles(occludee.input()).visibility, Visibility::visible)
+                    << "hid a triangle seen at a sample (per-sample depth " << sample_depth << ", scene " << scene << ", trial " << t << ")";
+            }
+        }
+    }
+    std::printf("large occludee triangles: %d trials, %d seen somewhere\n", trials, seen_count);
+    EXPECT_GT(seen_count, 200);
 }
 
 // Every instruction set gives the scalar reference's answers and counts: the row intervals of
