@@ -266,11 +266,11 @@ void count_triangle(const OuterBounds& b, const PlaneError& depth_error, const d
     const detail::RowIntervalsKernel row_intervals = has_area ? kernels.raster.row_intervals : nullptr;
     constexpr int kChunkRows = detail::kChunkSubtileRows * kH;
     std::int32_t chunk_first[kChunkRows + detail::kMaxSimdLanes], chunk_last[kChunkRows + detail::kMaxSimdLanes];
-    // A triangle whose columns the view's edge cuts: only the rows that can hold a sample in them
-    // (rows_reaching_columns, the row loop's bound, for the outer edges here). The rows it leaves
-    // out hold no sample: their intervals are empty, and they would add nothing to the counts.
+    // Only the rows that can hold a sample in the triangle's columns (the row loop's bound, for
+    // the outer edges here). The rows it leaves out hold no sample: their intervals are empty,
+    // and they would add nothing to the counts.
     int row_lo = j0, row_hi = j1;
-    if (has_area && (i0 == 0 || i1 == sample_width - 1) && j1 - j0 >= 4 * kH &&
+    if (has_area && detail::rows_worth_bounding(i0, i1, j0, j1, sample_width) &&
         !detail::rows_reaching_columns(edges, i0, i1, j0, j1, row_lo, row_hi))
         return;
     for (int ty = row_lo / kH, chunk_ty = ty; ty <= row_hi / kH; ++ty) {

@@ -229,6 +229,13 @@ bool rows_reaching_columns(const RasterTriangle& triangle, int& row_lo, int& row
 // The same for the double rule's edges (any thresholds: the occludee tests' outer ones too) over
 // columns [i0, i1] and rows [j0, j1].
 bool rows_reaching_columns(const TriangleEdges& edges, int i0, int i1, int j0, int j1, int& row_lo, int& row_hi);
+// Whether rows_reaching_columns may pay for a triangle's box of samples [i0, i1] x [j0, j1] in a
+// view sample_width wide: only where the view's side cut its columns (elsewhere every row of the
+// box reaches them) and it spans 16 sample rows or more (on the castle's walk, bounding every
+// triangle cost 1.25 % more instructions than it saved).
+inline bool rows_worth_bounding(int i0, int i1, int j0, int j1, int sample_width) {
+    return (i0 == 0 || i1 == sample_width - 1) && j1 - j0 >= 4 * kSubtileHeight;
+}
 
 // The coverage threshold of an edge with sign-normalized normal (sa, sb): an inner margin of
 // edge_margin samples (times the normal's L1 length) on a silhouette edge, none on a shared one.

@@ -486,13 +486,11 @@ std::uint64_t RasterizeRows(const RasterTarget& t, const RasterTriangle& triangl
     const PreparedTriangle& tri = triangle.plane;
     const int i0 = triangle.i0, i1 = triangle.i1, j1 = triangle.j1;
     constexpr int kH = kSubtileHeight;
-    // Only the rows that can hold a sample in the triangle's columns (rows_reaching_columns; the
-    // reference takes them all, and the tests hold the two to the same bits), for a triangle
-    // whose columns the view's edge cut (elsewhere every row of its box reaches them) and with
-    // rows enough to pay for the bound (the castle's walk took 1 % more instructions with it
-    // for every triangle, oa_thor's 1.5 % fewer).
+    // Only the rows that can hold a sample in the triangle's columns (rows_reaching_columns,
+    // where rows_worth_bounding; the reference takes them all, and the tests hold the two to
+    // the same bits).
     int row_lo = triangle.j0, row_hi = j1, ty_first, ty_last;
-    if ((i0 == 0 || i1 == t.sample_width - 1) && j1 - triangle.j0 >= 4 * kH && !rows_reaching_columns(triangle, row_lo, row_hi)) return 0;
+    if (rows_worth_bounding(i0, i1, triangle.j0, j1, t.sample_width) && !rows_reaching_columns(triangle, row_lo, row_hi)) return 0;
     if (!subtile_rows_within(row_lo, row_hi, t.row_begin, t.row_end, ty_first, ty_last)) return 0;
     const auto sample_lane = hn::Iota(hn::CappedTag<std::int32_t, kMaxSimdLanes>(), 0);
 
